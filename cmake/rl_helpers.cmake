@@ -1,0 +1,31 @@
+# rl_add_library(name SOURCES ... DEPS ...): a static library rl_<name> with alias rl::<name>.
+function(rl_add_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_library(rl_${name} STATIC ${ARG_SOURCES})
+  add_library(rl::${name} ALIAS rl_${name})
+  target_include_directories(rl_${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  target_link_libraries(rl_${name} PUBLIC ${ARG_DEPS})
+  rl_set_warnings(rl_${name})
+endfunction()
+
+# rl_add_executable(name SOURCES ... DEPS ...): a program, written to bin/ of the build tree.
+function(rl_add_executable name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${PROJECT_BINARY_DIR}/bin)
+  rl_set_warnings(${name})
+endfunction()
+
+# rl_add_test(name SOURCES ... DEPS ... [LABELS ...]): a GoogleTest unit test, label "unit".
+function(rl_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  rl_set_warnings(${name})
+  if(NOT ARG_LABELS)
+    set(ARG_LABELS unit)
+  endif()
+  gtest_discover_tests(${name} PROPERTIES LABELS "${ARG_LABELS}"
+                       ENVIRONMENT "LCM_DEFAULT_URL=memq://" DISCOVERY_TIMEOUT 60)
+endfunction()

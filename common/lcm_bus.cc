@@ -1,0 +1,95 @@
+#include "common/lcm_bus.h"
+
+#include <poll.h>
+
+#include <cstdio>
+#include <stdexcept>
+
+namespace rl {
+namespace {
+
+std::unique_ptr<lcm::LCM> OpenLcm(const std::string& url) {
+  auto lcm = std::make_unique<lcm::LCM>(url);
+  if (!lcm->good()) {
+    throw std::runtime_error(
+        "cannot start LCM on '" + url +
+        "' (is there a multicast route? e.g. ip route add 224.0.0.0/4 dev lo)");
+  }
+  return lcm;
+}
+
+// Logs the first drops and then every 1000th, so a flood of bad messages cannot flood the log.
+bool ShouldLog(int64_t n) { return n < 10 || n % 1000 == 0; }
+
+}  // namespace
+
+Bus::Bus(BusConfig config) : config_(std::move(config)) {
+  main_ = OpenLcm(config_.url);
+  bulk_ = OpenLcm(config_.bulk_url);
+}
+
+Bus::~Bus() = default;
+
+void Bus::SubscribeRaw(const std::string& channel, Port port,
+                       std::function<void(const uint8_t*, size_t)> on_bytes) {
+  auto sub = std::make_unique<RawSubscription>(RawSubscription{channel, std::move(on_bytes), this});
+  lcm::Subscription* s =
+      lcm(port).subscribeFunction<RawSubscription*>(channel, &Bus::OnRaw, sub.get());
+  if (s == nullptr) throw std::runtime_error("cannot subscribe to " + channel);
+  s->setQueueCapacity(config_.queue_capacity);
+  subscriptions_.push_back(std::move(sub));
+}
+
+void Bus::OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/,
+                RawSubscription* sub) {
+  try {
+    sub->on_bytes(static_cast<const uint8_t*>(rbuf->data), rbuf->data_size);
+  } catch (...) {
+    // Never let an exception cross LCM's C code.
+    ++sub->bus->counters_.invalid;
+  }
+}
+
+bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header) {
+  if (header.run_id != config_.run_id) {
+    ++counters_.foreign;
+    LogDrop(channel, "foreign", "another run's id");
+    return false;
+  }
+  // Count gaps in the sender's sequence; a sequence that goes back means the sender restarted.
+  auto [it, inserted] = last_seq_.try_emplace({channel, header.sender}, header.seq);
+  if (!inserted) {
+    if (header.seq > it->second + 1) counters_.lost += header.seq - it->second - 1;
+    it->second = header.seq;
+  }
+  return true;
+}
+
+void Bus::LogDrop(const std::string& channel, const char* kind, const char* reason) {
+  if (ShouldLog(drops_logged_++)) {
+    std::fprintf(stderr, "[%s] dropped a %s message on %s: %s\n", config_.sender.c_str(), kind,
+                 channel.c_str(), reason);
+  }
+}
+
+int Bus::Handle(int timeout_ms) {
+  pollfd fds[2] = {{main_->getFileno(), POLLIN, 0}, {bulk_->getFileno(), POLLIN, 0}};
+  int dispatched = 0;
+  int wait = timeout_ms;
+  // Dispatch until both queues are empty; bounded so that a flood cannot starve the caller.
+  for (int round = 0; round < 100000; ++round) {
+    if (poll(fds, 2, wait) <= 0) break;
+    wait = 0;
+    if (fds[0].revents & POLLIN) {
+      main_->handle();
+      ++dispatched;
+    }
+    if (fds[1].revents & POLLIN) {
+      bulk_->handle();
+      ++dispatched;
+    }
+  }
+  return dispatched;
+}
+
+}  // namespace rl

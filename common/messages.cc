@@ -1,0 +1,213 @@
+#include "common/messages.h"
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+namespace rl {
+namespace {
+
+// Reads big-endian LCM fields from a buffer, remembering whether anything ran past its end.
+class Reader {
+ public:
+  Reader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
+
+  bool Skip(int64_t n) {
+    if (n < 0 || static_cast<uint64_t>(n) > size_ - pos_) return ok_ = false;
+    pos_ += static_cast<size_t>(n);
+    return true;
+  }
+  int64_t ReadInt(int bytes) {
+    if (static_cast<size_t>(bytes) > size_ - pos_) {
+      ok_ = false;
+      return 0;
+    }
+    uint64_t v = 0;
+    for (int i = 0; i < bytes; ++i) v = (v << 8) | data_[pos_ + static_cast<size_t>(i)];
+    pos_ += static_cast<size_t>(bytes);
+    // Sign-extend.
+    const int shift = 64 - 8 * bytes;
+    return static_cast<int64_t>(v << shift) >> shift;
+  }
+  // A string: int32 length including the terminating NUL, then the bytes.
+  void String() {
+    const int64_t len = ReadInt(4);
+    if (len < 1) ok_ = false;
+    if (ok_) Skip(len);
+  }
+  // A variable array of `count` elements of `bytes` each.
+  void Array(int64_t count, int bytes) {
+    if (count < 0 || count > kMaxArrayElements) ok_ = false;
+    if (ok_) Skip(count * bytes);
+  }
+  void Header() {
+    Skip(8);   // run_id
+    String();  // sender
+    Skip(16);  // seq, utime
+  }
+  bool ok() const { return ok_; }
+  bool at_end() const { return pos_ == size_; }
+
+ private:
+  const uint8_t* data_;
+  size_t size_;
+  size_t pos_ = 0;
+  bool ok_ = true;
+};
+
+const char* Finish(const Reader& r) {
+  if (!r.ok()) return "truncated or bad length";
+  if (!r.at_end()) return "trailing bytes";
+  return nullptr;
+}
+
+bool AllFinite(const std::vector<float>& v) {
+  for (float x : v) {
+    if (!std::isfinite(x)) return false;
+  }
+  return true;
+}
+
+bool HeaderOk(const rlmsg::header_t& h) { return !h.sender.empty() && h.seq >= 0; }
+
+}  // namespace
+
+const char* Prescan(const rlmsg::transition_batch_t*, const uint8_t* data, size_t size) {
+  Reader r(data, size);
+  r.Skip(8);  // fingerprint
+  r.Header();
+  r.Skip(4);  // actor_id
+  r.Skip(4);  // obs_size
+  const int64_t count = r.ReadInt(4);
+  const int64_t num_values = r.ReadInt(4);
+  r.Array(num_values, 4);  // obs
+  r.Array(num_values, 4);  // next_obs
+  r.Array(count, 4);       // action
+  r.Array(count, 4);       // reward
+  r.Array(count, 4);       // discount
+  r.Array(count, 8);       // episode_id
+  r.Array(count, 4);       // priority
+  return Finish(r);
+}
+
+const char* Prescan(const rlmsg::sample_batch_t*, const uint8_t* data, size_t size) {
+  Reader r(data, size);
+  r.Skip(8);
+  r.Header();
+  r.String();  // requester
+  r.Skip(8);   // request_id
+  r.Skip(4);   // obs_size
+  const int64_t count = r.ReadInt(4);
+  const int64_t num_values = r.ReadInt(4);
+  r.Array(num_values, 4);  // obs
+  r.Array(num_values, 4);  // next_obs
+  r.Array(count, 4);       // action
+  r.Array(count, 4);       // reward
+  r.Array(count, 4);       // discount
+  r.Array(count, 8);       // index
+  r.Array(count, 4);       // weight
+  r.Skip(16);              // replay_size, total_inserts
+  return Finish(r);
+}
+
+const char* Prescan(const rlmsg::weights_chunk_t*, const uint8_t* data, size_t size) {
+  Reader r(data, size);
+  r.Skip(8);
+  r.Header();
+  r.Skip(8);   // version
+  r.String();  // architecture
+  r.Skip(16);  // total_size, chunk_index, num_chunks, offset
+  const int64_t count = r.ReadInt(4);
+  r.Array(count, 4);  // data
+  r.Skip(8);          // crc32
+  return Finish(r);
+}
+
+const char* Validate(const rlmsg::transition_batch_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (m.obs_size <= 0 || m.count <= 0) return "empty batch";
+  if (static_cast<int64_t>(m.obs_size) * m.count != m.num_values) return "num_values mismatch";
+  if (m.actor_id < 0) return "negative actor_id";
+  if (!AllFinite(m.obs) || !AllFinite(m.next_obs) || !AllFinite(m.reward) ||
+      !AllFinite(m.discount) || !AllFinite(m.priority)) {
+    return "non-finite value";
+  }
+  for (int i = 0; i < m.count; ++i) {
+    if (m.action[static_cast<size_t>(i)] < 0) return "negative action";
+    const float d = m.discount[static_cast<size_t>(i)];
+    if (d < 0.0f || d > 1.0f) return "discount outside [0, 1]";
+    if (m.priority[static_cast<size_t>(i)] < 0.0f) return "negative priority";
+  }
+  return nullptr;
+}
+
+const char* Validate(const rlmsg::sample_request_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (m.batch_size <= 0 || m.batch_size > 65536) return "batch_size outside [1, 65536]";
+  return nullptr;
+}
+
+const char* Validate(const rlmsg::sample_batch_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (m.obs_size <= 0 || m.count <= 0) return "empty batch";
+  if (static_cast<int64_t>(m.obs_size) * m.count != m.num_values) return "num_values mismatch";
+  if (!AllFinite(m.obs) || !AllFinite(m.next_obs) || !AllFinite(m.reward) ||
+      !AllFinite(m.discount) || !AllFinite(m.weight)) {
+    return "non-finite value";
+  }
+  for (int32_t a : m.action) {
+    if (a < 0) return "negative action";
+  }
+  return nullptr;
+}
+
+const char* Validate(const rlmsg::weights_chunk_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (m.version < 0) return "negative version";
+  if (m.architecture.empty()) return "empty architecture";
+  if (m.total_size <= 0 || m.num_chunks <= 0) return "empty weights";
+  if (m.chunk_index < 0 || m.chunk_index >= m.num_chunks) return "chunk_index out of range";
+  if (m.offset < 0 || m.count <= 0 ||
+      static_cast<int64_t>(m.offset) + m.count > static_cast<int64_t>(m.total_size)) {
+    return "chunk outside the buffer";
+  }
+  if (m.crc32 < 0 || m.crc32 > 0xFFFFFFFFLL) return "crc32 out of range";
+  if (!AllFinite(m.data)) return "non-finite value";
+  return nullptr;
+}
+
+const char* Validate(const rlmsg::checkpoint_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (m.path.empty()) return "empty path";
+  if (m.update < 0 || m.env_steps < 0 || !std::isfinite(m.wall_seconds)) return "bad counters";
+  return nullptr;
+}
+
+const char* Validate(const rlmsg::flow_control_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (m.insert_allowed != 0 && m.insert_allowed != 1) return "insert_allowed not 0 or 1";
+  if (!std::isfinite(m.samples_per_insert)) return "non-finite value";
+  return nullptr;
+}
+
+const char* Validate(const rlmsg::eval_result_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (m.episodes <= 0) return "no episodes";
+  if (!std::isfinite(m.mean) || !std::isfinite(m.std)) return "non-finite value";
+  return nullptr;
+}
+
+const char* Validate(const rlmsg::stats_actor_t& m) {
+  return HeaderOk(m.header) ? nullptr : "bad header";
+}
+const char* Validate(const rlmsg::stats_replay_t& m) {
+  return HeaderOk(m.header) ? nullptr : "bad header";
+}
+const char* Validate(const rlmsg::stats_learner_t& m) {
+  return HeaderOk(m.header) ? nullptr : "bad header";
+}
+const char* Validate(const rlmsg::stats_evaluator_t& m) {
+  return HeaderOk(m.header) ? nullptr : "bad header";
+}
+
+}  // namespace rl

@@ -1,0 +1,77 @@
+#include "common/options.h"
+
+#include <cstdio>
+#include <exception>
+#include <fstream>
+#include <iostream>
+#include <stdexcept>
+
+namespace rl {
+
+BusConfig CommonOptions::MakeBusConfig(const std::string& sender) const {
+  BusConfig c;
+  c.url = lcm_url;
+  c.bulk_url = lcm_bulk_url;
+  c.run_id = run_id;
+  c.sender = sender;
+  return c;
+}
+
+void AddCommonOptions(po::options_description* desc, CommonOptions* common) {
+  desc->add_options()                         //
+      ("help,h", "print this help and exit")  //
+      ("config", po::value(&common->config_file),
+       "INI preset (top-level keys and the keys of this process's section)")  //
+      ("run-id", po::value(&common->run_id)->default_value(common->run_id),
+       "id of the run; messages of other runs are dropped")  //
+      ("lcm-url", po::value(&common->lcm_url)->default_value(common->lcm_url),
+       "LCM URL of the main port (small, high-rate messages)")  //
+      ("lcm-bulk-url", po::value(&common->lcm_bulk_url)->default_value(common->lcm_bulk_url),
+       "LCM URL of the bulk port (weights, sample replies)");
+}
+
+bool ParseOptions(int argc, char** argv, const std::string& role, const std::string& usage,
+                  const po::options_description& desc, po::variables_map* vm) {
+  po::store(po::parse_command_line(argc, argv, desc), *vm);
+  if (vm->count("help")) {
+    std::cout << usage << "\n\n" << desc << "\n";
+    return false;
+  }
+  if (vm->count("config")) {
+    const std::string path = (*vm)["config"].as<std::string>();
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error("cannot open config file '" + path + "'");
+    // Read every key, keep the top-level ones we know and those of our section.
+    po::parsed_options parsed = po::parse_config_file(in, desc, /*allow_unregistered=*/true);
+    po::parsed_options kept(&desc);
+    const std::string prefix = role + ".";
+    for (po::option& opt : parsed.options) {
+      const std::string& key = opt.string_key;
+      if (key.rfind(prefix, 0) == 0) {
+        opt.string_key = key.substr(prefix.size());
+        if (desc.find_nothrow(opt.string_key, false) == nullptr) {
+          throw std::runtime_error("config file '" + path + "': unknown key '" + opt.string_key +
+                                   "' in section [" + role + "]");
+        }
+        opt.unregistered = false;
+        kept.options.push_back(opt);
+      } else if (key.find('.') == std::string::npos && !opt.unregistered) {
+        kept.options.push_back(opt);
+      }
+    }
+    po::store(kept, *vm);
+  }
+  po::notify(*vm);
+  return true;
+}
+
+int RunMain(const char* program, int (*body)(int, char**), int argc, char** argv) {
+  try {
+    return body(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error: %s\n", program, e.what());
+    return 2;
+  }
+}
+
+}  // namespace rl

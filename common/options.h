@@ -1,0 +1,41 @@
+// Command-line and INI options of our processes (Boost.Program_options).
+//
+// Every process reads the same preset file (--config configs/cartpole.ini). Keys at the top of
+// the file apply to every process that knows them; keys in a section [actor], [replay],
+// [learner] or [evaluator] apply to that process only, and an unknown key in a process's own
+// section is an error (a typo must not pass silently). The command line wins over the file.
+#pragma once
+
+#include <boost/program_options.hpp>
+
+#include <cstdint>
+#include <string>
+
+#include "common/lcm_bus.h"
+
+namespace rl {
+
+namespace po = boost::program_options;
+
+// Options every process has: --config, --run-id, --lcm-url, --lcm-bulk-url.
+struct CommonOptions {
+  std::string config_file;
+  int64_t run_id = 0;
+  std::string lcm_url = kDefaultLcmUrl;
+  std::string lcm_bulk_url = kDefaultLcmBulkUrl;
+
+  BusConfig MakeBusConfig(const std::string& sender) const;
+};
+
+void AddCommonOptions(po::options_description* desc, CommonOptions* common);
+
+// Parses argv and the --config file into *vm and notifies the bound variables. Returns false
+// when --help was asked for (the help text has been printed). Throws on bad options, with a
+// message that names the option.
+bool ParseOptions(int argc, char** argv, const std::string& role, const std::string& usage,
+                  const po::options_description& desc, po::variables_map* vm);
+
+// Runs body() and turns an exception into "<program>: error: <what>" on stderr and exit code 2.
+int RunMain(const char* program, int (*body)(int, char**), int argc, char** argv);
+
+}  // namespace rl

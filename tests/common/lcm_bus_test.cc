@@ -1,0 +1,176 @@
+#include "common/lcm_bus.h"
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "common/channels.h"
+
+namespace rl {
+namespace {
+
+BusConfig MemqConfig(int64_t run_id, const std::string& sender) {
+  BusConfig c;
+  c.url = "memq://";
+  c.bulk_url = "memq://";
+  c.run_id = run_id;
+  c.sender = sender;
+  return c;
+}
+
+rlmsg::transition_batch_t MakeBatch(int count, int obs_size) {
+  rlmsg::transition_batch_t m;
+  m.actor_id = 1;
+  m.obs_size = obs_size;
+  m.count = count;
+  m.num_values = count * obs_size;
+  m.obs.assign(static_cast<size_t>(m.num_values), 0.5f);
+  m.next_obs.assign(static_cast<size_t>(m.num_values), 0.25f);
+  m.action.assign(static_cast<size_t>(count), 1);
+  m.reward.assign(static_cast<size_t>(count), 1.0f);
+  m.discount.assign(static_cast<size_t>(count), 0.99f);
+  m.episode_id.assign(static_cast<size_t>(count), 7);
+  m.priority.assign(static_cast<size_t>(count), 0.0f);
+  return m;
+}
+
+std::vector<uint8_t> Encode(rlmsg::transition_batch_t m) {
+  m.header.run_id = 42;
+  m.header.sender = "actor-1";
+  std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+class BusTest : public ::testing::Test {
+ protected:
+  BusTest() : bus_(MemqConfig(42, "actor-1")) {
+    bus_.Subscribe<rlmsg::transition_batch_t>(
+        channels::kTransitions, [this](const rlmsg::transition_batch_t& m) { got_.push_back(m); });
+  }
+  Bus bus_;
+  std::vector<rlmsg::transition_batch_t> got_;
+};
+
+TEST_F(BusTest, DeliversAGoodMessageWithItsHeaderFilled) {
+  auto m = MakeBatch(3, 4);
+  ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
+  ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
+  bus_.Handle(100);
+  ASSERT_EQ(got_.size(), 2U);
+  EXPECT_EQ(got_[0].header.run_id, 42);
+  EXPECT_EQ(got_[0].header.sender, "actor-1");
+  EXPECT_EQ(got_[0].header.seq, 0);
+  EXPECT_EQ(got_[1].header.seq, 1);
+  EXPECT_GT(got_[0].header.utime, 0);
+  EXPECT_EQ(got_[1].obs.size(), 12U);
+  EXPECT_EQ(bus_.counters().received, 2);
+  EXPECT_EQ(bus_.counters().lost, 0);
+}
+
+TEST_F(BusTest, DropsAnotherRunsMessagesAsForeign) {
+  auto bytes = Encode(MakeBatch(2, 4));
+  rlmsg::transition_batch_t other = MakeBatch(2, 4);
+  other.header.run_id = 43;
+  other.header.sender = "actor-9";
+  std::vector<uint8_t> foreign(static_cast<size_t>(other.getEncodedSize()));
+  other.encode(foreign.data(), 0, static_cast<int>(foreign.size()));
+  bus_.PublishRaw(channels::kTransitions, foreign.data(), foreign.size());
+  bus_.PublishRaw(channels::kTransitions, bytes.data(), bytes.size());
+  bus_.Handle(100);
+  EXPECT_EQ(got_.size(), 1U);
+  EXPECT_EQ(bus_.counters().foreign, 1);
+}
+
+TEST_F(BusTest, DropsTruncatedAndForeignTypeBytesAsMalformed) {
+  auto bytes = Encode(MakeBatch(2, 4));
+  bus_.PublishRaw(channels::kTransitions, bytes.data(), bytes.size() - 5);  // truncated
+  const std::vector<uint8_t> junk(64, 0x42);                                // unknown type
+  bus_.PublishRaw(channels::kTransitions, junk.data(), junk.size());
+  rlmsg::checkpoint_t ckpt;  // a real message of another type
+  ckpt.header.run_id = 42;
+  ckpt.header.sender = "learner";
+  ckpt.path = "x";
+  std::vector<uint8_t> other(static_cast<size_t>(ckpt.getEncodedSize()));
+  ckpt.encode(other.data(), 0, static_cast<int>(other.size()));
+  bus_.PublishRaw(channels::kTransitions, other.data(), other.size());
+  bytes.push_back(0);  // trailing byte
+  bus_.PublishRaw(channels::kTransitions, bytes.data(), bytes.size());
+  bus_.Handle(100);
+  EXPECT_TRUE(got_.empty());
+  EXPECT_EQ(bus_.counters().malformed, 4);
+}
+
+TEST_F(BusTest, RefusesAForgedArrayLengthBeforeDecoding) {
+  auto bytes = Encode(MakeBatch(2, 4));
+  // num_values follows fingerprint (8), header (8 + 4 + 8 "actor-1\0" + 16), actor_id, obs_size
+  // and count (12): claim two billion floats.
+  const size_t at = 8 + 8 + 4 + 8 + 16 + 12;
+  bytes[at] = 0x7F;
+  bytes[at + 1] = 0xFF;
+  bus_.PublishRaw(channels::kTransitions, bytes.data(), bytes.size());
+  // A negative string length in the header.
+  auto neg = Encode(MakeBatch(2, 4));
+  neg[16] = 0xFF;
+  bus_.PublishRaw(channels::kTransitions, neg.data(), neg.size());
+  bus_.Handle(100);
+  EXPECT_TRUE(got_.empty());
+  EXPECT_EQ(bus_.counters().malformed, 2);
+}
+
+TEST_F(BusTest, DropsNonFiniteOrInconsistentContentAsInvalid) {
+  auto nan = MakeBatch(2, 4);
+  nan.reward[1] = std::numeric_limits<float>::quiet_NaN();
+  bus_.Publish(channels::kTransitions, &nan);
+  auto bad_discount = MakeBatch(2, 4);
+  bad_discount.discount[0] = 1.5f;
+  bus_.Publish(channels::kTransitions, &bad_discount);
+  auto bad_action = MakeBatch(2, 4);
+  bad_action.action[0] = -1;
+  bus_.Publish(channels::kTransitions, &bad_action);
+  bus_.Handle(100);
+  EXPECT_TRUE(got_.empty());
+  EXPECT_EQ(bus_.counters().invalid, 3);
+}
+
+TEST_F(BusTest, CountsSequenceGapsAsLost) {
+  for (int seq : {0, 1, 4, 5, 9}) {
+    auto m = MakeBatch(1, 4);
+    m.header.run_id = 42;
+    m.header.sender = "actor-1";
+    m.header.seq = seq;
+    std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+    m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    bus_.PublishRaw(channels::kTransitions, bytes.data(), bytes.size());
+  }
+  bus_.Handle(100);
+  EXPECT_EQ(got_.size(), 5U);
+  EXPECT_EQ(bus_.counters().lost, 2 + 3);
+}
+
+TEST(BusHandlerTest, AThrowingHandlerIsCountedAndDoesNotEscape) {
+  Bus bus(MemqConfig(1, "replay"));
+  bus.Subscribe<rlmsg::transition_batch_t>(
+      channels::kTransitions,
+      [](const rlmsg::transition_batch_t&) { throw std::runtime_error("boom"); });
+  auto m = MakeBatch(1, 4);
+  bus.Publish(channels::kTransitions, &m);
+  EXPECT_NO_THROW(bus.Handle(100));
+  EXPECT_EQ(bus.counters().invalid, 1);
+}
+
+TEST(BusOpenTest, ABadUrlThrowsWithTheUrlInTheMessage) {
+  BusConfig c = MemqConfig(1, "x");
+  c.url = "nosuchprovider://";
+  try {
+    Bus bus(c);
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nosuchprovider://"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace rl
