@@ -21,7 +21,7 @@ BusConfig MemqConfig(int64_t run_id, const std::string& sender) {
 }
 
 rlmsg::transition_batch_t MakeBatch(int count, int obs_size) {
-  rlmsg::transition_batch_t m;
+  rlmsg::transition_batch_t m{};
   m.actor_id = 1;
   m.obs_size = obs_size;
   m.count = count;
@@ -89,7 +89,7 @@ TEST_F(BusTest, DropsTruncatedAndForeignTypeBytesAsMalformed) {
   bus_.PublishRaw(channels::kTransitions, bytes.data(), bytes.size() - 5);  // truncated
   const std::vector<uint8_t> junk(64, 0x42);                                // unknown type
   bus_.PublishRaw(channels::kTransitions, junk.data(), junk.size());
-  rlmsg::checkpoint_t ckpt;  // a real message of another type
+  rlmsg::checkpoint_t ckpt{};  // a real message of another type
   ckpt.header.run_id = 42;
   ckpt.header.sender = "learner";
   ckpt.path = "x";

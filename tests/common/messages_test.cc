@@ -27,7 +27,7 @@ void ExpectPrescanMatchesTheEncoding(const Msg& m) {
 }
 
 TEST(PrescanTest, AgreesWithTheEncodingOfATransitionBatch) {
-  rlmsg::transition_batch_t m;
+  rlmsg::transition_batch_t m{};
   m.header.sender = "test";
   m.obs_size = 3;
   m.count = 5;
@@ -44,7 +44,7 @@ TEST(PrescanTest, AgreesWithTheEncodingOfATransitionBatch) {
 }
 
 TEST(PrescanTest, AgreesWithTheEncodingOfASampleBatch) {
-  rlmsg::sample_batch_t m;
+  rlmsg::sample_batch_t m{};
   m.header.sender = "test";
   m.requester = "learner";
   m.obs_size = 2;
@@ -62,7 +62,7 @@ TEST(PrescanTest, AgreesWithTheEncodingOfASampleBatch) {
 }
 
 TEST(PrescanTest, AgreesWithTheEncodingOfAWeightsChunk) {
-  rlmsg::weights_chunk_t m;
+  rlmsg::weights_chunk_t m{};
   m.header.sender = "test";
   m.version = 3;
   m.architecture = "linear(4,2)";
@@ -78,7 +78,7 @@ TEST(PrescanTest, AgreesWithTheEncodingOfAWeightsChunk) {
 }
 
 TEST(ValidateTest, RefusesAChunkOutsideItsBufferAndAnInconsistentBatch) {
-  rlmsg::weights_chunk_t w;
+  rlmsg::weights_chunk_t w{};
   w.header.sender = "learner";
   w.version = 1;
   w.architecture = "x";
@@ -88,17 +88,17 @@ TEST(ValidateTest, RefusesAChunkOutsideItsBufferAndAnInconsistentBatch) {
   w.count = 6;
   w.data.assign(6, 0.0f);
   EXPECT_NE(Validate(w), nullptr);
-  rlmsg::transition_batch_t t;
+  rlmsg::transition_batch_t t{};
   t.header.sender = "actor-0";
   t.obs_size = 4;
   t.count = 2;
   t.num_values = 7;
   EXPECT_NE(Validate(t), nullptr);
-  rlmsg::sample_request_t r;
+  rlmsg::sample_request_t r{};
   r.header.sender = "learner";
   r.batch_size = 0;
   EXPECT_NE(Validate(r), nullptr);
-  rlmsg::flow_control_t f;
+  rlmsg::flow_control_t f{};
   f.header.sender = "replay";
   f.insert_allowed = 3;
   EXPECT_NE(Validate(f), nullptr);
