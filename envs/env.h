@@ -1,0 +1,71 @@
+// The environment interface shared by the actor and the evaluator: a static spec, Reset, Step, the
+// current observation and an RGB rendering. Episode bookkeeping (time limits) lives in wrappers
+// such as TimeLimit, as in Gymnasium.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace rl::envs {
+
+/// Outcome of one Step. `terminated` means the MDP reached a terminal state (no bootstrapping);
+/// `truncated` means the episode was cut short (by a time limit); both can be true at once.
+struct StepResult {
+  double reward = 0;
+  bool terminated = false;
+  bool truncated = false;
+};
+
+/// Static description of an environment (shapes and registration data).
+struct EnvSpec {
+  std::string id;           // Registered id, e.g. "CartPole-v1".
+  int observation_size;     // Number of float32 values in observation().
+  int num_actions;          // Discrete actions are 0 .. num_actions - 1.
+  int max_episode_steps;    // Time limit applied by the registry (TimeLimit).
+  double reward_threshold;  // Average return at which the task counts as solved.
+};
+
+/// One environment instance. Not thread-safe: an instance is used by one thread at a time. Each
+/// instance owns its RNG, so instances never share random state.
+class Env {
+ public:
+  virtual ~Env() = default;
+
+  /// Static spec; the reference stays valid for the lifetime of the env.
+  virtual const EnvSpec& spec() const = 0;
+
+  /// Seeds the env's own RNG from `seed` and samples an initial state.
+  virtual void Reset(uint64_t seed) = 0;
+
+  /// Samples an initial state, continuing the env's RNG stream (like Gymnasium's reset() without a
+  /// seed after a seeded one). Before any seeded Reset, the RNG is seeded from std::random_device.
+  virtual void Reset() = 0;
+
+  /// Advances one step. Throws std::invalid_argument for an action outside [0, num_actions), and
+  /// std::logic_error if Reset was never called.
+  virtual StepResult Step(int action) = 0;
+
+  /// Current observation (observation_size float32 values). Valid until the next Reset or Step.
+  virtual std::span<const float> observation() const = 0;
+
+  /// Renders the current state at the env's native size as RGB bytes, row-major, top row first,
+  /// height x width x 3. Resizes *rgb and writes the size to *width and *height.
+  virtual void Render(std::vector<uint8_t>* rgb, int* width, int* height) const = 0;
+
+  /// Renders at width x height (both positive, else std::invalid_argument); same layout as Render.
+  /// The default renders at the native size and resamples by area averaging; envs that can draw
+  /// at any size override it.
+  virtual void RenderSized(int width, int height, std::vector<uint8_t>* rgb) const;
+
+ protected:
+  // Copying and moving are for derived classes only, so that an Env is never sliced.
+  Env() = default;
+  Env(const Env&) = default;
+  Env& operator=(const Env&) = default;
+  Env(Env&&) = default;
+  Env& operator=(Env&&) = default;
+};
+
+}  // namespace rl::envs

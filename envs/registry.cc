@@ -1,0 +1,48 @@
+#include "envs/registry.h"
+
+#include <algorithm>
+#include <array>
+#include <stdexcept>
+#include <string_view>
+
+#include "envs/cartpole.h"
+#include "envs/time_limit.h"
+
+namespace rl::envs {
+namespace {
+
+// One registered id and how to build it, time limit included.
+struct Registration {
+  std::string_view id;
+  std::unique_ptr<Env> (*make)();
+};
+
+constexpr std::array kRegistrations = {
+    Registration{"CartPole-v1",
+                 []() -> std::unique_ptr<Env> {
+                   return std::make_unique<TimeLimit>(std::make_unique<CartPole>(), 500);
+                 }},
+};
+
+}  // namespace
+
+std::unique_ptr<Env> MakeEnv(const std::string& id) {
+  for (const Registration& r : kRegistrations) {
+    if (r.id == id) return r.make();
+  }
+  std::string known;
+  for (const std::string& name : RegisteredEnvs()) {
+    known += known.empty() ? name : ", " + name;
+  }
+  throw std::invalid_argument("MakeEnv: unknown environment id \"" + id +
+                              "\"; known ids: " + known);
+}
+
+std::vector<std::string> RegisteredEnvs() {
+  std::vector<std::string> ids;
+  for (const Registration& r : kRegistrations) ids.emplace_back(r.id);
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+}  // namespace rl::envs

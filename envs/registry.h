@@ -1,0 +1,19 @@
+// Creates environments by their Gymnasium id, with the time limit that gymnasium.make applies.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "envs/env.h"
+
+namespace rl::envs {
+
+/// Creates a fresh, not yet reset env for a registered id. "CartPole-v1" gives
+/// TimeLimit(CartPole, 500). Throws std::invalid_argument naming the known ids for an unknown id.
+std::unique_ptr<Env> MakeEnv(const std::string& id);
+
+/// The registered ids, sorted.
+std::vector<std::string> RegisteredEnvs();
+
+}  // namespace rl::envs

@@ -1,0 +1,201 @@
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "envs/cartpole.h"
+#include "envs/raster.h"
+#include "envs/registry.h"
+
+namespace rl::envs {
+namespace {
+
+constexpr Rgb kWhite{255, 255, 255};
+constexpr Rgb kBlack{0, 0, 0};
+constexpr Rgb kPole{202, 152, 101};
+constexpr Rgb kAxle{129, 132, 203};
+
+// A rendered RGB image with pixel access.
+struct Image {
+  std::vector<uint8_t> rgb;
+  int width = 0;
+  int height = 0;
+
+  Rgb at(int x, int y) const {
+    const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 3;
+    return Rgb{rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+};
+
+// Mean column and row of the pixels of one colour, and their count; optionally skipping a row.
+struct Blob {
+  int count = 0;
+  double mean_x = 0;
+  double mean_y = 0;
+};
+Blob FindColor(const Image& image, Rgb color, int skip_row = -1) {
+  Blob blob;
+  for (int y = 0; y < image.height; ++y) {
+    if (y == skip_row) continue;
+    for (int x = 0; x < image.width; ++x) {
+      if (image.at(x, y) == color) {
+        ++blob.count;
+        blob.mean_x += x;
+        blob.mean_y += y;
+      }
+    }
+  }
+  if (blob.count > 0) {
+    blob.mean_x /= blob.count;
+    blob.mean_y /= blob.count;
+  }
+  return blob;
+}
+
+Image RenderState(const std::array<double, 4>& state) {
+  CartPole env;
+  env.set_state(state);
+  Image image;
+  env.Render(&image.rgb, &image.width, &image.height);
+  return image;
+}
+
+// In the 600x400 image (y down) the track is row 400 - 1 - 100 = 299; the cart is centred on
+// column x * 125 + 300 and spans rows [400 - 115, 400 - 85) = [285, 315).
+constexpr int kTrackRow = 299;
+
+TEST(CartPoleRenderTest, ImageIs600By400RgbOnWhite) {
+  const Image image = RenderState({0, 0, 0, 0});
+  EXPECT_EQ(image.width, 600);
+  EXPECT_EQ(image.height, 400);
+  EXPECT_EQ(image.rgb.size(), 600u * 400u * 3u);
+  EXPECT_EQ(image.at(0, 0), kWhite);
+  EXPECT_EQ(image.at(599, 399), kWhite);
+  EXPECT_EQ(image.at(100, 150), kWhite);
+  // Mostly background.
+  EXPECT_GT(FindColor(image, kWhite).count, 600 * 400 * 9 / 10);
+}
+
+TEST(CartPoleRenderTest, TrackIsABlackRowAcrossTheWholeWidth) {
+  const Image image = RenderState({0, 0, 0, 0});
+  for (int x = 0; x < 600; ++x) ASSERT_EQ(image.at(x, kTrackRow), kBlack) << "column " << x;
+  EXPECT_EQ(image.at(10, kTrackRow - 1), kWhite);
+  EXPECT_EQ(image.at(10, kTrackRow + 1), kWhite);
+}
+
+TEST(CartPoleRenderTest, CartIsABlack50By30RectangleAtTheCentre) {
+  const Image image = RenderState({0, 0, 0, 0});
+  // Corners of the cart, below the axle and pole.
+  EXPECT_EQ(image.at(275, 285), kBlack);
+  EXPECT_EQ(image.at(324, 285), kBlack);
+  EXPECT_EQ(image.at(275, 314), kBlack);
+  EXPECT_EQ(image.at(324, 314), kBlack);
+  EXPECT_EQ(image.at(280, 310), kBlack);
+  // Just outside.
+  EXPECT_EQ(image.at(274, 310), kWhite);
+  EXPECT_EQ(image.at(325, 310), kWhite);
+  EXPECT_EQ(image.at(280, 284), kWhite);
+  EXPECT_EQ(image.at(280, 315), kWhite);
+  // The black pixels off the track row are the cart minus what the pole and axle cover.
+  const Blob cart = FindColor(image, kBlack, kTrackRow);
+  EXPECT_GT(cart.count, 50 * 29 - 150);
+  EXPECT_LE(cart.count, 50 * 29);
+  EXPECT_NEAR(cart.mean_x, 299.5, 0.5);
+}
+
+TEST(CartPoleRenderTest, UprightPoleAndAxleSitAboveTheCart) {
+  const Image image = RenderState({0, 0, 0, 0});
+  // The pole runs from 2.5 px below the axle to 122.5 px above it: rows (172.5, 297.5).
+  EXPECT_EQ(image.at(300, 200), kPole);
+  EXPECT_EQ(image.at(296, 180), kPole);
+  EXPECT_EQ(image.at(300, 170), kWhite);
+  EXPECT_EQ(image.at(290, 200), kWhite);
+  const Blob pole = FindColor(image, kPole);
+  EXPECT_NEAR(pole.mean_x, 299.5, 0.5);
+  EXPECT_NEAR(pole.count, 10 * 125 - 80, 60);  // Minus what the axle covers.
+  // Axle: radius-5 disc centred on pixel (300, 292).
+  EXPECT_EQ(image.at(300, 292), kAxle);
+  EXPECT_EQ(image.at(305, 292), kAxle);
+  EXPECT_EQ(image.at(300, 287), kAxle);
+  const Blob axle = FindColor(image, kAxle);
+  EXPECT_NEAR(axle.count, 3.14159 * 25, 12);
+  EXPECT_NEAR(axle.mean_x, 300, 0.01);
+  EXPECT_NEAR(axle.mean_y, 292, 0.01);
+}
+
+TEST(CartPoleRenderTest, MovingTheCartMovesTheBlackPixels) {
+  const Image centre = RenderState({0, 0, 0, 0});
+  const Image right = RenderState({1.0, 0, 0, 0});  // 125 px to the right.
+  EXPECT_EQ(right.at(280, 310), kWhite);
+  EXPECT_EQ(right.at(405, 310), kBlack);
+  const Blob a = FindColor(centre, kBlack, kTrackRow);
+  const Blob b = FindColor(right, kBlack, kTrackRow);
+  EXPECT_EQ(a.count, b.count);
+  EXPECT_DOUBLE_EQ(b.mean_x - a.mean_x, 125.0);
+  EXPECT_DOUBLE_EQ(b.mean_y, a.mean_y);
+
+  const Image left = RenderState({-1.2, 0, 0, 0});  // 150 px to the left.
+  EXPECT_DOUBLE_EQ(FindColor(left, kBlack, kTrackRow).mean_x - a.mean_x, -150.0);
+}
+
+TEST(CartPoleRenderTest, PositiveThetaLeansThePoleTowardsPositiveX) {
+  const Image upright = RenderState({0, 0, 0, 0});
+  const Image leaning = RenderState({0, 0, 0.2, 0});
+  const Blob a = FindColor(upright, kPole);
+  const Blob b = FindColor(leaning, kPole);
+  // The pole's centre is about 57.5 px from the axle along its axis.
+  EXPECT_NEAR(b.mean_x - a.mean_x, 57.5 * std::sin(0.2), 3.0);
+  EXPECT_GT(b.mean_y, a.mean_y);  // Lower in the image: the pole tilts down.
+  // The far end is at about 120 px from the axle.
+  EXPECT_EQ(leaning.at(300 + static_cast<int>(115 * std::sin(0.2)),
+                       292 - static_cast<int>(115 * std::cos(0.2))),
+            kPole);
+}
+
+TEST(CartPoleRenderTest, RenderSizedScalesTheSamePicture) {
+  CartPole env;
+  env.set_state({0.8, 0, 0, 0});  // Cart centre at column 400 of 600.
+  std::vector<uint8_t> rgb;
+  env.RenderSized(300, 200, &rgb);
+  ASSERT_EQ(rgb.size(), 300u * 200u * 3u);
+  Image small{rgb, 300, 200};
+  EXPECT_EQ(small.at(0, 0), kWhite);
+  EXPECT_EQ(small.at(200, 155), kBlack);  // Cart at half scale: centre (200, 150).
+  EXPECT_EQ(small.at(150, 155), kWhite);
+  EXPECT_GT(FindColor(small, kPole).count, 200);
+  EXPECT_GT(FindColor(small, kAxle).count, 10);
+  // The track stays at least one pixel thick when shrinking a lot.
+  env.RenderSized(60, 40, &rgb);
+  Image tiny{rgb, 60, 40};
+  int black_rows = 0;
+  for (int y = 0; y < 40; ++y) black_rows += tiny.at(1, y) == kBlack;
+  EXPECT_EQ(black_rows, 1);
+  EXPECT_THROW(env.RenderSized(0, 10, &rgb), std::invalid_argument);
+}
+
+TEST(CartPoleRenderTest, RunawayStatesRenderWithoutCrashing) {
+  for (double x : {50.0, -1e300, 1e300}) {
+    const Image image = RenderState({x, 0, 3.0, 0});
+    EXPECT_EQ(image.rgb.size(), 600u * 400u * 3u);
+    EXPECT_EQ(image.at(300, 310), kWhite);  // The cart is off screen.
+    EXPECT_EQ(image.at(300, kTrackRow), kBlack);
+  }
+}
+
+TEST(CartPoleRenderTest, RenderThroughTheRegistryWorksAfterReset) {
+  auto env = MakeEnv("CartPole-v1");
+  Image image;
+  EXPECT_THROW(env->Render(&image.rgb, &image.width, &image.height), std::logic_error);
+  env->Reset(0);
+  env->Render(&image.rgb, &image.width, &image.height);
+  EXPECT_EQ(image.width, 600);
+  EXPECT_EQ(image.height, 400);
+  EXPECT_GT(FindColor(image, kPole).count, 1000);
+}
+
+}  // namespace
+}  // namespace rl::envs
