@@ -1,0 +1,75 @@
+// The replay daemon: stores the actors' transitions and answers the learner's sample requests,
+// holding both to a samples-per-insert ratio. See README.md.
+#include <cstdint>
+#include <cstdio>
+#include <string>
+
+#include "common/lcm_bus.h"
+#include "common/options.h"
+#include "common/shutdown.h"
+#include "replay/replay_service.h"
+
+namespace {
+
+constexpr char kUsage[] =
+    "Usage: replay [options]\n"
+    "The replay daemon: stores transitions from RL_TRANSITIONS in a ring buffer and answers\n"
+    "RL_SAMPLE_REQUEST with uniformly drawn batches on RL_SAMPLES, holding the ratio of\n"
+    "samples to inserts near --samples-per-insert (actors are paused through RL_FLOW).";
+
+int Main(int argc, char** argv) {
+  namespace po = rl::po;
+  rl::CommonOptions common;
+  rl::replay::ReplayServiceOptions options;
+  options.progress_seconds = 5.0;
+
+  po::options_description desc("Options");
+  rl::AddCommonOptions(&desc, &common);
+  desc.add_options()  //
+      ("capacity", po::value(&options.table.capacity)->default_value(options.table.capacity),
+       "transitions kept; the oldest are overwritten")  //
+      ("obs-size", po::value(&options.table.obs_size)->default_value(options.table.obs_size),
+       "floats per observation (0: from the first batch); other sizes are refused")  //
+      ("min-size",
+       po::value(&options.limiter.min_size_to_sample)
+           ->default_value(options.limiter.min_size_to_sample),
+       "transitions inserted before the first sample")  //
+      ("samples-per-insert",
+       po::value(&options.limiter.samples_per_insert)
+           ->default_value(options.limiter.samples_per_insert),
+       "target transitions sampled per transition inserted (<= 0: no ratio, only --min-size)")  //
+      ("error-buffer",
+       po::value(&options.limiter.error_buffer)->default_value(options.limiter.error_buffer),
+       "tolerated deviation from the ratio, in samples: actors may run error-buffer / "
+       "samples-per-insert transitions ahead, the learner error-buffer samples ahead")  //
+      ("seed", po::value(&options.seed)->default_value(options.seed),
+       "seed of the sampler")  //
+      ("max-pending-requests",
+       po::value(&options.max_pending_requests)->default_value(options.max_pending_requests),
+       "sample requests held while the rate limiter waits; the oldest is dropped beyond")  //
+      ("flow-hz", po::value(&options.flow_hz)->default_value(options.flow_hz),
+       "RL_FLOW messages per second (and at once on every change)")  //
+      ("stats-hz", po::value(&options.stats_hz)->default_value(options.stats_hz),
+       "RL_STATS_REPLAY messages per second");
+  po::variables_map vm;
+  if (!rl::ParseOptions(argc, argv, "replay", kUsage, desc, &vm)) return 0;
+
+  // Refuse bad values before touching the network.
+  options.Validate();
+  rl::InstallStopHandlers();
+  rl::Bus bus(common.MakeBusConfig("replay"));
+  rl::replay::ReplayService service(&bus, options);
+  std::printf("replay: ready\n");
+  std::fflush(stdout);
+
+  service.Run(rl::StopRequested);
+  std::printf("replay: stopped after %lld inserts and %lld samples\n",
+              static_cast<long long>(service.table().total_inserts()),
+              static_cast<long long>(service.table().total_samples()));
+  std::fflush(stdout);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return rl::RunMain("replay", Main, argc, argv); }

@@ -1,0 +1,278 @@
+#include "replay/replay_service.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "common/channels.h"
+#include "common/check.h"
+
+namespace rl::replay {
+namespace {
+
+// Logs the first refusals and then every 1000th, so that a flood cannot flood the log.
+bool ShouldLog(int64_t n) { return n < 10 || n % 1000 == 0; }
+
+// Shortest readable form of a number, for error messages.
+std::string Str(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%g", x);
+  return buf;
+}
+
+// Throws std::invalid_argument unless x is a finite rate > 0.
+void CheckRate(const char* name, double x) {
+  if (!std::isfinite(x) || x <= 0) {
+    throw std::invalid_argument(std::string("replay service: ") + name + " must be > 0, got " +
+                                Str(x));
+  }
+}
+
+ReplayServiceOptions Validated(ReplayServiceOptions options) {
+  options.Validate();
+  return options;
+}
+
+}  // namespace
+
+void ReplayServiceOptions::Validate() const {
+  table.Validate();
+  limiter.Validate();
+  if (insert_unit < 1) {
+    throw std::invalid_argument("replay service: insert_unit must be at least 1, got " +
+                                std::to_string(insert_unit));
+  }
+  if (max_pending_requests < 1) {
+    throw std::invalid_argument("replay service: max_pending_requests must be at least 1, got " +
+                                std::to_string(max_pending_requests));
+  }
+  if (max_reply_bytes < 1024) {
+    throw std::invalid_argument("replay service: max_reply_bytes must be at least 1024, got " +
+                                std::to_string(max_reply_bytes));
+  }
+  CheckRate("flow_hz", flow_hz);
+  CheckRate("stats_hz", stats_hz);
+  if (!std::isfinite(progress_seconds) || progress_seconds < 0) {
+    throw std::invalid_argument("replay service: progress_seconds must be >= 0 (0: none), got " +
+                                Str(progress_seconds));
+  }
+  if (handle_timeout_ms < 0) {
+    throw std::invalid_argument("replay service: handle_timeout_ms must be >= 0, got " +
+                                std::to_string(handle_timeout_ms));
+  }
+}
+
+double ReplayService::IntervalRate::Take(int64_t count, double now) {
+  const double dt = now - last_time_;
+  const double rate =
+      (last_time_ >= 0 && dt > 0) ? static_cast<double>(count - last_count_) / dt : 0.0;
+  last_time_ = now;
+  last_count_ = count;
+  return rate;
+}
+
+ReplayService::ReplayService(Bus* bus, ReplayServiceOptions options)
+    : bus_(*bus),
+      options_(Validated(std::move(options))),
+      table_(options_.table),
+      limiter_(options_.limiter),
+      rng_(options_.seed) {
+  insert_allowed_ = limiter_.CanInsert(options_.insert_unit);
+  bus_.Subscribe<rlmsg::transition_batch_t>(
+      channels::kTransitions, [this](const rlmsg::transition_batch_t& m) { OnTransitions(m); });
+  bus_.Subscribe<rlmsg::sample_request_t>(
+      channels::kSampleRequest, [this](const rlmsg::sample_request_t& m) { OnSampleRequest(m); });
+}
+
+ReplayService::~ReplayService() = default;
+
+void ReplayService::LogRefusal(const char* what, const char* why) {
+  if (ShouldLog(refusals_logged_++)) {
+    std::fprintf(stderr, "[%s] refused a %s: %s\n", bus_.config().sender.c_str(), what, why);
+  }
+}
+
+void ReplayService::OnTransitions(const rlmsg::transition_batch_t& m) {
+  // The bus has checked sizes and values; the table checks what only it knows (obs_size).
+  const TransitionBatchView view{m.obs_size, m.count,    m.obs,        m.next_obs, m.action,
+                                 m.reward,   m.discount, m.episode_id, m.priority};
+  if (const char* why = table_.Insert(view)) {
+    ++counters_.batches_refused;
+    LogRefusal("transition batch", why);
+    return;
+  }
+  limiter_.Insert(m.count);
+  PublishFlow(/*force=*/false);
+}
+
+void ReplayService::OnSampleRequest(const rlmsg::sample_request_t& m) {
+  PendingRequest request{m.header.sender, m.request_id, m.batch_size};
+  if (const char* why = Unanswerable(request)) {
+    ++counters_.requests_refused;
+    LogRefusal("sample request", why);
+    return;
+  }
+  // A retried request that is still waiting here is held once, not twice.
+  for (const PendingRequest& p : pending_) {
+    if (p.request_id == request.request_id && p.requester == request.requester) return;
+  }
+  // Keep the newest requests: the requester has given up on the oldest by now.
+  if (static_cast<int>(pending_.size()) >= options_.max_pending_requests) {
+    pending_.pop_front();
+    ++counters_.requests_dropped;
+  }
+  pending_.push_back(std::move(request));
+}
+
+const char* ReplayService::Unanswerable(const PendingRequest& request) {
+  const int64_t max_batch = limiter_.max_sample_batch();
+  if (max_batch > 0 && request.batch_size > max_batch) {
+    return "batch_size above 2 * error_buffer - samples_per_insert (the limiter could never "
+           "allow it)";
+  }
+  // The reply's size is known once the observation size is.
+  if (table_.obs_size() > 0) {
+    // Two float arrays of batch_size * obs_size alone (also keeps num_values from overflowing).
+    if (int64_t{request.batch_size} * table_.obs_size() * 8 > options_.max_reply_bytes) {
+      return "reply above max_reply_bytes";
+    }
+    reply_.header.sender = bus_.config().sender;
+    reply_.requester = request.requester;
+    reply_.count = request.batch_size;
+    reply_.num_values = request.batch_size * table_.obs_size();
+    if (reply_.getEncodedSize() > options_.max_reply_bytes) return "reply above max_reply_bytes";
+  }
+  return nullptr;
+}
+
+int ReplayService::Serve() {
+  int answered = 0;
+  while (!pending_.empty()) {
+    const PendingRequest& request = pending_.front();
+    // Requests that arrived before the observation size was known are checked now.
+    if (const char* why = Unanswerable(request)) {
+      ++counters_.requests_refused;
+      LogRefusal("sample request", why);
+      pending_.pop_front();
+      continue;
+    }
+    if (!limiter_.CanSample(request.batch_size)) break;
+    Answer(request);
+    pending_.pop_front();
+    ++answered;
+  }
+  if (answered > 0) PublishFlow(/*force=*/false);
+  return answered;
+}
+
+void ReplayService::Answer(const PendingRequest& request) {
+  // Size the reused reply (no allocation once warm) and let the table fill it.
+  const int count = request.batch_size;
+  const int obs_size = table_.obs_size();
+  const auto n = static_cast<size_t>(count);
+  const size_t values = n * static_cast<size_t>(obs_size);
+  reply_.requester = request.requester;
+  reply_.request_id = request.request_id;
+  reply_.obs_size = obs_size;
+  reply_.count = count;
+  reply_.num_values = count * obs_size;
+  reply_.obs.resize(values);
+  reply_.next_obs.resize(values);
+  reply_.action.resize(n);
+  reply_.reward.resize(n);
+  reply_.discount.resize(n);
+  reply_.index.resize(n);
+  reply_.weight.resize(n);
+  const SampleSpans out{reply_.obs,      reply_.next_obs, reply_.action, reply_.reward,
+                        reply_.discount, reply_.index,    reply_.weight, {}};
+  // CanSample() held, so at least min_size_to_sample >= 1 transitions are stored.
+  const bool sampled = table_.Sample(count, &rng_, out);
+  RL_CHECK(sampled) << "the limiter allowed a sample from an empty table";
+  limiter_.Sample(count);
+  reply_.replay_size = table_.size();
+  reply_.total_inserts = table_.total_inserts();
+  bus_.Publish(channels::kSamples, &reply_, Port::kBulk);
+  ++counters_.requests_answered;
+}
+
+void ReplayService::PublishFlow(bool force) {
+  const bool allowed = limiter_.CanInsert(options_.insert_unit);
+  if (!force && allowed == insert_allowed_) return;
+  insert_allowed_ = allowed;
+  flow_.insert_allowed = allowed ? 1 : 0;
+  flow_.samples_per_insert = limiter_.samples_per_insert();
+  flow_.target_samples_per_insert = limiter_.options().samples_per_insert;
+  flow_.error_buffer = limiter_.options().error_buffer;
+  bus_.Publish(channels::kFlow, &flow_);
+}
+
+void ReplayService::PublishStats(double now) {
+  stats_.size = table_.size();
+  stats_.capacity = table_.capacity();
+  stats_.total_inserts = table_.total_inserts();
+  stats_.total_samples = table_.total_samples();
+  stats_.inserts_per_second = stats_insert_rate_.Take(table_.total_inserts(), now);
+  stats_.samples_per_second = stats_sample_rate_.Take(table_.total_samples(), now);
+  stats_.samples_per_insert = limiter_.samples_per_insert();
+  stats_.insert_allowed = insert_allowed_ ? 1 : 0;
+  stats_.pending_requests = pending_requests();
+  bus_.FillCounters(&stats_);
+  // What the service refused itself is invalid input as well.
+  stats_.dropped_invalid += counters_.batches_refused + counters_.requests_refused;
+  bus_.Publish(channels::kStatsReplay, &stats_);
+}
+
+void ReplayService::PrintProgress(double now) {
+  const double inserts_per_second = progress_insert_rate_.Take(table_.total_inserts(), now);
+  const double samples_per_second = progress_sample_rate_.Take(table_.total_samples(), now);
+  const BusCounters& bus = bus_.counters();
+  std::printf(
+      "replay: size %lld/%lld inserts %lld (%.1f/s) samples %lld (%.1f/s) spi %.2f "
+      "insert_allowed %d pending %d dropped %lld lost %lld\n",
+      static_cast<long long>(table_.size()), static_cast<long long>(table_.capacity()),
+      static_cast<long long>(table_.total_inserts()), inserts_per_second,
+      static_cast<long long>(table_.total_samples()), samples_per_second,
+      limiter_.samples_per_insert(), insert_allowed_ ? 1 : 0, pending_requests(),
+      static_cast<long long>(bus.malformed + bus.foreign + bus.invalid + counters_.batches_refused +
+                             counters_.requests_refused + counters_.requests_dropped),
+      static_cast<long long>(bus.lost));
+  std::fflush(stdout);
+}
+
+void ReplayService::Tick(double now) {
+  // Each publication is due once its period has passed; a late tick does not cause a burst.
+  if (now >= next_flow_) {
+    PublishFlow(/*force=*/true);
+    next_flow_ = now + 1.0 / options_.flow_hz;
+  }
+  if (now >= next_stats_) {
+    PublishStats(now);
+    next_stats_ = now + 1.0 / options_.stats_hz;
+  }
+  if (options_.progress_seconds > 0 && now >= next_progress_) {
+    // The first call only starts the rate intervals.
+    if (next_progress_ >= 0) {
+      PrintProgress(now);
+    } else {
+      progress_insert_rate_.Take(table_.total_inserts(), now);
+      progress_sample_rate_.Take(table_.total_samples(), now);
+    }
+    next_progress_ = now + options_.progress_seconds;
+  }
+}
+
+void ReplayService::Run(const std::function<bool()>& should_stop) {
+  while (!should_stop()) {
+    bus_.Handle(options_.handle_timeout_ms);
+    Serve();
+    Tick();
+  }
+  // Leave a last word for the monitor.
+  const double now = MonoSeconds();
+  PublishFlow(/*force=*/true);
+  PublishStats(now);
+}
+
+}  // namespace rl::replay

@@ -1,0 +1,161 @@
+// ReplayService: the replay daemon's LCM side. It connects a ReplayTable and a RateLimiter to
+// the bus.
+//
+// In (main port):
+//   RL_TRANSITIONS     transition_batch_t  every valid batch is stored, whatever the limiter says
+//                                          (the limiter only tells actors to pause)
+//   RL_SAMPLE_REQUEST  sample_request_t    queued; several may be in flight
+// Out:
+//   RL_SAMPLES         sample_batch_t      (bulk port) one reply per request, in request order,
+//                                          as soon as the limiter allows a sample of its size
+//   RL_FLOW            flow_control_t      at flow_hz, and at once whenever insert_allowed changes
+//   RL_STATS_REPLAY    stats_replay_t      at stats_hz
+//
+// What the bus drops (malformed, foreign, invalid, lost) is counted by the bus; what the service
+// itself refuses (a batch the table will not store, a request that can never be answered) is
+// counted here and reported in stats_replay_t.dropped_invalid together with the bus's count.
+//
+// Replies are one message each: a request whose reply would exceed max_reply_bytes is refused.
+// For CartPole a batch of 128 is about 7 KB.
+//
+// Not thread-safe: one thread constructs the service and calls every method; the bus must be
+// used by that thread only and must outlive the service.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <random>
+#include <string>
+
+#include "common/clock.h"
+#include "common/lcm_bus.h"
+#include "replay/rate_limiter.h"
+#include "replay/replay_table.h"
+#include "rlmsg/flow_control_t.hpp"
+#include "rlmsg/sample_batch_t.hpp"
+#include "rlmsg/sample_request_t.hpp"
+#include "rlmsg/stats_replay_t.hpp"
+#include "rlmsg/transition_batch_t.hpp"
+
+namespace rl::replay {
+
+struct ReplayServiceOptions {
+  // Storage: capacity and observation size.
+  ReplayTableOptions table;
+  // Samples-per-insert ratio, minimum size and tolerance.
+  RateLimiterOptions limiter;
+  // Seed of the sampler's random generator.
+  uint64_t seed = 1;
+  // Transitions an actor asks to insert at a time: insert_allowed is CanInsert(insert_unit).
+  int insert_unit = 1;
+  // Sample requests waiting for the limiter; when full, the oldest is dropped.
+  int max_pending_requests = 64;
+  // Largest reply (encoded bytes); larger requests are refused. The default fits twice into the
+  // 8 MiB receive buffers of our URLs.
+  int64_t max_reply_bytes = 4 << 20;
+  // Periodic flow_control_t publications per second (changes are published at once as well).
+  double flow_hz = 20.0;
+  // stats_replay_t publications per second.
+  double stats_hz = 4.0;
+  // Seconds between progress lines on stdout (size, rates); 0: none.
+  double progress_seconds = 0.0;
+  // Milliseconds Run() waits for traffic in each round.
+  int handle_timeout_ms = 10;
+
+  /// Throws std::invalid_argument naming the field when a value is out of range.
+  void Validate() const;
+};
+
+/// What the service refused or dropped itself (the bus counts the rest).
+struct ServiceCounters {
+  int64_t batches_refused = 0;    // transition batches the table would not store
+  int64_t requests_refused = 0;   // requests whose batch could never be served
+  int64_t requests_dropped = 0;   // pending requests pushed out of a full queue
+  int64_t requests_answered = 0;  // replies published
+};
+
+class ReplayService {
+ public:
+  /// Subscribes to RL_TRANSITIONS and RL_SAMPLE_REQUEST on `bus`. Throws std::invalid_argument
+  /// when the options are bad.
+  ReplayService(Bus* bus, ReplayServiceOptions options);
+  ReplayService(const ReplayService&) = delete;
+  ReplayService& operator=(const ReplayService&) = delete;
+  ~ReplayService();
+
+  /// Answers pending requests, oldest first, while the limiter allows the oldest one's batch.
+  /// Returns the number of replies published.
+  int Serve();
+
+  /// Time-driven work: periodic flow control, stats and progress lines when due. `now` is in
+  /// seconds on the monotonic clock (MonoSeconds()).
+  void Tick(double now);
+  void Tick() { Tick(MonoSeconds()); }
+
+  /// Handles traffic, serves and ticks until should_stop() returns true (checked before each
+  /// round). Publishes a flow_control_t and a stats_replay_t before returning.
+  void Run(const std::function<bool()>& should_stop);
+
+  const ReplayTable& table() const { return table_; }
+  const RateLimiter& limiter() const { return limiter_; }
+  const ServiceCounters& counters() const { return counters_; }
+  int pending_requests() const { return static_cast<int>(pending_.size()); }
+  /// Last value of insert_allowed published on RL_FLOW.
+  bool insert_allowed() const { return insert_allowed_; }
+
+ private:
+  struct PendingRequest {
+    std::string requester;
+    int64_t request_id = 0;
+    int32_t batch_size = 0;
+  };
+
+  // Events per second over the interval between two calls of Take().
+  class IntervalRate {
+   public:
+    double Take(int64_t count, double now);
+
+   private:
+    int64_t last_count_ = 0;
+    double last_time_ = -1.0;
+  };
+
+  void OnTransitions(const rlmsg::transition_batch_t& m);
+  void OnSampleRequest(const rlmsg::sample_request_t& m);
+  // Draws and publishes the reply to one request.
+  void Answer(const PendingRequest& request);
+  // Why a request can never be answered, or nullptr.
+  const char* Unanswerable(const PendingRequest& request);
+  // Publishes flow_control_t when insert_allowed changed (or always, when forced).
+  void PublishFlow(bool force);
+  void PublishStats(double now);
+  void PrintProgress(double now);
+  void LogRefusal(const char* what, const char* why);
+
+  Bus& bus_;
+  ReplayServiceOptions options_;
+  ReplayTable table_;
+  RateLimiter limiter_;
+  std::mt19937_64 rng_;
+  std::deque<PendingRequest> pending_;
+  ServiceCounters counters_;
+  bool insert_allowed_ = true;
+  int64_t refusals_logged_ = 0;
+
+  // Next due times of the periodic publications (monotonic seconds; < 0: at the next Tick).
+  double next_flow_ = -1.0;
+  double next_stats_ = -1.0;
+  double next_progress_ = -1.0;
+  IntervalRate stats_insert_rate_;
+  IntervalRate stats_sample_rate_;
+  IntervalRate progress_insert_rate_;
+  IntervalRate progress_sample_rate_;
+
+  // Reused messages, so that a warm service does not allocate per reply.
+  rlmsg::sample_batch_t reply_{};
+  rlmsg::flow_control_t flow_{};
+  rlmsg::stats_replay_t stats_{};
+};
+
+}  // namespace rl::replay

@@ -1,0 +1,151 @@
+#include "replay/replay_table.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "common/check.h"
+#include "replay/uniform_sampler.h"
+
+namespace rl::replay {
+namespace {
+
+// Largest observation we accept (floats); far above any flat or pixel observation we use.
+constexpr int kMaxObsSize = 1 << 24;
+
+// Copies n values from `from` to `to`.
+template <class T>
+void CopyN(const T* from, size_t n, T* to) {
+  std::copy(from, from + n, to);
+}
+
+}  // namespace
+
+void ReplayTableOptions::Validate() const {
+  if (capacity < 1) {
+    throw std::invalid_argument("replay table: capacity must be at least 1, got " +
+                                std::to_string(capacity));
+  }
+  if (obs_size < 0 || obs_size > kMaxObsSize) {
+    throw std::invalid_argument("replay table: obs_size must be in [0, " +
+                                std::to_string(kMaxObsSize) + "] (0: from the first batch), got " +
+                                std::to_string(obs_size));
+  }
+}
+
+void SampleBatch::Resize(int new_count, int new_obs_size) {
+  count = new_count;
+  obs_size = new_obs_size;
+  const auto n = static_cast<size_t>(new_count);
+  const size_t values = n * static_cast<size_t>(new_obs_size);
+  obs.resize(values);
+  next_obs.resize(values);
+  action.resize(n);
+  reward.resize(n);
+  discount.resize(n);
+  index.resize(n);
+  weight.resize(n);
+  episode_id.resize(n);
+}
+
+SampleSpans SampleBatch::spans() {
+  return SampleSpans{obs, next_obs, action, reward, discount, index, weight, episode_id};
+}
+
+ReplayTable::ReplayTable(ReplayTableOptions options, std::unique_ptr<Sampler> sampler)
+    : options_(options), sampler_(std::move(sampler)) {
+  options_.Validate();
+  if (sampler_ == nullptr) sampler_ = std::make_unique<UniformSampler>(options_.capacity);
+  if (options_.obs_size > 0) Allocate(options_.obs_size);
+}
+
+ReplayTable::~ReplayTable() = default;
+
+void ReplayTable::Allocate(int obs_size) {
+  obs_size_ = obs_size;
+  const auto slots = static_cast<size_t>(options_.capacity);
+  obs_.assign(slots * static_cast<size_t>(obs_size), 0.0f);
+  next_obs_.assign(slots * static_cast<size_t>(obs_size), 0.0f);
+  action_.assign(slots, 0);
+  reward_.assign(slots, 0.0f);
+  discount_.assign(slots, 0.0f);
+  episode_id_.assign(slots, -1);
+  insert_number_.assign(slots, -1);
+}
+
+const char* ReplayTable::Insert(const TransitionBatchView& batch) {
+  // Check the whole batch before storing any of it.
+  if (batch.count <= 0) return "empty batch";
+  if (batch.obs_size <= 0 || batch.obs_size > kMaxObsSize) return "obs_size out of range";
+  if (obs_size_ != 0 && batch.obs_size != obs_size_) return "obs_size differs from the table's";
+  const auto n = static_cast<size_t>(batch.count);
+  const size_t values = n * static_cast<size_t>(batch.obs_size);
+  if (batch.obs.size() != values || batch.next_obs.size() != values) {
+    return "obs or next_obs size is not count * obs_size";
+  }
+  if (batch.action.size() != n || batch.reward.size() != n || batch.discount.size() != n) {
+    return "action, reward or discount size is not count";
+  }
+  if (!batch.episode_id.empty() && batch.episode_id.size() != n) {
+    return "episode_id size is neither 0 nor count";
+  }
+  if (!batch.priority.empty() && batch.priority.size() != n) {
+    return "priority size is neither 0 nor count";
+  }
+  if (obs_size_ == 0) Allocate(batch.obs_size);
+
+  // Write each transition into the slot after the newest one, wrapping around.
+  const auto obs_size = static_cast<size_t>(obs_size_);
+  for (size_t i = 0; i < n; ++i) {
+    const int64_t slot = total_inserts_ % options_.capacity;
+    const auto s = static_cast<size_t>(slot);
+    CopyN(batch.obs.data() + i * obs_size, obs_size, obs_.data() + s * obs_size);
+    CopyN(batch.next_obs.data() + i * obs_size, obs_size, next_obs_.data() + s * obs_size);
+    action_[s] = batch.action[i];
+    reward_[s] = batch.reward[i];
+    discount_[s] = batch.discount[i];
+    episode_id_[s] = batch.episode_id.empty() ? -1 : batch.episode_id[i];
+    insert_number_[s] = total_inserts_;
+    sampler_->Insert(slot, batch.priority.empty() ? 0.0 : batch.priority[i]);
+    ++total_inserts_;
+  }
+  size_ = std::min(total_inserts_, options_.capacity);
+  return nullptr;
+}
+
+bool ReplayTable::Sample(int batch_size, std::mt19937_64* rng, const SampleSpans& out) {
+  RL_CHECK(batch_size > 0) << "batch_size must be positive, got " << batch_size;
+  if (size_ == 0) return false;
+  const auto n = static_cast<size_t>(batch_size);
+  const auto obs_size = static_cast<size_t>(obs_size_);
+  RL_CHECK(out.obs.size() == n * obs_size && out.next_obs.size() == n * obs_size)
+      << "obs and next_obs must hold batch_size * obs_size = " << n * obs_size << " floats";
+  RL_CHECK(out.action.size() == n && out.reward.size() == n && out.discount.size() == n &&
+           out.index.size() == n && out.weight.size() == n)
+      << "action, reward, discount, index and weight must hold batch_size = " << n << " values";
+  RL_CHECK(out.episode_id.empty() || out.episode_id.size() == n)
+      << "episode_id must be empty or hold batch_size = " << n << " values";
+
+  // Let the sampler choose the slots, then gather their fields.
+  if (items_.size() < n) items_.resize(n);
+  const std::span<SampledItem> items(items_.data(), n);
+  sampler_->Sample(rng, items);
+  for (size_t i = 0; i < n; ++i) {
+    const auto s = static_cast<size_t>(items[i].slot);
+    RL_DCHECK(items[i].slot >= 0 && items[i].slot < size_) << "sampler chose an empty slot";
+    CopyN(obs_.data() + s * obs_size, obs_size, out.obs.data() + i * obs_size);
+    CopyN(next_obs_.data() + s * obs_size, obs_size, out.next_obs.data() + i * obs_size);
+    out.action[i] = action_[s];
+    out.reward[i] = reward_[s];
+    out.discount[i] = discount_[s];
+    out.index[i] = insert_number_[s];
+    // Uniform sampling needs no correction; a prioritized sampler will supply real weights.
+    out.weight[i] = 1.0f;
+    if (!out.episode_id.empty()) out.episode_id[i] = episode_id_[s];
+  }
+  total_samples_ += batch_size;
+  return true;
+}
+
+}  // namespace rl::replay

@@ -1,0 +1,379 @@
+#include "replay/replay_service.h"
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <memory>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "common/channels.h"
+#include "common/lcm_bus.h"
+
+namespace rl::replay {
+namespace {
+
+constexpr int64_t kRunId = 42;
+
+BusConfig MemqConfig() {
+  BusConfig c;
+  c.url = "memq://";
+  c.bulk_url = "memq://";
+  c.run_id = kRunId;
+  c.sender = "replay";
+  return c;
+}
+
+ReplayServiceOptions Options(double spi, int64_t min_size, double error_buffer) {
+  ReplayServiceOptions o;
+  o.table.capacity = 1000;
+  o.limiter.samples_per_insert = spi;
+  o.limiter.min_size_to_sample = min_size;
+  o.limiter.error_buffer = error_buffer;
+  return o;
+}
+
+// Transition v has obs {v, v + 0.5, ...}, next_obs obs + 1000, action v % 2, reward v / 4.
+rlmsg::transition_batch_t MakeBatch(int first, int count, int obs_size) {
+  rlmsg::transition_batch_t m{};
+  m.actor_id = 0;
+  m.obs_size = obs_size;
+  m.count = count;
+  m.num_values = count * obs_size;
+  for (int v = first; v < first + count; ++v) {
+    for (int j = 0; j < obs_size; ++j) {
+      m.obs.push_back(static_cast<float>(v) + 0.5f * static_cast<float>(j));
+      m.next_obs.push_back(static_cast<float>(v) + 0.5f * static_cast<float>(j) + 1000.0f);
+    }
+    m.action.push_back(v % 2);
+    m.reward.push_back(static_cast<float>(v) / 4.0f);
+    m.discount.push_back(0.99f);
+    m.episode_id.push_back(0);
+    m.priority.push_back(0.0f);
+  }
+  return m;
+}
+
+// One bus shared by the service and the test (memq delivers within one LCM instance). The test
+// publishes as other senders by encoding the header itself.
+class ReplayServiceTest : public ::testing::Test {
+ protected:
+  ReplayServiceTest() : bus_(MemqConfig()) {
+    bus_.Subscribe<rlmsg::sample_batch_t>(
+        channels::kSamples, [this](const rlmsg::sample_batch_t& m) { replies_.push_back(m); },
+        Port::kBulk);
+    bus_.Subscribe<rlmsg::flow_control_t>(
+        channels::kFlow, [this](const rlmsg::flow_control_t& m) { flows_.push_back(m); });
+    bus_.Subscribe<rlmsg::stats_replay_t>(
+        channels::kStatsReplay, [this](const rlmsg::stats_replay_t& m) { stats_.push_back(m); });
+  }
+
+  void Start(const ReplayServiceOptions& options) {
+    service_ = std::make_unique<ReplayService>(&bus_, options);
+  }
+
+  template <class Msg>
+  void PublishAs(const std::string& channel, Msg m, const std::string& sender,
+                 int64_t run_id = kRunId) {
+    m.header.run_id = run_id;
+    m.header.sender = sender;
+    m.header.seq = next_seq_[{channel, sender}]++;
+    m.header.utime = 1;
+    std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+    ASSERT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())),
+              static_cast<int>(bytes.size()));
+    ASSERT_TRUE(bus_.PublishRaw(channel, bytes.data(), bytes.size()));
+  }
+
+  void SendTransitions(int first, int count, int obs_size = 4) {
+    PublishAs(channels::kTransitions, MakeBatch(first, count, obs_size), "actor-0");
+  }
+
+  void SendRequest(int64_t request_id, int batch_size) {
+    rlmsg::sample_request_t r{};
+    r.request_id = request_id;
+    r.batch_size = batch_size;
+    PublishAs(channels::kSampleRequest, r, "learner-0");
+  }
+
+  // Delivers what was published, lets the service answer, and delivers its replies.
+  void Pump() {
+    bus_.Handle(0);
+    service_->Serve();
+    bus_.Handle(0);
+  }
+
+  Bus bus_;
+  std::unique_ptr<ReplayService> service_;
+  std::map<std::pair<std::string, std::string>, int64_t> next_seq_;
+  std::vector<rlmsg::sample_batch_t> replies_;
+  std::vector<rlmsg::flow_control_t> flows_;
+  std::vector<rlmsg::stats_replay_t> stats_;
+};
+
+TEST_F(ReplayServiceTest, RefusesBadOptions) {
+  ReplayServiceOptions o = Options(8, 100, 200);
+  o.max_pending_requests = 0;
+  EXPECT_THROW(Start(o), std::invalid_argument);
+  o = Options(8, 100, 200);
+  o.flow_hz = 0;
+  EXPECT_THROW(Start(o), std::invalid_argument);
+  o = Options(8, 100, 2);  // error buffer below samples_per_insert
+  EXPECT_THROW(Start(o), std::invalid_argument);
+}
+
+TEST_F(ReplayServiceTest, StoresIncomingTransitions) {
+  Start(Options(8, 100, 200));
+  SendTransitions(0, 10);
+  SendTransitions(10, 15);
+  Pump();
+  EXPECT_EQ(service_->table().size(), 25);
+  EXPECT_EQ(service_->table().total_inserts(), 25);
+  EXPECT_EQ(service_->limiter().inserts(), 25);
+  EXPECT_EQ(bus_.counters().lost, 0);
+}
+
+TEST_F(ReplayServiceTest, HoldsARequestUntilMinSizeThenAnswersIt) {
+  Start(Options(8, 50, 400));
+  SendTransitions(0, 20);
+  SendRequest(7, 16);
+  Pump();
+  EXPECT_TRUE(replies_.empty());
+  EXPECT_EQ(service_->pending_requests(), 1);
+
+  SendTransitions(20, 30);
+  Pump();
+  ASSERT_EQ(replies_.size(), 1U);
+  EXPECT_EQ(service_->pending_requests(), 0);
+  const rlmsg::sample_batch_t& r = replies_[0];
+  EXPECT_EQ(r.header.sender, "replay");
+  EXPECT_EQ(r.requester, "learner-0");
+  EXPECT_EQ(r.request_id, 7);
+  EXPECT_EQ(r.count, 16);
+  EXPECT_EQ(r.obs_size, 4);
+  EXPECT_EQ(r.num_values, 64);
+  EXPECT_EQ(r.replay_size, 50);
+  EXPECT_EQ(r.total_inserts, 50);
+  // Every transition is one that was inserted, whole and in the right place.
+  for (size_t i = 0; i < 16; ++i) {
+    const float v = r.obs[i * 4];
+    ASSERT_GE(v, 0.0f);
+    ASSERT_LT(v, 50.0f);
+    ASSERT_EQ(v, std::floor(v));
+    for (size_t j = 0; j < 4; ++j) {
+      EXPECT_EQ(r.obs[i * 4 + j], v + 0.5f * static_cast<float>(j));
+      EXPECT_EQ(r.next_obs[i * 4 + j], v + 0.5f * static_cast<float>(j) + 1000.0f);
+    }
+    EXPECT_EQ(r.action[i], static_cast<int>(v) % 2);
+    EXPECT_EQ(r.reward[i], v / 4.0f);
+    EXPECT_EQ(r.discount[i], 0.99f);
+    EXPECT_EQ(r.index[i], static_cast<int64_t>(v));
+    EXPECT_EQ(r.weight[i], 1.0f);
+  }
+  EXPECT_EQ(service_->table().total_samples(), 16);
+  EXPECT_EQ(service_->counters().requests_answered, 1);
+}
+
+TEST_F(ReplayServiceTest, HoldsARetriedRequestOnceAndAnswersItOnce) {
+  Start(Options(8, 50, 400));
+  SendRequest(7, 16);
+  SendRequest(7, 16);  // the learner's retry after a timeout
+  SendRequest(8, 16);
+  Pump();
+  EXPECT_EQ(service_->pending_requests(), 2);
+  SendTransitions(0, 50);
+  Pump();
+  ASSERT_EQ(replies_.size(), 2U);
+  EXPECT_EQ(replies_[0].request_id, 7);
+  EXPECT_EQ(replies_[1].request_id, 8);
+}
+
+TEST_F(ReplayServiceTest, AnswersSeveralRequestsInOrderAsTheLimiterAllows) {
+  // SPI 1, min 10, error buffer 10: right after the warm-up (diff 10), 10 samples are allowed.
+  Start(Options(1, 10, 10));
+  SendTransitions(0, 10);
+  SendRequest(1, 6);
+  SendRequest(2, 6);
+  SendRequest(3, 2);
+  Pump();
+  // The first fits; the second must wait (diff 4 - 6 < 0) and holds up the third.
+  ASSERT_EQ(replies_.size(), 1U);
+  EXPECT_EQ(replies_[0].request_id, 1);
+  EXPECT_EQ(service_->pending_requests(), 2);
+  SendTransitions(10, 4);  // diff 8
+  Pump();
+  ASSERT_EQ(replies_.size(), 3U);
+  EXPECT_EQ(replies_[1].request_id, 2);
+  EXPECT_EQ(replies_[2].request_id, 3);
+}
+
+TEST_F(ReplayServiceTest, FlowControlPausesActorsThatRunAheadAndResumesThemAfterSamples) {
+  // max_diff = 1 * 10 + 10 = 20: one more insert is refused once 20 transitions are in.
+  Start(Options(1, 10, 10));
+  EXPECT_TRUE(service_->insert_allowed());
+  SendTransitions(0, 5);
+  SendTransitions(5, 5);
+  SendTransitions(10, 5);
+  Pump();
+  EXPECT_TRUE(flows_.empty()) << "no change yet, so no immediate flow message";
+  SendTransitions(15, 5);
+  Pump();
+  ASSERT_EQ(flows_.size(), 1U);
+  EXPECT_EQ(flows_[0].insert_allowed, 0);
+  EXPECT_EQ(flows_[0].target_samples_per_insert, 1.0);
+  EXPECT_EQ(flows_[0].error_buffer, 10.0);
+  EXPECT_FALSE(service_->insert_allowed());
+
+  // Transitions still in flight are stored all the same.
+  SendTransitions(20, 2);
+  Pump();
+  EXPECT_EQ(service_->table().size(), 22);
+  EXPECT_EQ(flows_.size(), 1U);
+
+  // The learner catches up: diff 22 - 12 = 10, and 11 <= 20 allows inserts again.
+  SendRequest(1, 12);
+  Pump();
+  ASSERT_EQ(replies_.size(), 1U);
+  ASSERT_EQ(flows_.size(), 2U);
+  EXPECT_EQ(flows_[1].insert_allowed, 1);
+  EXPECT_TRUE(service_->insert_allowed());
+}
+
+TEST_F(ReplayServiceTest, DropsForeignAndNonFiniteBatchesAndKeepsWorking) {
+  Start(Options(1, 5, 10));
+  PublishAs(channels::kTransitions, MakeBatch(0, 5, 4), "actor-9", /*run_id=*/kRunId + 1);
+  rlmsg::transition_batch_t nan = MakeBatch(0, 5, 4);
+  nan.obs[3] = std::numeric_limits<float>::quiet_NaN();
+  PublishAs(channels::kTransitions, nan, "actor-0");
+  Pump();
+  EXPECT_EQ(service_->table().size(), 0);
+  EXPECT_EQ(bus_.counters().foreign, 1);
+  EXPECT_EQ(bus_.counters().invalid, 1);
+
+  SendTransitions(0, 5);
+  SendRequest(1, 3);
+  Pump();
+  EXPECT_EQ(service_->table().size(), 5);
+  ASSERT_EQ(replies_.size(), 1U);
+  service_->Tick(100.0);
+  bus_.Handle(0);
+  ASSERT_EQ(stats_.size(), 1U);
+  EXPECT_EQ(stats_[0].dropped_foreign, 1);
+  EXPECT_EQ(stats_[0].dropped_invalid, 1);
+  EXPECT_EQ(stats_[0].size, 5);
+}
+
+TEST_F(ReplayServiceTest, RefusesABatchOfAnotherObsSizeAndCountsItAsInvalid) {
+  Start(Options(1, 5, 10));
+  SendTransitions(0, 5, /*obs_size=*/4);
+  SendTransitions(5, 5, /*obs_size=*/3);
+  SendTransitions(10, 5, /*obs_size=*/4);
+  Pump();
+  EXPECT_EQ(service_->table().size(), 10);
+  EXPECT_EQ(service_->counters().batches_refused, 1);
+  // The limiter counts only what was stored.
+  EXPECT_EQ(service_->limiter().inserts(), 10);
+  service_->Tick(100.0);
+  bus_.Handle(0);
+  ASSERT_EQ(stats_.size(), 1U);
+  EXPECT_EQ(stats_[0].dropped_invalid, 1);
+}
+
+TEST_F(ReplayServiceTest, DropsTheOldestRequestWhenTheQueueIsFull) {
+  ReplayServiceOptions o = Options(0, 10, 0);  // no ratio: every request is served once warm
+  o.max_pending_requests = 4;
+  Start(o);
+  for (int64_t id = 0; id < 6; ++id) SendRequest(id, 2);
+  Pump();
+  EXPECT_EQ(service_->pending_requests(), 4);
+  EXPECT_EQ(service_->counters().requests_dropped, 2);
+  SendTransitions(0, 10);
+  Pump();
+  ASSERT_EQ(replies_.size(), 4U);
+  for (size_t i = 0; i < 4; ++i) EXPECT_EQ(replies_[i].request_id, static_cast<int64_t>(i) + 2);
+}
+
+TEST_F(ReplayServiceTest, RefusesRequestsThatCouldNeverBeAnswered) {
+  // max_sample_batch = 2 * 10 - 1 = 19.
+  ReplayServiceOptions o = Options(1, 5, 10);
+  o.max_reply_bytes = 1024;
+  Start(o);
+  SendRequest(1, 20);
+  SendRequest(2, 19);  // allowed by the limiter, but its reply (~1.2 KB) exceeds 1024 bytes
+  Pump();
+  EXPECT_EQ(service_->counters().requests_refused, 1);
+  EXPECT_EQ(service_->pending_requests(), 1);
+  SendTransitions(0, 5);
+  Pump();
+  EXPECT_TRUE(replies_.empty());
+  EXPECT_EQ(service_->counters().requests_refused, 2);
+  EXPECT_EQ(service_->pending_requests(), 0);
+  // A small one still goes through.
+  SendRequest(3, 4);
+  Pump();
+  ASSERT_EQ(replies_.size(), 1U);
+  EXPECT_EQ(replies_[0].request_id, 3);
+}
+
+TEST_F(ReplayServiceTest, TickPublishesFlowAndStatsAtTheirRates) {
+  ReplayServiceOptions o = Options(8, 100, 200);
+  o.flow_hz = 20;  // every 0.05 s
+  o.stats_hz = 4;  // every 0.25 s
+  Start(o);
+  SendTransitions(0, 8);
+  Pump();
+  service_->Tick(10.0);
+  bus_.Handle(0);
+  EXPECT_EQ(flows_.size(), 1U);
+  EXPECT_EQ(stats_.size(), 1U);
+  service_->Tick(10.01);
+  bus_.Handle(0);
+  EXPECT_EQ(flows_.size(), 1U);
+  EXPECT_EQ(stats_.size(), 1U);
+  service_->Tick(10.06);
+  bus_.Handle(0);
+  EXPECT_EQ(flows_.size(), 2U);
+  EXPECT_EQ(stats_.size(), 1U);
+  SendTransitions(8, 12);
+  Pump();
+  service_->Tick(10.5);
+  bus_.Handle(0);
+  EXPECT_EQ(flows_.size(), 3U);
+  ASSERT_EQ(stats_.size(), 2U);
+
+  const rlmsg::stats_replay_t& s = stats_[1];
+  EXPECT_EQ(s.header.sender, "replay");
+  EXPECT_EQ(s.size, 20);
+  EXPECT_EQ(s.capacity, 1000);
+  EXPECT_EQ(s.total_inserts, 20);
+  EXPECT_EQ(s.total_samples, 0);
+  EXPECT_DOUBLE_EQ(s.inserts_per_second, 12 / 0.5);
+  EXPECT_EQ(s.samples_per_second, 0.0);
+  EXPECT_EQ(s.insert_allowed, 1);
+  EXPECT_EQ(s.pending_requests, 0);
+  EXPECT_EQ(flows_.back().insert_allowed, 1);
+  EXPECT_EQ(flows_.back().target_samples_per_insert, 8.0);
+}
+
+TEST_F(ReplayServiceTest, RunServesUntilAskedToStop) {
+  Start(Options(8, 10, 200));
+  SendTransitions(0, 10);
+  SendRequest(5, 8);
+  int rounds = 0;
+  service_->Run([&] { return !replies_.empty() || ++rounds > 500; });
+  ASSERT_EQ(replies_.size(), 1U);
+  EXPECT_EQ(replies_[0].request_id, 5);
+  // Run leaves a last flow and stats message behind.
+  bus_.Handle(0);
+  ASSERT_FALSE(flows_.empty());
+  ASSERT_FALSE(stats_.empty());
+  EXPECT_EQ(stats_.back().total_samples, 8);
+}
+
+}  // namespace
+}  // namespace rl::replay
