@@ -1,0 +1,297 @@
+#include "evaluator/evaluator_service.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdarg>
+#include <filesystem>
+#include <random>
+#include <stdexcept>
+#include <system_error>
+
+#include "common/channels.h"
+#include "common/clock.h"
+#include "common/shutdown.h"
+#include "envs/registry.h"
+#include "nn/checkpoint.h"
+#include "nn/sequential.h"
+#include "rlmsg/eval_result_t.hpp"
+#include "rlmsg/stats_evaluator_t.hpp"
+
+namespace rl::evaluator {
+namespace {
+
+std::string FileName(const std::string& path) {
+  return std::filesystem::path(path).filename().string();
+}
+
+// The name of the run folder `dir` ("runs/cartpole-1/" -> "cartpole-1").
+std::string FolderName(const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::path p = std::filesystem::absolute(dir, ec).lexically_normal();
+  if (ec) p = std::filesystem::path(dir).lexically_normal();
+  if (p.filename().empty()) p = p.parent_path();
+  return p.filename().string();
+}
+
+}  // namespace
+
+void EvaluatorConfig::Validate() const {
+  if (env_id.empty()) throw std::invalid_argument("env id must not be empty");
+  if (episodes < 1) {
+    throw std::invalid_argument("episodes must be at least 1, got " + std::to_string(episodes));
+  }
+  if (!(epsilon >= 0.0 && epsilon <= 1.0)) {
+    throw std::invalid_argument("epsilon must be in [0, 1], got " + std::to_string(epsilon));
+  }
+  if (!(stats_period_seconds > 0.0)) {
+    throw std::invalid_argument("stats period must be positive");
+  }
+  if (std::isinf(goal)) throw std::invalid_argument("goal must be finite");
+}
+
+EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
+                               double epsilon, uint64_t first_seed) {
+  // Load and build; every failure is a refusal with a reason.
+  nn::Checkpoint ckpt = nn::LoadCheckpoint(path);
+  std::mt19937 init_rng(0);  // the initial weights are overwritten by the checkpoint's
+  nn::Sequential net;
+  try {
+    net = nn::BuildFromArchitecture(ckpt.architecture, &init_rng);
+  } catch (const std::exception& e) {
+    throw std::runtime_error("checkpoint " + path + ": cannot build architecture '" +
+                             ckpt.architecture + "': " + e.what());
+  }
+  if (static_cast<int64_t>(ckpt.params.size()) != net.NumParams()) {
+    throw std::runtime_error("checkpoint " + path + ": " + std::to_string(ckpt.params.size()) +
+                             " parameters, but architecture '" + ckpt.architecture + "' has " +
+                             std::to_string(net.NumParams()));
+  }
+  net.SetFlat(ckpt.params.data(), ckpt.params.size());
+  const std::string misfit =
+      CheckNetworkFitsEnv(net.InputSize(), net.OutputSize(), envs::MakeEnv(env_id)->spec());
+  if (!misfit.empty()) throw std::runtime_error("checkpoint " + path + ": " + misfit);
+
+  // Score.
+  const double start = MonoSeconds();
+  const EvalScore score = ScorePolicy(&net, env_id, episodes, epsilon, first_seed);
+  EvalRecord r;
+  r.checkpoint = FileName(path);
+  r.update = ckpt.meta.update;
+  r.env_steps = ckpt.meta.env_steps;
+  r.wall_seconds = ckpt.meta.wall_seconds;
+  r.mean = score.mean;
+  r.std = score.std;
+  r.min = score.min;
+  r.max = score.max;
+  r.episodes = score.episodes;
+  r.eval_seconds = MonoSeconds() - start;
+  return r;
+}
+
+EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* progress)
+    : config_(std::move(config)), bus_(bus), progress_(progress) {
+  config_.Validate();
+  // The goal defaults to the env's reward threshold (MakeEnv throws for an unknown id).
+  const envs::EnvSpec spec = envs::MakeEnv(config_.env_id)->spec();
+  goal_ = std::isnan(config_.goal) ? spec.reward_threshold : config_.goal;
+  char epsilon[32];
+  std::snprintf(epsilon, sizeof(epsilon), "%g", config_.epsilon);
+  const uint64_t last_seed = config_.seed_base + static_cast<uint64_t>(config_.episodes) - 1;
+  eval_settings_ = "Each checkpoint is scored on " + std::to_string(config_.episodes) +
+                   " episodes (seeds " + std::to_string(config_.seed_base) + " to " +
+                   std::to_string(last_seed) + ") with epsilon " + epsilon + ".";
+
+  // Resume the history of the run folder.
+  if (!config_.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(config_.out_dir, ec);
+    if (ec) {
+      throw std::runtime_error("cannot create '" + config_.out_dir + "': " + ec.message());
+    }
+    jsonl_path_ = (std::filesystem::path(config_.out_dir) / "eval.jsonl").string();
+    report_dir_ = (std::filesystem::path(config_.out_dir) / "report").string();
+    run_name_ = config_.run_name.empty() ? FolderName(config_.out_dir) : config_.run_name;
+    int skipped_lines = 0;
+    records_ = LoadJsonLines(jsonl_path_, &skipped_lines);
+    if (!records_.empty() || skipped_lines > 0) {
+      Log("evaluator: resumed %zu records from %s (%d unreadable lines skipped)\n", records_.size(),
+          jsonl_path_.c_str(), skipped_lines);
+    }
+    for (const EvalRecord& r : records_) {
+      scored_keys_.insert({r.checkpoint, r.update});
+      if (r.mean >= goal_) goal_reached_ = true;
+    }
+  } else {
+    run_name_ = config_.run_name;
+  }
+
+  // The bus cannot unsubscribe: after the service is gone, its handler does nothing.
+  bus_->Subscribe<rlmsg::checkpoint_t>(channels::kCheckpoint,
+                                       [alive = alive_](const rlmsg::checkpoint_t& m) {
+                                         if (*alive != nullptr) (*alive)->OnCheckpoint(m);
+                                       });
+  WriteReportNow();
+  next_stats_time_ = MonoSeconds();
+}
+
+EvaluatorService::~EvaluatorService() { *alive_ = nullptr; }
+
+void EvaluatorService::Log(const char* fmt, ...) const {
+  if (progress_ == nullptr) return;
+  va_list args;
+  va_start(args, fmt);
+  std::vfprintf(progress_, fmt, args);
+  va_end(args);
+  std::fflush(progress_);
+}
+
+void EvaluatorService::OnCheckpoint(const rlmsg::checkpoint_t& msg) {
+  // A re-announcement of a scored checkpoint changes nothing.
+  if (scored_keys_.count({FileName(msg.path), msg.update}) > 0 ||
+      (pending_ && pending_->path == msg.path && pending_->update == msg.update)) {
+    ++duplicates_;
+    return;
+  }
+  // Keep the newest; the other one is skipped.
+  if (pending_ && msg.update < pending_->update) {
+    ++skipped_;
+    return;
+  }
+  if (pending_) ++skipped_;
+  pending_ = msg;
+}
+
+const EvalRecord* EvaluatorService::best() const {
+  const EvalRecord* b = nullptr;
+  for (const EvalRecord& r : records_) {
+    if (b == nullptr || r.mean > b->mean) b = &r;
+  }
+  return b;
+}
+
+bool EvaluatorService::Poll(int timeout_ms) {
+  // Wait no longer than until the next stats message.
+  const double until_stats = next_stats_time_ - MonoSeconds();
+  const int stats_ms = until_stats <= 0 ? 0 : static_cast<int>(std::ceil(until_stats * 1000.0));
+  bus_->Handle(std::clamp(stats_ms, 0, std::max(timeout_ms, 0)));
+  const bool reached = ScorePending();
+  if (MonoSeconds() >= next_stats_time_) PublishStats();
+  return reached && config_.stop_at_goal;
+}
+
+void EvaluatorService::Run() {
+  while (!StopRequested()) {
+    if (Poll(100)) break;
+  }
+  WriteReportNow();
+  PublishStats();
+}
+
+bool EvaluatorService::ScorePending() {
+  if (!pending_) return false;
+  const rlmsg::checkpoint_t announced = std::move(*pending_);
+  pending_.reset();
+  busy_ = true;
+  PublishStats();
+
+  // Load and score; a refused file is logged and counted.
+  EvalRecord record;
+  try {
+    record = ScoreCheckpointFile(announced.path, config_.env_id, config_.episodes, config_.epsilon,
+                                 config_.seed_base);
+  } catch (const std::exception& e) {
+    ++refused_;
+    busy_ = false;
+    std::fprintf(stderr, "evaluator: checkpoint refused: %s\n", e.what());
+    std::fflush(stderr);
+    return false;
+  }
+  busy_ = false;
+  // The announcement says when the checkpoint was taken.
+  record.update = announced.update;
+  record.env_steps = announced.env_steps;
+  record.wall_seconds = announced.wall_seconds;
+  const bool reached = record.mean >= goal_;
+  goal_reached_ = goal_reached_ || reached;
+  ++scored_;
+  last_mean_ = record.mean;
+  records_.push_back(record);
+  scored_keys_.insert({record.checkpoint, record.update});
+
+  // Persist: the line first (the history), then the report.
+  if (!jsonl_path_.empty()) {
+    try {
+      AppendJsonLine(jsonl_path_, record);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "evaluator: %s\n", e.what());
+      std::fflush(stderr);
+    }
+  }
+  WriteReportNow();
+
+  // Announce the result.
+  rlmsg::eval_result_t result{};
+  result.checkpoint = announced.path;
+  result.update = record.update;
+  result.env_steps = record.env_steps;
+  result.wall_seconds = record.wall_seconds;
+  result.episodes = record.episodes;
+  result.mean = record.mean;
+  result.std = record.std;
+  result.min = record.min;
+  result.max = record.max;
+  result.goal_reached = reached ? 1 : 0;
+  bus_->Publish(channels::kEval, &result);
+
+  Log("evaluator: update %lld, env steps %lld, wall %.1f s: mean %.1f \xC2\xB1 %.1f "
+      "(min %g, max %g, %d episodes, %.2f s)%s\n",
+      static_cast<long long>(record.update), static_cast<long long>(record.env_steps),
+      record.wall_seconds, record.mean, record.std, record.min, record.max, record.episodes,
+      record.eval_seconds, reached ? ", goal reached" : "");
+  return reached;
+}
+
+void EvaluatorService::WriteReportNow() {
+  if (report_dir_.empty()) return;
+  ReportInfo info;
+  info.env_id = config_.env_id;
+  info.run_name = run_name_;
+  info.run_id = bus_->config().run_id;
+  info.goal = goal_;
+  info.run_config = config_.run_config_text;
+  info.eval_settings = eval_settings_;
+  info.checkpoints_skipped = skipped_;
+  info.checkpoints_refused = refused_;
+  try {
+    WriteReport(report_dir_, records_, info);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "evaluator: cannot write the report: %s\n", e.what());
+    std::fflush(stderr);
+  }
+}
+
+void EvaluatorService::PublishStats() {
+  rlmsg::stats_evaluator_t s{};
+  s.checkpoints_scored = scored_;
+  s.checkpoints_skipped = skipped_;
+  s.checkpoints_refused = refused_;
+  s.last_mean = last_mean_;
+  const EvalRecord* b = best();
+  s.best_mean = b != nullptr ? b->mean : 0.0;
+  s.best_update = b != nullptr ? b->update : -1;
+  s.busy = busy_ ? 1 : 0;
+  bus_->FillCounters(&s);
+  bus_->Publish(channels::kStatsEvaluator, &s);
+  next_stats_time_ = MonoSeconds() + config_.stats_period_seconds;
+}
+
+std::string EvaluatorService::FinalLine() const {
+  if (goal_reached_) return "evaluator: goal reached";
+  const EvalRecord* b = best();
+  if (b == nullptr) return "evaluator: goal not reached (no checkpoint scored)";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.1f", b->mean);
+  return std::string("evaluator: goal not reached (best ") + buf + ")";
+}
+
+}  // namespace rl::evaluator

@@ -1,0 +1,135 @@
+// The evaluator's LCM service: it scores the checkpoints the learner announces and keeps the
+// run's evaluation history (eval.jsonl) and report (report/) up to date.
+//
+// Channels:
+//   in:  RL_CHECKPOINT (checkpoint_t)       a checkpoint file was written completely
+//   out: RL_EVAL (eval_result_t)            one per scored checkpoint
+//        RL_STATS_EVALUATOR (stats_evaluator_t), a few times per second
+//
+// Only the newest announced checkpoint that is not scored yet is kept: when the learner writes
+// checkpoints faster than they are scored, the older unscored ones are skipped (and counted).
+// Scoring runs in the thread that calls Poll(), between Bus::Handle() calls.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/lcm_bus.h"
+#include "evaluator/report.h"
+#include "evaluator/scorer.h"
+#include "rlmsg/checkpoint_t.hpp"
+
+namespace rl::evaluator {
+
+/// Settings of the evaluator service.
+struct EvaluatorConfig {
+  std::string env_id = "CartPole-v1";         // env the checkpoints are scored on
+  int episodes = 100;                         // evaluation episodes per checkpoint
+  double epsilon = kDefaultEvalEpsilon;       // exploration rate while scoring
+  uint64_t seed_base = kDefaultEvalSeedBase;  // episode i is reset with seed seed_base + i
+  std::string out_dir;  // run folder: out_dir/eval.jsonl and out_dir/report/; empty: no files
+  double goal = std::nan("");         // mean return that counts as solved; NaN: the env's threshold
+  bool stop_at_goal = false;          // Run() returns once a checkpoint reaches the goal
+  std::string run_config_text;        // shown in the report
+  std::string run_name;               // shown in the report's title; empty: out_dir's folder name
+  double stats_period_seconds = 0.3;  // stats_evaluator_t period (about 3 Hz)
+
+  /// Throws std::invalid_argument saying what is wrong.
+  void Validate() const;
+};
+
+/// Loads a checkpoint file, builds its network and scores it on `env_id` (see ScorePolicy).
+/// The record's update, env_steps and wall_seconds come from the file's metadata. Throws
+/// std::runtime_error with the reason when the file is refused: it does not load (missing,
+/// truncated, corrupted, foreign), its architecture does not build, its parameters do not fit
+/// the architecture, or the network does not fit the env.
+EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
+                               double epsilon, uint64_t first_seed);
+
+/// The service. Not thread-safe: construct it, call Poll() or Run() and read it from one thread,
+/// the thread that uses `bus`.
+class EvaluatorService {
+ public:
+  /// Subscribes to RL_CHECKPOINT on `bus` (not owned; must outlive the service). With an
+  /// out_dir, creates it, loads the history of an existing out_dir/eval.jsonl and writes the
+  /// report. Progress lines go to `progress` (not owned; nullptr: none). Throws
+  /// std::invalid_argument for a bad config or env and std::runtime_error when out_dir cannot
+  /// be created.
+  EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* progress = stdout);
+  EvaluatorService(const EvaluatorService&) = delete;
+  EvaluatorService& operator=(const EvaluatorService&) = delete;
+  /// The subscription stays on the bus (it cannot unsubscribe) but does nothing afterwards.
+  ~EvaluatorService();
+
+  /// Waits at most timeout_ms for announcements (less when stats are due), scores the pending
+  /// checkpoint if there is one, and publishes stats when due. Returns true when stop_at_goal is
+  /// set and the checkpoint just scored reached the goal.
+  bool Poll(int timeout_ms);
+
+  /// Polls until StopRequested() or, with stop_at_goal, until a checkpoint reaches the goal;
+  /// then rewrites the report and publishes stats one last time.
+  void Run();
+
+  /// Scores the pending checkpoint, if any. Returns true when it reached the goal.
+  bool ScorePending();
+
+  /// Rewrites out_dir/report/ (no-op without out_dir). Logs, never throws.
+  void WriteReportNow();
+
+  /// Publishes stats_evaluator_t now.
+  void PublishStats();
+
+  /// "evaluator: goal reached" or "evaluator: goal not reached (best X)".
+  std::string FinalLine() const;
+
+  double goal() const { return goal_; }
+  bool goal_reached() const { return goal_reached_; }
+  bool has_pending() const { return pending_.has_value(); }
+  /// Every record, resumed ones first, in scoring order.
+  const std::vector<EvalRecord>& records() const { return records_; }
+  int64_t checkpoints_scored() const { return scored_; }
+  int64_t checkpoints_skipped() const { return skipped_; }
+  int64_t checkpoints_refused() const { return refused_; }
+  /// Announcements of checkpoints already scored (by file name and update), ignored.
+  int64_t duplicates_ignored() const { return duplicates_; }
+  /// Best record so far (including resumed ones), or nullptr.
+  const EvalRecord* best() const;
+  const std::string& eval_jsonl_path() const { return jsonl_path_; }
+  const std::string& report_dir() const { return report_dir_; }
+
+ private:
+  void OnCheckpoint(const rlmsg::checkpoint_t& msg);
+  void Log(const char* fmt, ...) const __attribute__((format(printf, 2, 3)));
+
+  EvaluatorConfig config_;
+  Bus* bus_;
+  std::FILE* progress_;
+  double goal_ = 0;
+  std::string jsonl_path_;  // empty without out_dir
+  std::string report_dir_;  // empty without out_dir
+  std::string run_name_;
+  std::string eval_settings_;
+
+  std::optional<rlmsg::checkpoint_t> pending_;
+  std::set<std::pair<std::string, int64_t>> scored_keys_;  // file name and update
+  std::vector<EvalRecord> records_;
+  int64_t scored_ = 0;
+  int64_t skipped_ = 0;
+  int64_t refused_ = 0;
+  int64_t duplicates_ = 0;
+  double last_mean_ = 0;
+  bool busy_ = false;
+  bool goal_reached_ = false;
+  double next_stats_time_ = 0;  // MonoSeconds() when stats are due
+  // Points at this service while it lives; the bus handler holds a copy.
+  std::shared_ptr<EvaluatorService*> alive_ = std::make_shared<EvaluatorService*>(this);
+};
+
+}  // namespace rl::evaluator

@@ -1,0 +1,110 @@
+// The evaluator: scores the checkpoints of a run and writes its report (service mode), or scores
+// one checkpoint file (standalone mode). See README.md.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "common/lcm_bus.h"
+#include "common/options.h"
+#include "common/shutdown.h"
+#include "evaluator/evaluator_service.h"
+#include "evaluator/report.h"
+
+namespace {
+
+constexpr char kUsage[] =
+    "Usage:\n"
+    "  evaluator --out DIR [options]\n"
+    "      Service mode: scores every checkpoint the learner announces on RL_CHECKPOINT (the\n"
+    "      newest first; older unscored ones are skipped), appends DIR/eval.jsonl, rewrites\n"
+    "      DIR/report/index.html and its learning curves, publishes RL_EVAL and\n"
+    "      RL_STATS_EVALUATOR. Prints 'evaluator: ready' once subscribed. Stops on SIGINT or\n"
+    "      SIGTERM, or with --stop-at-goal once a checkpoint reaches the goal, and then prints\n"
+    "      'evaluator: goal reached' or 'evaluator: goal not reached (best X)'; exit status 0.\n"
+    "  evaluator --checkpoint FILE [--env ID] [--episodes N] [--epsilon E] [--seed-base S]\n"
+    "      Standalone mode: scores one checkpoint file and prints one JSON object (checkpoint,\n"
+    "      update, env_steps, wall_seconds, mean, std, min, max, episodes, eval_seconds).\n"
+    "      A refused file prints 'evaluator: error: <reason>' and exits with status 2.\n"
+    "\n"
+    "Episode i of an evaluation is reset with seed seed-base + i; the default seed base is far\n"
+    "above the seeds actors train with, so evaluation never replays a training seed.";
+
+std::string ReadTextFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot open '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+int Main(int argc, char** argv) {
+  rl::CommonOptions common;
+  rl::evaluator::EvaluatorConfig config;
+  std::string checkpoint;
+  std::string run_config_file;
+  double goal = 0;
+
+  rl::po::options_description desc("Options");
+  rl::AddCommonOptions(&desc, &common);
+  desc.add_options()  //
+      ("checkpoint", rl::po::value(&checkpoint),
+       "standalone mode: score this checkpoint file, print one JSON object and exit")  //
+      ("env", rl::po::value(&config.env_id)->default_value(config.env_id),
+       "environment the checkpoints are scored on")  //
+      ("episodes", rl::po::value(&config.episodes)->default_value(config.episodes),
+       "evaluation episodes per checkpoint")  //
+      ("epsilon", rl::po::value(&config.epsilon)->default_value(config.epsilon, "0.05"),
+       "exploration rate while scoring (0.05 as in Mnih et al. 2015)")  //
+      ("seed-base", rl::po::value(&config.seed_base)->default_value(config.seed_base),
+       "seed of the first evaluation episode (episode i: seed-base + i); keep it away from "
+       "training seeds")  //
+      ("out", rl::po::value(&config.out_dir),
+       "service mode: run folder; writes DIR/eval.jsonl and DIR/report/ (required)")  //
+      ("goal", rl::po::value(&goal),
+       "mean return that counts as solved (default: the env's reward threshold, 475 for "
+       "CartPole-v1)")  //
+      ("stop-at-goal", rl::po::bool_switch(&config.stop_at_goal),
+       "exit (status 0) right after a checkpoint reaches the goal")  //
+      ("run-config", rl::po::value(&run_config_file),
+       "text file shown in the report as the run's config (default: the --config file)");
+
+  rl::po::variables_map vm;
+  if (!rl::ParseOptions(argc, argv, "evaluator", kUsage, desc, &vm)) return 0;
+
+  // Standalone mode: one file, one JSON object.
+  if (!checkpoint.empty()) {
+    config.Validate();
+    rl::evaluator::EvalRecord record = rl::evaluator::ScoreCheckpointFile(
+        checkpoint, config.env_id, config.episodes, config.epsilon, config.seed_base);
+    record.checkpoint = checkpoint;
+    std::cout << rl::evaluator::ToJson(record) << std::endl;
+    return 0;
+  }
+
+  // Service mode.
+  if (config.out_dir.empty()) {
+    throw std::invalid_argument("--out DIR is required in service mode (or give --checkpoint)");
+  }
+  if (vm.count("goal") > 0) config.goal = goal;
+  if (!run_config_file.empty()) {
+    config.run_config_text = ReadTextFile(run_config_file);
+  } else if (!common.config_file.empty()) {
+    config.run_config_text = ReadTextFile(common.config_file);
+  }
+  rl::InstallStopHandlers();
+  rl::Bus bus(common.MakeBusConfig("evaluator"));
+  rl::evaluator::EvaluatorService service(config, &bus, stdout);
+  std::printf("evaluator: ready\n");
+  std::fflush(stdout);
+  service.Run();
+  std::printf("%s\n", service.FinalLine().c_str());
+  std::fflush(stdout);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return rl::RunMain("evaluator", Main, argc, argv); }

@@ -1,0 +1,302 @@
+#include "evaluator/evaluator_service.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "common/channels.h"
+#include "common/lcm_bus.h"
+#include "nn/checkpoint.h"
+#include "nn/sequential.h"
+#include "temp_dir.h"
+
+namespace rl::evaluator {
+namespace {
+
+using testing::CountOccurrences;
+using testing::ReadFile;
+using testing::TempDir;
+
+BusConfig MemqConfig() {
+  BusConfig c;
+  c.url = "memq://";
+  c.bulk_url = "memq://";
+  c.run_id = 77;
+  c.sender = "evaluator";
+  return c;
+}
+
+// A CartPole network that always pushes left (its output is the last layer's bias).
+nn::Checkpoint AlwaysLeftCheckpoint(int64_t update) {
+  std::mt19937 rng(3);
+  nn::Sequential net = nn::MakeMlp(4, {16}, 2, &rng);
+  nn::Checkpoint ckpt;
+  ckpt.architecture = net.Architecture();
+  ckpt.params.assign(static_cast<size_t>(net.NumParams()), 0.0f);
+  ckpt.params[ckpt.params.size() - 2] = 1.0f;
+  ckpt.meta.update = update;
+  ckpt.meta.env_steps = update * 4;
+  ckpt.meta.wall_seconds = static_cast<double>(update) / 100.0;
+  ckpt.meta.run_id = 77;
+  return ckpt;
+}
+
+class EvaluatorServiceTest : public ::testing::Test {
+ protected:
+  EvaluatorServiceTest() : bus_(MemqConfig()) {
+    bus_.Subscribe<rlmsg::eval_result_t>(
+        channels::kEval, [this](const rlmsg::eval_result_t& m) { results_.push_back(m); });
+    bus_.Subscribe<rlmsg::stats_evaluator_t>(
+        channels::kStatsEvaluator,
+        [this](const rlmsg::stats_evaluator_t& m) { stats_.push_back(m); });
+  }
+
+  EvaluatorConfig Config() const {
+    EvaluatorConfig c;
+    c.episodes = 5;
+    c.out_dir = dir_.path() + "/run-a";
+    c.run_config_text = "env = CartPole-v1\n";
+    return c;
+  }
+
+  std::string WriteCheckpoint(int64_t update) {
+    const std::string path = dir_ / ("ckpt_" + std::to_string(update) + ".bin");
+    nn::SaveCheckpoint(path, AlwaysLeftCheckpoint(update));
+    return path;
+  }
+
+  void Announce(const std::string& path, int64_t update) {
+    rlmsg::checkpoint_t m;
+    m.path = path;
+    m.update = update;
+    m.env_steps = update * 4;
+    m.wall_seconds = static_cast<double>(update) / 100.0;
+    ASSERT_TRUE(bus_.Publish(channels::kCheckpoint, &m));
+  }
+
+  // Polls until `done` holds (at most about two seconds). Returns whether it does.
+  bool PollUntil(EvaluatorService* service, const std::function<bool()>& done) {
+    for (int i = 0; i < 200 && !done(); ++i) service->Poll(10);
+    return done();
+  }
+
+  std::vector<std::string> JsonLines(const EvaluatorService& service) const {
+    std::vector<std::string> lines;
+    std::ifstream in(service.eval_jsonl_path());
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+  }
+
+  TempDir dir_;
+  Bus bus_;
+  std::vector<rlmsg::eval_result_t> results_;
+  std::vector<rlmsg::stats_evaluator_t> stats_;
+};
+
+TEST_F(EvaluatorServiceTest, ScoresAnAnnouncedCheckpointAndPublishesTheResult) {
+  EvaluatorService service(Config(), &bus_, nullptr);
+  EXPECT_DOUBLE_EQ(service.goal(), 475.0);  // CartPole-v1's reward threshold
+  Announce(WriteCheckpoint(1200), 1200);
+  ASSERT_TRUE(PollUntil(&service, [&] { return !results_.empty(); }));
+
+  const rlmsg::eval_result_t& r = results_.front();
+  EXPECT_EQ(r.header.run_id, 77);
+  EXPECT_EQ(r.update, 1200);
+  EXPECT_EQ(r.env_steps, 4800);
+  EXPECT_DOUBLE_EQ(r.wall_seconds, 12.0);
+  EXPECT_EQ(r.episodes, 5);
+  EXPECT_GT(r.mean, 0.0);
+  EXPECT_LT(r.mean, 20.0);
+  EXPECT_LE(r.min, r.mean);
+  EXPECT_GE(r.max, r.mean);
+  EXPECT_EQ(r.goal_reached, 0);
+  EXPECT_EQ(service.checkpoints_scored(), 1);
+
+  // The history line and the report.
+  const std::vector<std::string> lines = JsonLines(service);
+  ASSERT_EQ(lines.size(), 1U);
+  EvalRecord rec;
+  ASSERT_TRUE(ParseJson(lines[0], &rec));
+  EXPECT_EQ(rec.checkpoint, "ckpt_1200.bin");
+  EXPECT_EQ(rec.update, 1200);
+  EXPECT_EQ(rec.mean, r.mean);
+  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  EXPECT_NE(html.find("ckpt_1200.bin"), std::string::npos);
+  EXPECT_NE(html.find("run-a"), std::string::npos);
+
+  // Stats follow within a stats period.
+  ASSERT_TRUE(PollUntil(&service, [&] {
+    return !stats_.empty() && stats_.back().checkpoints_scored == 1 && stats_.back().busy == 0;
+  }));
+  EXPECT_EQ(stats_.back().best_update, 1200);
+  EXPECT_DOUBLE_EQ(stats_.back().best_mean, r.mean);
+  EXPECT_DOUBLE_EQ(stats_.back().last_mean, r.mean);
+  EXPECT_EQ(service.FinalLine().rfind("evaluator: goal not reached (best ", 0), 0U);
+}
+
+TEST_F(EvaluatorServiceTest, RefusesACorruptedCheckpointAndStillScoresTheNextGoodOne) {
+  EvaluatorService service(Config(), &bus_, nullptr);
+  // Flip one byte in the middle of a real checkpoint.
+  const std::string good = WriteCheckpoint(100);
+  const std::string bad = dir_ / "ckpt_corrupted.bin";
+  std::filesystem::copy_file(good, bad);
+  {
+    std::fstream f(bad, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekg(0, std::ios::end);
+    const std::streamoff size = f.tellg();
+    f.seekg(size / 2);
+    char c = 0;
+    f.get(c);
+    f.seekp(size / 2);
+    f.put(static_cast<char>(c ^ 0x5A));
+  }
+  Announce(bad, 50);
+  ASSERT_TRUE(PollUntil(&service, [&] { return service.checkpoints_refused() == 1; }));
+  EXPECT_TRUE(results_.empty());
+  EXPECT_TRUE(JsonLines(service).empty());
+  EXPECT_EQ(service.checkpoints_scored(), 0);
+
+  // A missing file is refused the same way.
+  Announce(dir_ / "ckpt_missing.bin", 60);
+  ASSERT_TRUE(PollUntil(&service, [&] { return service.checkpoints_refused() == 2; }));
+
+  Announce(good, 100);
+  ASSERT_TRUE(PollUntil(&service, [&] { return !results_.empty(); }));
+  EXPECT_EQ(results_.front().update, 100);
+  EXPECT_EQ(JsonLines(service).size(), 1U);
+  EXPECT_EQ(service.checkpoints_refused(), 2);
+}
+
+TEST_F(EvaluatorServiceTest, RefusesANetworkThatDoesNotFitTheEnv) {
+  EvaluatorService service(Config(), &bus_, nullptr);
+  std::mt19937 rng(1);
+  nn::Sequential wide = nn::MakeMlp(6, {8}, 3, &rng);
+  nn::Checkpoint ckpt;
+  ckpt.architecture = wide.Architecture();
+  wide.GetFlat(&ckpt.params);
+  const std::string path = dir_ / "wide.bin";
+  nn::SaveCheckpoint(path, ckpt);
+  Announce(path, 10);
+  ASSERT_TRUE(PollUntil(&service, [&] { return service.checkpoints_refused() == 1; }));
+  EXPECT_TRUE(results_.empty());
+}
+
+TEST_F(EvaluatorServiceTest, ScoresOnlyTheNewestOfSeveralUnscoredCheckpoints) {
+  EvaluatorService service(Config(), &bus_, nullptr);
+  const std::string a = WriteCheckpoint(10), b = WriteCheckpoint(20), c = WriteCheckpoint(30);
+  Announce(a, 10);
+  Announce(c, 30);
+  Announce(b, 20);  // arrives late, older than the pending one
+  ASSERT_TRUE(PollUntil(&service, [&] { return !results_.empty(); }));
+  for (int i = 0; i < 5; ++i) service.Poll(5);
+  ASSERT_EQ(results_.size(), 1U);
+  EXPECT_EQ(results_.front().update, 30);
+  EXPECT_EQ(service.checkpoints_skipped(), 2);
+  EXPECT_FALSE(service.has_pending());
+  ASSERT_TRUE(PollUntil(&service, [&] {
+    return !stats_.empty() && stats_.back().checkpoints_skipped == 2 &&
+           stats_.back().checkpoints_scored == 1;
+  }));
+}
+
+TEST_F(EvaluatorServiceTest, StopsAtTheGoalWhenAsked) {
+  EvaluatorConfig config = Config();
+  config.goal = 5;  // the always-left policy lasts about nine steps
+  config.stop_at_goal = true;
+  EvaluatorService service(config, &bus_, nullptr);
+  Announce(WriteCheckpoint(7), 7);
+  bool stop = false;
+  for (int i = 0; i < 200 && !stop; ++i) stop = service.Poll(10);
+  EXPECT_TRUE(stop);
+  // The result was published before Poll returned; deliver it to our subscription.
+  for (int i = 0; i < 20 && results_.empty(); ++i) bus_.Handle(10);
+  ASSERT_EQ(results_.size(), 1U);
+  EXPECT_EQ(results_.front().goal_reached, 1);
+  EXPECT_TRUE(service.goal_reached());
+  EXPECT_EQ(service.FinalLine(), "evaluator: goal reached");
+  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  EXPECT_NE(html.find("badge yes\">reached"), std::string::npos);
+}
+
+TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsTheHistoryAndIgnoresRepeats) {
+  const std::string path = WriteCheckpoint(40);
+  {
+    EvaluatorService first(Config(), &bus_, nullptr);
+    Announce(path, 40);
+    ASSERT_TRUE(PollUntil(&first, [&] { return results_.size() == 1; }));
+  }
+  // The restarted service gets a bus of its own, as a new process would.
+  Bus bus2(MemqConfig());
+  EvaluatorService second(Config(), &bus2, nullptr);
+  ASSERT_EQ(second.records().size(), 1U);
+  EXPECT_EQ(second.records()[0].update, 40);
+  EXPECT_EQ(second.checkpoints_scored(), 0);
+  ASSERT_NE(second.best(), nullptr);
+
+  // Announcing the scored checkpoint again changes nothing.
+  rlmsg::checkpoint_t m;
+  m.path = path;
+  m.update = 40;
+  ASSERT_TRUE(bus2.Publish(channels::kCheckpoint, &m));
+  for (int i = 0; i < 10; ++i) second.Poll(5);
+  EXPECT_EQ(second.duplicates_ignored(), 1);
+  EXPECT_EQ(second.checkpoints_scored(), 0);
+  const std::string html = ReadFile(second.report_dir() + "/index.html");
+  EXPECT_EQ(CountOccurrences(html, "<td>ckpt_40.bin</td>"), 1);
+}
+
+TEST_F(EvaluatorServiceTest, ProgressLinesGoToTheGivenStream) {
+  std::FILE* out = std::tmpfile();
+  ASSERT_NE(out, nullptr);
+  {
+    EvaluatorService service(Config(), &bus_, out);
+    Announce(WriteCheckpoint(5), 5);
+    ASSERT_TRUE(PollUntil(&service, [&] { return !results_.empty(); }));
+  }
+  std::rewind(out);
+  std::string text;
+  for (int ch; (ch = std::fgetc(out)) != EOF;) text += static_cast<char>(ch);
+  std::fclose(out);
+  EXPECT_NE(text.find("evaluator: update 5, env steps 20"), std::string::npos) << text;
+  EXPECT_NE(text.find("mean "), std::string::npos) << text;
+}
+
+TEST_F(EvaluatorServiceTest, AnnouncementsAfterTheServiceIsGoneAreHarmless) {
+  { EvaluatorService service(Config(), &bus_, nullptr); }
+  Announce(WriteCheckpoint(3), 3);
+  EXPECT_GE(bus_.Handle(50), 1);
+  EXPECT_TRUE(results_.empty());
+  EXPECT_EQ(bus_.counters().invalid, 0);
+}
+
+TEST(EvaluatorConfigTest, RejectsBadSettings) {
+  EvaluatorConfig c;
+  EXPECT_NO_THROW(c.Validate());
+  c.episodes = 0;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = EvaluatorConfig();
+  c.epsilon = 2;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
+TEST(ScoreCheckpointFileTest, ReadsTheMetadataAndRefusesATruncatedFile) {
+  TempDir dir;
+  const std::string path = dir / "c.bin";
+  nn::SaveCheckpoint(path, AlwaysLeftCheckpoint(9));
+  const EvalRecord r = ScoreCheckpointFile(path, "CartPole-v1", 3, 0.0, 1000);
+  EXPECT_EQ(r.checkpoint, "c.bin");
+  EXPECT_EQ(r.update, 9);
+  EXPECT_EQ(r.env_steps, 36);
+  EXPECT_EQ(r.episodes, 3);
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) - 7);
+  EXPECT_THROW(ScoreCheckpointFile(path, "CartPole-v1", 3, 0.0, 1000), std::runtime_error);
+}
+
+}  // namespace
+}  // namespace rl::evaluator

@@ -1,0 +1,84 @@
+#include "evaluator/learning_curve.h"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace rl::evaluator {
+namespace {
+
+TEST(NiceTicksTest, CoverTheRangeWithRoundSteps) {
+  const std::vector<double> t = NiceTicks(0, 475, 5);
+  ASSERT_GE(t.size(), 2U);
+  EXPECT_LE(t.front(), 0);
+  EXPECT_GE(t.back(), 475);
+  EXPECT_EQ(t, (std::vector<double>{0, 100, 200, 300, 400, 500}));
+  const std::vector<double> big = NiceTicks(0, 1.3e6, 6);
+  EXPECT_EQ(big.back(), 1.4e6);
+  EXPECT_DOUBLE_EQ(big[1] - big[0], 2e5);
+}
+
+TEST(NiceTicksTest, AnEmptyRangeIsWidened) {
+  const std::vector<double> t = NiceTicks(10, 10, 5);
+  ASSERT_GE(t.size(), 2U);
+  EXPECT_LT(t.front(), t.back());
+  EXPECT_LE(t.front(), 10);
+  EXPECT_GE(t.back(), 10);
+}
+
+TEST(LearningCurveTest, DrawsLineBandGoalAndAxisTitles) {
+  CurveStyle style;
+  style.title = "return vs steps";
+  style.x_label = "environment steps";
+  style.goal = 475;
+  const std::string svg =
+      RenderLearningCurveSvg({{2000, 30, 5}, {1000, 10, 2}, {3000, 200, 50}}, style);
+  EXPECT_EQ(svg.rfind("<svg xmlns=\"http://www.w3.org/2000/svg\"", 0), 0U);
+  EXPECT_NE(svg.find("<polyline class=\"mean\""), std::string::npos);
+  EXPECT_NE(svg.find("<path class=\"band\""), std::string::npos);
+  EXPECT_NE(svg.find("<line class=\"goal\""), std::string::npos);
+  EXPECT_NE(svg.find("environment steps"), std::string::npos);
+  EXPECT_NE(svg.find("evaluation return"), std::string::npos);
+  EXPECT_NE(svg.find(">3k<"), std::string::npos);   // an x tick label
+  EXPECT_NE(svg.find(">500<"), std::string::npos);  // a y tick label
+  EXPECT_NE(svg.find("</svg>"), std::string::npos);
+  // Three points in x order: the polyline's x coordinates increase.
+  const size_t at = svg.find("points=\"") + 8;
+  const std::string pts = svg.substr(at, svg.find('"', at) - at);
+  std::vector<double> xs;
+  for (size_t p = 0; p < pts.size();) {
+    xs.push_back(std::stod(pts.substr(p)));
+    p = pts.find(' ', p);
+    if (p == std::string::npos) break;
+    ++p;
+  }
+  ASSERT_EQ(xs.size(), 3U);
+  EXPECT_LT(xs[0], xs[1]);
+  EXPECT_LT(xs[1], xs[2]);
+}
+
+TEST(LearningCurveTest, PicksMinutesForLongDurations) {
+  CurveStyle style;
+  style.x_label = "wall time";
+  style.x_kind = XAxisKind::kSeconds;
+  style.goal = 475;
+  const std::string svg = RenderLearningCurveSvg({{60, 10, 1}, {900, 100, 10}}, style);
+  EXPECT_NE(svg.find("wall time (min)"), std::string::npos);
+  const std::string short_run = RenderLearningCurveSvg({{5, 10, 1}, {50, 100, 10}}, style);
+  EXPECT_NE(short_run.find("wall time (s)"), std::string::npos);
+}
+
+TEST(LearningCurveTest, LeavesOutNonFinitePointsAndHandlesNoPoints) {
+  CurveStyle style;
+  style.goal = std::nan("");
+  const std::string svg = RenderLearningCurveSvg({{1, std::nan(""), 0}}, style);
+  EXPECT_EQ(svg.find("<polyline"), std::string::npos);
+  EXPECT_EQ(svg.find("class=\"goal\""), std::string::npos);
+  EXPECT_NE(svg.find("no checkpoint scored yet"), std::string::npos);
+  EXPECT_EQ(svg.find("nan"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rl::evaluator

@@ -1,0 +1,213 @@
+#include "evaluator/report.h"
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "temp_dir.h"
+
+namespace rl::evaluator {
+namespace {
+
+using testing::CountOccurrences;
+using testing::ReadFile;
+using testing::TempDir;
+
+EvalRecord Record(const std::string& name, int64_t update, double mean) {
+  EvalRecord r;
+  r.checkpoint = name;
+  r.update = update;
+  r.env_steps = update * 4;
+  r.wall_seconds = static_cast<double>(update) / 30.0;
+  r.mean = mean;
+  r.std = mean / 7.0;
+  r.min = mean / 2;
+  r.max = mean * 1.5;
+  r.episodes = 100;
+  r.eval_seconds = 0.1 + static_cast<double>(update) * 1e-6;
+  return r;
+}
+
+ReportInfo Info(double goal) {
+  ReportInfo info;
+  info.env_id = "CartPole-v1";
+  info.run_name = "cartpole-dqn";
+  info.run_id = 4242;
+  info.goal = goal;
+  info.run_config = "env = CartPole-v1\n[learner]\nlr = 0.0005\n";
+  return info;
+}
+
+TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
+  TempDir dir;
+  const std::string path = dir / "eval.jsonl";
+  EvalRecord a = Record("ckpt_000001000.bin", 1000, 1.0 / 3.0);
+  a.wall_seconds = 0.1;
+  EvalRecord b = Record("odd \"name\" \\ tab\t\xC3\xA9.bin", 2000, 475.25);
+  b.min = -1e-300;
+  AppendJsonLine(path, a);
+  AppendJsonLine(path, b);
+
+  const std::string text = ReadFile(path);
+  EXPECT_EQ(CountOccurrences(text, "\n"), 2);
+  int skipped = -1;
+  const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
+  EXPECT_EQ(skipped, 0);
+  ASSERT_EQ(back.size(), 2U);
+  EXPECT_EQ(back[0], a);
+  EXPECT_EQ(back[1], b);
+}
+
+TEST(JsonLinesTest, ALineHasTheDocumentedFields) {
+  const std::string line = ToJson(Record("c.bin", 10, 9.5));
+  for (const char* key : {"\"checkpoint\": \"c.bin\"", "\"update\": 10", "\"env_steps\": 40",
+                          "\"wall_seconds\":", "\"mean\": 9.5",
+                          "\"std\":", "\"min\":", "\"max\":", "\"episodes\": 100"}) {
+    EXPECT_NE(line.find(key), std::string::npos) << key << " missing in " << line;
+  }
+  EXPECT_EQ(line.find('\n'), std::string::npos);
+}
+
+TEST(JsonLinesTest, ATornLastLineIsSkippedAndCounted) {
+  TempDir dir;
+  const std::string path = dir / "eval.jsonl";
+  AppendJsonLine(path, Record("a.bin", 1, 10));
+  AppendJsonLine(path, Record("b.bin", 2, 20));
+  {
+    std::ofstream out(path, std::ios::app);
+    out << "{\"checkpoint\": \"c.bin\", \"upd";
+  }
+  int skipped = 0;
+  const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
+  EXPECT_EQ(skipped, 1);
+  ASSERT_EQ(back.size(), 2U);
+  EXPECT_EQ(back[1].checkpoint, "b.bin");
+}
+
+TEST(JsonLinesTest, AMissingFileGivesNoRecords) {
+  TempDir dir;
+  int skipped = -1;
+  EXPECT_TRUE(LoadJsonLines(dir / "nothing.jsonl", &skipped).empty());
+  EXPECT_EQ(skipped, 0);
+}
+
+TEST(JsonLinesTest, ParseAcceptsOtherKeyOrderAndRejectsNonObjects) {
+  EvalRecord r;
+  ASSERT_TRUE(ParseJson(R"({ "mean" : 12.5, "extra": "y", "update": 3, "checkpoint": "x" })", &r));
+  EXPECT_EQ(r.checkpoint, "x");
+  EXPECT_EQ(r.update, 3);
+  EXPECT_EQ(r.mean, 12.5);
+  EXPECT_FALSE(ParseJson("[1, 2]", &r));
+  EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3})", &r));  // no mean
+  EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1} trailing)", &r));
+  EXPECT_FALSE(ParseJson("", &r));
+}
+
+TEST(JsonLinesTest, AppendingToAnUnwritablePathThrowsNamingIt) {
+  TempDir dir;
+  const std::string path = dir / "no/such/dir/eval.jsonl";
+  try {
+    AppendJsonLine(path, Record("a.bin", 1, 1));
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+TEST(ReportTest, WritesIndexWithOneRowPerCheckpointNewestFirstAndBothCurves) {
+  TempDir dir;
+  const std::string report = dir / "report";
+  const std::vector<EvalRecord> records = {Record("ckpt_a.bin", 1000, 20.0),
+                                           Record("ckpt_b.bin", 2000, 180.0),
+                                           Record("ckpt_c.bin", 3000, 90.0)};
+  WriteReport(report, records, Info(475));
+
+  const std::string html = ReadFile(report + "/index.html");
+  ASSERT_FALSE(html.empty());
+  EXPECT_NE(html.find("<title>"), std::string::npos);
+  EXPECT_NE(html.find("CartPole-v1"), std::string::npos);
+  EXPECT_NE(html.find("cartpole-dqn"), std::string::npos);
+  const size_t tbody = html.find("<tbody>");
+  ASSERT_NE(tbody, std::string::npos);
+  const std::string rows = html.substr(tbody, html.find("</tbody>") - tbody);
+  EXPECT_EQ(CountOccurrences(rows, "<tr"), 3);
+  // Newest (highest update) first.
+  const size_t c = rows.find("ckpt_c.bin"), b = rows.find("ckpt_b.bin"),
+               a = rows.find("ckpt_a.bin");
+  ASSERT_NE(a, std::string::npos);
+  EXPECT_LT(c, b);
+  EXPECT_LT(b, a);
+  // The best checkpoint is marked and summarized; the goal was not reached.
+  EXPECT_NE(rows.find("<tr class=\"best\"><td>ckpt_b.bin"), std::string::npos);
+  EXPECT_NE(html.find("180.0"), std::string::npos);
+  EXPECT_NE(html.find("not reached"), std::string::npos);
+  // Both curves are referenced and exist, with a line, a band and a dashed goal.
+  for (const char* svg : {"curve_env_steps.svg", "curve_wall_time.svg"}) {
+    EXPECT_NE(html.find(std::string("<img src=\"") + svg + "\""), std::string::npos) << svg;
+    const std::string text = ReadFile(report + "/" + svg);
+    EXPECT_EQ(text.rfind("<svg", 0), 0U) << svg;
+    EXPECT_NE(text.find("<polyline class=\"mean\""), std::string::npos) << svg;
+    EXPECT_NE(text.find("<path class=\"band\""), std::string::npos) << svg;
+    EXPECT_NE(text.find("stroke-dasharray"), std::string::npos) << svg;
+    EXPECT_NE(text.find("goal 475"), std::string::npos) << svg;
+  }
+  // Self-contained: no scripts, nothing fetched from the network.
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("http://"), std::string::npos);
+  EXPECT_EQ(html.find("https://"), std::string::npos);
+  // No temporary file is left behind.
+  for (const auto& entry : std::filesystem::directory_iterator(report)) {
+    EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
+  }
+}
+
+TEST(ReportTest, SaysWhenAndWhereTheGoalWasFirstReached) {
+  TempDir dir;
+  const std::vector<EvalRecord> records = {
+      Record("a.bin", 1000, 100.0), Record("b.bin", 2000, 480.0), Record("c.bin", 3000, 500.0)};
+  WriteReport(dir.path(), records, Info(475));
+  const std::string html = ReadFile(dir / "index.html");
+  EXPECT_NE(html.find("badge yes\">reached"), std::string::npos);
+  EXPECT_NE(html.find("first at update 2,000"), std::string::npos);
+  EXPECT_EQ(html.find("not reached"), std::string::npos);
+}
+
+TEST(ReportTest, EscapesTheConfigAndCheckpointNames) {
+  TempDir dir;
+  ReportInfo info = Info(475);
+  info.run_config = "note = a<b & \"c\" </pre><script>alert(1)</script>";
+  info.run_name = "<b>run</b>";
+  WriteReport(dir.path(), {Record("<img src=x>.bin", 5, 1.0)}, info);
+  const std::string html = ReadFile(dir / "index.html");
+  EXPECT_NE(html.find("note = a&lt;b &amp; &quot;c&quot; &lt;/pre&gt;&lt;script&gt;alert(1)"
+                      "&lt;/script&gt;"),
+            std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("<b>run</b>"), std::string::npos);
+  EXPECT_NE(html.find("&lt;img src=x&gt;.bin"), std::string::npos);
+  EXPECT_EQ(HtmlEscape("'&'"), "&#39;&amp;&#39;");
+}
+
+TEST(ReportTest, AnEmptyHistoryStillGivesAReportAndCurves) {
+  TempDir dir;
+  WriteReport(dir / "report", {}, Info(475));
+  const std::string html = ReadFile(dir / "report/index.html");
+  EXPECT_NE(html.find("No checkpoint scored yet"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir / "report/curve_env_steps.svg"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "report/curve_wall_time.svg"));
+}
+
+TEST(ReportTest, RewritingReplacesTheOldReport) {
+  TempDir dir;
+  WriteReport(dir.path(), {Record("first.bin", 1, 1.0)}, Info(475));
+  WriteReport(dir.path(), {Record("second.bin", 2, 2.0)}, Info(475));
+  const std::string html = ReadFile(dir / "index.html");
+  EXPECT_EQ(html.find("first.bin"), std::string::npos);
+  EXPECT_NE(html.find("second.bin"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rl::evaluator

@@ -1,0 +1,141 @@
+#include "evaluator/scorer.h"
+
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "envs/registry.h"
+#include "nn/sequential.h"
+
+namespace rl::evaluator {
+namespace {
+
+constexpr char kEnv[] = "CartPole-v1";
+
+// A CartPole network whose output is its last layer's bias: every weight zero, so the greedy
+// action is always `action`.
+nn::Sequential AlwaysChooses(int action) {
+  std::mt19937 rng(1);
+  nn::Sequential net = nn::MakeMlp(4, {16}, 2, &rng);
+  std::vector<float> flat(static_cast<size_t>(net.NumParams()), 0.0f);
+  // Parameters are layer by layer, weight then bias: the last two floats are the output bias.
+  flat[flat.size() - 2 + static_cast<size_t>(action)] = 1.0f;
+  net.SetFlat(flat.data(), flat.size());
+  return net;
+}
+
+// Plays the episodes first_seed .. first_seed + episodes - 1 with a fixed action.
+std::vector<double> PlayByHand(int action, int episodes, uint64_t first_seed) {
+  auto env = envs::MakeEnv(kEnv);
+  std::vector<double> returns;
+  for (int i = 0; i < episodes; ++i) {
+    env->Reset(first_seed + static_cast<uint64_t>(i));
+    double total = 0;
+    for (;;) {
+      const envs::StepResult r = env->Step(action);
+      total += r.reward;
+      if (r.terminated || r.truncated) break;
+    }
+    returns.push_back(total);
+  }
+  return returns;
+}
+
+TEST(ScorerTest, AConstantActionNetworkScoresAsTheSameEpisodesPlayedByHand) {
+  nn::Sequential net = AlwaysChooses(1);
+  const std::vector<float> obs = {0.01f, -0.02f, 0.03f, 0.04f};
+  ASSERT_EQ(net.Argmax(obs.data(), 4), 1);
+
+  const EvalScore score = ScorePolicy(&net, kEnv, 20, /*epsilon=*/0.0, kDefaultEvalSeedBase);
+  const std::vector<double> by_hand = PlayByHand(1, 20, kDefaultEvalSeedBase);
+  EXPECT_EQ(score.returns, by_hand);
+  double sum = 0;
+  for (double r : by_hand) sum += r;
+  EXPECT_DOUBLE_EQ(score.mean, sum / 20.0);
+  // Pushing the cart one way topples the pole within a few steps.
+  EXPECT_LT(score.mean, 20.0);
+  EXPECT_GT(score.mean, 5.0);
+  EXPECT_LE(score.max, 20.0);
+}
+
+TEST(ScorerTest, TheSameSeedsGiveTheSameScore) {
+  std::mt19937 rng(7);
+  nn::Sequential net = nn::MakeMlp(4, {32}, 2, &rng);
+  for (double epsilon : {0.0, 0.05, 0.5}) {
+    const EvalScore a = ScorePolicy(&net, kEnv, 10, epsilon, 123);
+    const EvalScore b = ScorePolicy(&net, kEnv, 10, epsilon, 123);
+    EXPECT_EQ(a.returns, b.returns) << "epsilon " << epsilon;
+  }
+  // Other seeds give other initial states.
+  const EvalScore a = ScorePolicy(&net, kEnv, 10, 0.5, 123);
+  const EvalScore c = ScorePolicy(&net, kEnv, 10, 0.5, 456);
+  EXPECT_NE(a.returns, c.returns);
+}
+
+TEST(ScorerTest, EpisodeIUsesSeedFirstSeedPlusI) {
+  nn::Sequential net = AlwaysChooses(0);
+  const EvalScore from_10 = ScorePolicy(&net, kEnv, 5, 0.0, 10);
+  const EvalScore from_11 = ScorePolicy(&net, kEnv, 4, 0.0, 11);
+  ASSERT_EQ(from_10.returns.size(), 5U);
+  EXPECT_EQ(std::vector<double>(from_10.returns.begin() + 1, from_10.returns.end()),
+            from_11.returns);
+}
+
+TEST(ScorerTest, RunsTheRequestedNumberOfEpisodes) {
+  nn::Sequential net = AlwaysChooses(0);
+  for (int episodes : {1, 7, 30}) {
+    const EvalScore s = ScorePolicy(&net, kEnv, episodes, 0.05, 99);
+    EXPECT_EQ(s.episodes, episodes);
+    EXPECT_EQ(s.returns.size(), static_cast<size_t>(episodes));
+  }
+}
+
+TEST(ScorerTest, EpsilonOneNeverAsksThePolicyAndEpsilonZeroAlwaysDoes) {
+  int calls = 0;
+  const GreedyPolicy counting = [&calls](std::span<const float>) {
+    ++calls;
+    return 0;
+  };
+  ScoreGreedyPolicy(counting, kEnv, 5, 1.0, 3);
+  EXPECT_EQ(calls, 0);
+  const EvalScore s = ScoreGreedyPolicy(counting, kEnv, 5, 0.0, 3);
+  // CartPole rewards 1 per step, so the returns add up to the steps taken.
+  double steps = 0;
+  for (double r : s.returns) steps += r;
+  EXPECT_EQ(calls, static_cast<int>(steps));
+}
+
+TEST(ScorerTest, SummarizeUsesThePopulationStd) {
+  const EvalScore s = Summarize({1.0, 2.0, 3.0, 4.0});
+  EXPECT_EQ(s.episodes, 4);
+  EXPECT_DOUBLE_EQ(s.mean, 2.5);
+  EXPECT_DOUBLE_EQ(s.std, std::sqrt(1.25));
+  EXPECT_EQ(s.min, 1.0);
+  EXPECT_EQ(s.max, 4.0);
+}
+
+TEST(ScorerTest, RefusesBadArgumentsAndANetworkThatDoesNotFitTheEnv) {
+  nn::Sequential net = AlwaysChooses(0);
+  EXPECT_THROW(ScorePolicy(&net, kEnv, 0, 0.05, 1), std::invalid_argument);
+  EXPECT_THROW(ScorePolicy(&net, kEnv, 5, 1.5, 1), std::invalid_argument);
+  EXPECT_THROW(ScorePolicy(&net, kEnv, 5, -0.1, 1), std::invalid_argument);
+  EXPECT_THROW(ScorePolicy(&net, "NoSuchEnv-v0", 5, 0.05, 1), std::invalid_argument);
+  std::mt19937 rng(1);
+  nn::Sequential wide = nn::MakeMlp(5, {8}, 2, &rng);
+  EXPECT_THROW(ScorePolicy(&wide, kEnv, 5, 0.05, 1), std::invalid_argument);
+  nn::Sequential three = nn::MakeMlp(4, {8}, 3, &rng);
+  EXPECT_THROW(ScorePolicy(&three, kEnv, 5, 0.05, 1), std::invalid_argument);
+  const GreedyPolicy out_of_range = [](std::span<const float>) { return 2; };
+  EXPECT_THROW(ScoreGreedyPolicy(out_of_range, kEnv, 1, 0.0, 1), std::invalid_argument);
+}
+
+TEST(ScorerTest, TheDefaultSeedBaseIsFarFromTrainingSeeds) {
+  EXPECT_EQ(kDefaultEvalSeedBase, 1'000'000'000U);
+  EXPECT_DOUBLE_EQ(kDefaultEvalEpsilon, 0.05);
+}
+
+}  // namespace
+}  // namespace rl::evaluator
