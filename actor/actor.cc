@@ -1,0 +1,199 @@
+#include "actor/actor.h"
+
+#include <cstdio>
+#include <numeric>
+#include <stdexcept>
+
+#include "common/channels.h"
+#include "common/clock.h"
+#include "common/shutdown.h"
+#include "envs/registry.h"
+#include "rlmsg/flow_control_t.hpp"
+#include "rlmsg/stats_actor_t.hpp"
+
+namespace rl::actor {
+
+void ActorConfig::Validate() const {
+  exploration.Validate();
+  if (num_actors < 1) throw std::invalid_argument("num-actors must be >= 1");
+  if (actor_id < 0 || actor_id >= num_actors) {
+    throw std::invalid_argument("actor-id must be in [0, num-actors)");
+  }
+  if (envs_per_actor < 1 || envs_per_actor > 100) {
+    throw std::invalid_argument("envs-per-actor must be in [1, 100]");
+  }
+  if (batch_size < 1) throw std::invalid_argument("batch-size must be >= 1");
+  if (n_step < 1) throw std::invalid_argument("n-step must be >= 1");
+  if (!(gamma >= 0 && gamma <= 1)) throw std::invalid_argument("gamma must be in [0, 1]");
+  if (!(stats_hz > 0)) throw std::invalid_argument("stats-hz must be > 0");
+}
+
+uint64_t TrainingSeed(uint64_t run_seed, int actor_id, int env_index) {
+  return (run_seed % 1000) * 1000000 + static_cast<uint64_t>(actor_id) * 100 +
+         static_cast<uint64_t>(env_index);
+}
+
+Actor::Actor(ActorConfig config, Bus* bus)
+    : config_(std::move(config)),
+      bus_(bus),
+      rng_(TrainingSeed(config_.seed, config_.actor_id, 99)) {
+  config_.Validate();
+  for (int j = 0; j < config_.envs_per_actor; ++j) {
+    auto env = envs::MakeEnv(config_.env_id);
+    obs_size_ = env->spec().observation_size;
+    num_actions_ = env->spec().num_actions;
+    env->Reset(TrainingSeed(config_.seed, config_.actor_id, j));
+    auto o = env->observation();
+    slots_.push_back(EnvSlot{std::move(env), std::vector<float>(o.begin(), o.end()),
+                             NStepAccumulator(config_.n_step, config_.gamma, obs_size_), 0.0, 0});
+  }
+  random_action_ = std::uniform_int_distribution<int>(0, num_actions_ - 1);
+  epsilon_ = config_.exploration.Epsilon(config_.actor_id, config_.num_actors, 0);
+  batch_.actor_id = config_.actor_id;
+  batch_.obs_size = obs_size_;
+
+  bus_->Subscribe<rlmsg::weights_chunk_t>(
+      channels::kWeights, [this](const rlmsg::weights_chunk_t& c) { OnWeights(c); }, Port::kBulk);
+  bus_->Subscribe<rlmsg::flow_control_t>(channels::kFlow, [this](const rlmsg::flow_control_t& f) {
+    insert_allowed_ = f.insert_allowed != 0;
+  });
+}
+
+void Actor::OnWeights(const rlmsg::weights_chunk_t& chunk) {
+  if (!assembler_.Add(chunk)) return;
+  std::optional<Weights> w = assembler_.Take();
+  if (!w) return;
+  if (w->architecture != net_.Architecture()) {
+    std::mt19937 init_rng(0);
+    nn::Sequential net = nn::BuildFromArchitecture(w->architecture, &init_rng);
+    if (net.InputSize() != obs_size_ || net.OutputSize() != num_actions_) {
+      ++weights_refused_;
+      std::fprintf(stderr, "[actor-%d] refused weights '%s': the env has %d inputs, %d actions\n",
+                   config_.actor_id, w->architecture.c_str(), obs_size_, num_actions_);
+      return;
+    }
+    net_ = std::move(net);
+  }
+  net_.SetFlat(w->params.data(), w->params.size());
+  weights_version_ = w->version;
+}
+
+int Actor::SelectAction(const std::vector<float>& obs) {
+  if (weights_version_ < 0 || unit_(rng_) < epsilon_) return random_action_(rng_);
+  return net_.Argmax(obs.data(), obs_size_);
+}
+
+void Actor::Append(const Transition& t, int64_t episode_id) {
+  batch_.obs.insert(batch_.obs.end(), t.obs.begin(), t.obs.end());
+  batch_.next_obs.insert(batch_.next_obs.end(), t.next_obs.begin(), t.next_obs.end());
+  batch_.action.push_back(t.action);
+  batch_.reward.push_back(t.reward);
+  batch_.discount.push_back(t.discount);
+  batch_.episode_id.push_back(episode_id);
+  batch_.priority.push_back(0.0f);
+  if (static_cast<int>(batch_.action.size()) >= config_.batch_size) PublishBatch();
+}
+
+void Actor::PublishBatch() {
+  batch_.count = static_cast<int32_t>(batch_.action.size());
+  if (batch_.count == 0) return;
+  batch_.num_values = batch_.count * obs_size_;
+  bus_->Publish(channels::kTransitions, &batch_);
+  published_ += batch_.count;
+  batch_.obs.clear();
+  batch_.next_obs.clear();
+  batch_.action.clear();
+  batch_.reward.clear();
+  batch_.discount.clear();
+  batch_.episode_id.clear();
+  batch_.priority.clear();
+}
+
+int Actor::StepEnvs() {
+  for (EnvSlot& s : slots_) {
+    const int action = SelectAction(s.obs);
+    const envs::StepResult r = s.env->Step(action);
+    const std::span<const float> next = s.env->observation();
+    s.episode_return += r.reward;
+    const int64_t episode_id = s.episode_id;
+    s.nstep.Add(s.obs, action, r.reward, next, r.terminated, r.truncated,
+                [this, episode_id](const Transition& t) { Append(t, episode_id); });
+    if (r.terminated || r.truncated) {
+      recent_returns_.push_back(s.episode_return);
+      if (recent_returns_.size() > 100) recent_returns_.pop_front();
+      ++episodes_;
+      ++s.episode_id;
+      s.episode_return = 0;
+      s.env->Reset();
+      const std::span<const float> o = s.env->observation();
+      s.obs.assign(o.begin(), o.end());
+    } else {
+      s.obs.assign(next.begin(), next.end());
+    }
+  }
+  env_steps_ += static_cast<int64_t>(slots_.size());
+  epsilon_ = config_.exploration.Epsilon(config_.actor_id, config_.num_actors, env_steps_);
+  return static_cast<int>(slots_.size());
+}
+
+double Actor::mean_return() const {
+  if (recent_returns_.empty()) return 0.0;
+  return std::accumulate(recent_returns_.begin(), recent_returns_.end(), 0.0) /
+         static_cast<double>(recent_returns_.size());
+}
+
+void Actor::PublishStats() {
+  const double now = MonoSeconds();
+  rlmsg::stats_actor_t s{};
+  s.actor_id = config_.actor_id;
+  s.env_steps = env_steps_;
+  s.episodes = episodes_;
+  const double dt = now - stats_last_time_;
+  s.steps_per_second = (stats_last_time_ > 0 && dt > 0)
+                           ? static_cast<double>(env_steps_ - stats_last_steps_) / dt
+                           : 0.0;
+  stats_last_time_ = now;
+  stats_last_steps_ = env_steps_;
+  s.mean_return = mean_return();
+  s.epsilon = epsilon_;
+  s.weights_version = weights_version_;
+  s.paused = insert_allowed_ ? 0 : 1;
+  s.transitions_published = published_;
+  bus_->FillCounters(&s);
+  bus_->Publish(channels::kStatsActor, &s);
+}
+
+void Actor::Run() {
+  const double stats_period = 1.0 / config_.stats_hz;
+  double next_stats = MonoSeconds();
+  double next_log = MonoSeconds() + 5.0;
+  while (!StopRequested()) {
+    if (config_.max_steps > 0 && env_steps_ >= config_.max_steps) break;
+    if (insert_allowed_) {
+      // Step until a batch went out (or a bounded number of steps), then look at LCM.
+      const int64_t before = published_;
+      for (int i = 0; i < config_.batch_size && published_ == before; ++i) StepEnvs();
+      bus_->Handle(0);
+    } else {
+      bus_->Handle(5);
+    }
+    const double now = MonoSeconds();
+    if (now >= next_stats) {
+      PublishStats();
+      next_stats = now + stats_period;
+    }
+    if (now >= next_log) {
+      std::printf(
+          "actor-%d: steps %lld episodes %lld mean return %.1f epsilon %.4f weights %lld%s\n",
+          config_.actor_id, static_cast<long long>(env_steps_), static_cast<long long>(episodes_),
+          mean_return(), epsilon_, static_cast<long long>(weights_version_),
+          insert_allowed_ ? "" : " (paused)");
+      std::fflush(stdout);
+      next_log = now + 5.0;
+    }
+  }
+  PublishBatch();
+  PublishStats();
+}
+
+}  // namespace rl::actor

@@ -1,0 +1,67 @@
+// The actor process: see actor/actor.h and actor/README.md.
+#include <cstdio>
+#include <string>
+
+#include "actor/actor.h"
+#include "common/options.h"
+#include "common/shutdown.h"
+
+namespace {
+
+int Main(int argc, char** argv) {
+  rl::CommonOptions common;
+  rl::actor::ActorConfig c;
+  rl::po::options_description desc("Options");
+  rl::AddCommonOptions(&desc, &common);
+  auto& e = c.exploration;
+  desc.add_options()                                                                //
+      ("env", rl::po::value(&c.env_id)->default_value(c.env_id), "environment id")  //
+      ("actor-id", rl::po::value(&c.actor_id)->default_value(c.actor_id),
+       "index of this actor, 0 .. num-actors - 1")  //
+      ("num-actors", rl::po::value(&c.num_actors)->default_value(c.num_actors),
+       "actors in the run (sets the Ape-X epsilons)")  //
+      ("envs-per-actor", rl::po::value(&c.envs_per_actor)->default_value(c.envs_per_actor),
+       "environments stepped in turn by this actor")                       //
+      ("seed", rl::po::value(&c.seed)->default_value(c.seed), "run seed")  //
+      ("batch-size", rl::po::value(&c.batch_size)->default_value(c.batch_size),
+       "transitions per published message")                                                     //
+      ("n-step", rl::po::value(&c.n_step)->default_value(c.n_step), "n of the n-step returns")  //
+      ("gamma", rl::po::value(&c.gamma)->default_value(c.gamma), "discount factor")             //
+      ("exploration", rl::po::value(&e.mode)->default_value(e.mode),
+       "apex (constant epsilon_i = base^(1 + alpha i/(N-1))), linear (annealed), constant")  //
+      ("apex-base", rl::po::value(&e.apex_base)->default_value(e.apex_base),
+       "Ape-X base epsilon")  //
+      ("apex-alpha", rl::po::value(&e.apex_alpha)->default_value(e.apex_alpha),
+       "Ape-X exponent spread")  //
+      ("epsilon-start", rl::po::value(&e.start)->default_value(e.start),
+       "linear: first epsilon")  //
+      ("epsilon-end", rl::po::value(&e.end)->default_value(e.end),
+       "linear: final epsilon; constant: the epsilon")  //
+      ("epsilon-anneal-steps", rl::po::value(&e.anneal_steps)->default_value(e.anneal_steps),
+       "linear: steps from start to end")  //
+      ("stats-hz", rl::po::value(&c.stats_hz)->default_value(c.stats_hz),
+       "stats messages per second")  //
+      ("max-steps", rl::po::value(&c.max_steps)->default_value(c.max_steps),
+       "stop after this many env steps (0: until stopped)");
+  rl::po::variables_map vm;
+  if (!rl::ParseOptions(argc, argv, "actor",
+                        "Usage: actor [options]\n"
+                        "Runs environments with an epsilon-greedy policy and publishes their "
+                        "transitions to the replay daemon over LCM.",
+                        desc, &vm)) {
+    return 0;
+  }
+  rl::InstallStopHandlers();
+  rl::Bus bus(common.MakeBusConfig("actor-" + std::to_string(c.actor_id)));
+  rl::actor::Actor actor(c, &bus);
+  std::printf("actor-%d: ready (epsilon %.5f)\n", c.actor_id, actor.epsilon());
+  std::fflush(stdout);
+  actor.Run();
+  std::printf("actor-%d: stopped after %lld steps, %lld episodes\n", c.actor_id,
+              static_cast<long long>(actor.env_steps()), static_cast<long long>(actor.episodes()));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return rl::RunMain("actor", Main, argc, argv); }

@@ -1,0 +1,56 @@
+// NStepAccumulator turns one environment's steps into n-step transitions.
+//
+// For each step t it emits (o_t, a_t, R_t, d_t, o_{t+k}) with R_t = sum_{j<k} gamma^j r_{t+j}:
+// k = n while the episode goes on (d_t = gamma^n); at a termination every pending step is
+// emitted with d_t = 0; at a time-limit truncation (not a terminal) every pending step is emitted
+// with k the steps left before the cut and d_t = gamma^k, bootstrapping from the last
+// observation. With n = 1 this is the one-step transition of DQN.
+#pragma once
+
+#include <deque>
+#include <functional>
+#include <span>
+#include <vector>
+
+namespace rl::actor {
+
+struct Transition {
+  std::span<const float> obs;
+  int action = 0;
+  float reward = 0;    // n-step discounted return
+  float discount = 0;  // gamma^k, or 0 after a termination
+  std::span<const float> next_obs;
+};
+
+class NStepAccumulator {
+ public:
+  using Sink = std::function<void(const Transition&)>;
+
+  NStepAccumulator(int n, double gamma, int obs_size);
+
+  // Records the step taken from `obs` with `action`, which gave `reward` and `next_obs`, and
+  // emits every transition that is now complete.
+  void Add(std::span<const float> obs, int action, double reward, std::span<const float> next_obs,
+           bool terminated, bool truncated, const Sink& sink);
+
+  // Steps waiting for their n-step return.
+  int pending() const { return static_cast<int>(steps_.size()); }
+
+ private:
+  struct Pending {
+    std::vector<float> obs;
+    int action;
+    double reward;
+  };
+  // Emits the oldest pending step with the return of all pending steps; `bootstrap` says
+  // whether the last observation is bootstrapped from (discount gamma^k) or not (0).
+  void EmitOldest(bool bootstrap, const Sink& sink);
+
+  int n_;
+  double gamma_;
+  int obs_size_;
+  std::deque<Pending> steps_;
+  std::vector<float> next_obs_;
+};
+
+}  // namespace rl::actor

@@ -1,0 +1,113 @@
+#include "learner/dqn.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "nn/losses.h"
+
+namespace rl::learner {
+
+void DqnConfig::Validate() const {
+  if (hidden.empty()) throw std::invalid_argument("hidden: at least one hidden layer");
+  for (int h : hidden) {
+    if (h < 1) throw std::invalid_argument("hidden: widths must be >= 1");
+  }
+  if (optimizer != "adam" && optimizer != "rmsprop") {
+    throw std::invalid_argument("optimizer must be adam or rmsprop, not '" + optimizer + "'");
+  }
+  if (loss != "huber" && loss != "mse") {
+    throw std::invalid_argument("loss must be huber or mse, not '" + loss + "'");
+  }
+  if (!(learning_rate > 0)) throw std::invalid_argument("learning-rate must be > 0");
+  if (target_update_period < 1) throw std::invalid_argument("target-update-period must be >= 1");
+  if (!(tau > 0 && tau <= 1)) throw std::invalid_argument("tau must be in (0, 1]");
+  if (!(max_grad_norm >= 0)) throw std::invalid_argument("max-grad-norm must be >= 0");
+}
+
+Dqn::Dqn(int obs_size, int num_actions, DqnConfig config)
+    : config_(std::move(config)), obs_size_(obs_size), num_actions_(num_actions) {
+  config_.Validate();
+  std::mt19937 rng(static_cast<std::mt19937::result_type>(config_.seed));
+  online_ = nn::MakeMlp(obs_size, config_.hidden, num_actions, &rng);
+  target_ = online_;
+  params_ = online_.Params();
+  if (config_.optimizer == "adam") {
+    optimizer_ =
+        std::make_unique<nn::Adam>(params_, config_.learning_rate, 0.9f, 0.999f, config_.adam_eps);
+  } else {
+    optimizer_ =
+        std::make_unique<nn::RmsProp>(params_, config_.learning_rate, config_.rmsprop_alpha,
+                                      config_.rmsprop_eps, config_.rmsprop_centered);
+  }
+}
+
+UpdateResult Dqn::Update(const BatchView& b) {
+  if (b.obs_size != obs_size_) throw std::invalid_argument("batch observation size mismatch");
+  if (b.count < 1) throw std::invalid_argument("empty batch");
+  const int n = b.count;
+  obs_ = Eigen::Map<const nn::Matrix>(b.obs, obs_size_, n);
+  next_obs_ = Eigen::Map<const nn::Matrix>(b.next_obs, obs_size_, n);
+
+  // Targets y = r + discount * Q_target(s', a*), a* = argmax of the online (Double DQN) or
+  // target network. The online network's forward on s' comes first, because the forward on s
+  // below must stay cached for the backward pass.
+  next_actions_.resize(static_cast<size_t>(n));
+  if (config_.double_dqn) {
+    const nn::Matrix& q_online_next = online_.Forward(next_obs_);
+    for (int i = 0; i < n; ++i)
+      q_online_next.col(i).maxCoeff(&next_actions_[static_cast<size_t>(i)]);
+  }
+  const nn::Matrix& q_next = target_.Forward(next_obs_);
+  target_values_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    int a = 0;
+    if (config_.double_dqn) {
+      a = next_actions_[static_cast<size_t>(i)];
+    } else {
+      q_next.col(i).maxCoeff(&a);
+    }
+    target_values_[i] = b.reward[i] + b.discount[i] * q_next(a, i);
+  }
+
+  // Q(s, a) of the taken actions.
+  const nn::Matrix& q = online_.Forward(obs_);
+  pred_.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const int a = b.action[i];
+    if (a < 0 || a >= num_actions_) throw std::invalid_argument("action outside the network's");
+    pred_[i] = q(a, i);
+  }
+  const nn::Vector* w = nullptr;
+  if (b.weight != nullptr) {
+    weights_ = Eigen::Map<const nn::Vector>(b.weight, n);
+    w = &weights_;
+  }
+  UpdateResult result;
+  result.loss = config_.loss == "huber" ? nn::HuberLoss(pred_, target_values_, &loss_grad_, 1.0f, w)
+                                        : nn::MseLoss(pred_, target_values_, &loss_grad_, w);
+  result.mean_q = pred_.mean();
+  td_abs_.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i)
+    td_abs_[static_cast<size_t>(i)] = std::abs(target_values_[i] - pred_[i]);
+
+  // Gradient flows only into the chosen actions' outputs.
+  grad_q_.setZero(num_actions_, n);
+  for (int i = 0; i < n; ++i) grad_q_(b.action[i], i) = loss_grad_[i];
+  online_.ZeroGrad();
+  online_.Backward(grad_q_);
+  if (config_.max_grad_norm > 0) {
+    result.grad_norm = nn::ClipGradNorm(params_, config_.max_grad_norm);
+  }
+  optimizer_->Step();
+  ++updates_;
+  if (updates_ % config_.target_update_period == 0) {
+    if (config_.tau >= 1.0f) {
+      target_.CopyParamsFrom(online_);
+    } else {
+      target_.SoftUpdateFrom(online_, config_.tau);
+    }
+  }
+  return result;
+}
+
+}  // namespace rl::learner

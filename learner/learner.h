@@ -1,0 +1,85 @@
+// Learner: samples batches from the replay daemon, trains a Dqn on them, broadcasts weights,
+// writes and announces checkpoints, and publishes its stats.
+//
+// Sampling is request/reply with requests_in_flight requests outstanding; a request without a
+// reply after request_timeout seconds is sent again with the same id (the replay ignores a
+// request it already holds), so a lost reply stalls nothing. Single-threaded.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <string>
+
+#include "common/lcm_bus.h"
+#include "learner/dqn.h"
+#include "learner/weights_publisher.h"
+#include "rlmsg/sample_batch_t.hpp"
+
+namespace rl::learner {
+
+struct LearnerConfig {
+  std::string env_id = "CartPole-v1";  // environment (gives the network's input and output sizes)
+  DqnConfig dqn;                       // the algorithm
+  int batch_size = 128;                // transitions per update
+  int requests_in_flight = 4;          // sample requests outstanding at once
+  double request_timeout = 2.0;        // seconds before a request is sent again
+  int weights_every = 100;             // updates between weight broadcasts
+  int checkpoint_every = 1000;         // updates between checkpoints
+  std::string out_dir = ".";           // checkpoints go to <out_dir>/checkpoints/
+  int64_t max_updates = 0;             // stop after this many updates (0: until stopped)
+  double stats_hz = 4.0;               // stats messages per second
+
+  void Validate() const;
+};
+
+class Learner {
+ public:
+  // Subscribes to sample replies on `bus`, which must outlive the learner.
+  Learner(LearnerConfig config, Bus* bus);
+  Learner(const Learner&) = delete;
+  Learner& operator=(const Learner&) = delete;
+
+  // Trains until StopRequested() or max_updates, then writes a last checkpoint.
+  void Run();
+
+  int64_t updates() const { return dqn_.updates(); }
+  Dqn& dqn() { return dqn_; }
+  // Writes a checkpoint of the current parameters, announces it and returns its path.
+  std::string Checkpoint();
+
+ private:
+  struct Request {
+    double sent = 0;
+  };
+
+  void OnSamples(const rlmsg::sample_batch_t& m);
+  void TopUpRequests(double now);
+  void SendRequest(int64_t id);
+  void TrainOn(const rlmsg::sample_batch_t& m);
+  void PublishStats(double now);
+
+  LearnerConfig config_;
+  Bus* bus_;
+  int obs_size_ = 0;
+  Dqn dqn_;
+  WeightsPublisher weights_;
+  std::string sender_;
+  double start_time_ = 0;
+
+  std::map<int64_t, Request> in_flight_;  // by request id
+  int64_t next_request_id_ = 0;
+  std::deque<rlmsg::sample_batch_t> ready_;
+  int64_t env_steps_ = 0;
+  int64_t request_timeouts_ = 0;
+  int64_t stale_replies_ = 0;
+  std::vector<float> flat_;
+
+  // Stats since the last stats message.
+  double loss_sum_ = 0, q_sum_ = 0;
+  int64_t stat_updates_ = 0;
+  double stats_last_time_ = 0;
+  int64_t stats_last_updates_ = 0;
+};
+
+}  // namespace rl::learner

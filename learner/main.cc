@@ -1,0 +1,94 @@
+// The learner process: see learner/learner.h and learner/README.md.
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "common/options.h"
+#include "common/shutdown.h"
+#include "learner/learner.h"
+
+namespace {
+
+std::vector<int> ParseWidths(const std::string& text) {
+  std::vector<int> widths;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      size_t used = 0;
+      widths.push_back(std::stoi(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw std::invalid_argument("hidden: expected comma-separated widths like 120,84, got '" +
+                                  text + "'");
+    }
+  }
+  return widths;
+}
+
+int Main(int argc, char** argv) {
+  rl::CommonOptions common;
+  rl::learner::LearnerConfig c;
+  rl::learner::DqnConfig& d = c.dqn;
+  std::string hidden = "120,84";
+  rl::po::options_description desc("Options");
+  rl::AddCommonOptions(&desc, &common);
+  desc.add_options()                                                                //
+      ("env", rl::po::value(&c.env_id)->default_value(c.env_id), "environment id")  //
+      ("out", rl::po::value(&c.out_dir)->default_value(c.out_dir),
+       "run folder; checkpoints go to <out>/checkpoints")  //
+      ("hidden", rl::po::value(&hidden)->default_value(hidden),
+       "hidden layer widths of the MLP")  //
+      ("batch-size", rl::po::value(&c.batch_size)->default_value(c.batch_size),
+       "transitions per update")                                                                 //
+      ("optimizer", rl::po::value(&d.optimizer)->default_value(d.optimizer), "adam or rmsprop")  //
+      ("learning-rate", rl::po::value(&d.learning_rate)->default_value(d.learning_rate),
+       "step size")                                                                        //
+      ("adam-eps", rl::po::value(&d.adam_eps)->default_value(d.adam_eps), "Adam epsilon")  //
+      ("loss", rl::po::value(&d.loss)->default_value(d.loss), "huber or mse")              //
+      ("double-dqn", rl::po::value(&d.double_dqn)->default_value(d.double_dqn),
+       "Double DQN targets (1/0)")  //
+      ("target-update-period",
+       rl::po::value(&d.target_update_period)->default_value(d.target_update_period),
+       "updates between target network refreshes")  //
+      ("tau", rl::po::value(&d.tau)->default_value(d.tau),
+       "refresh weight of the online network (1: hard copy)")  //
+      ("max-grad-norm", rl::po::value(&d.max_grad_norm)->default_value(d.max_grad_norm),
+       "gradient norm clip (0: none)")                                                //
+      ("seed", rl::po::value(&d.seed)->default_value(d.seed), "initialisation seed")  //
+      ("requests-in-flight",
+       rl::po::value(&c.requests_in_flight)->default_value(c.requests_in_flight),
+       "sample requests outstanding at once")  //
+      ("request-timeout", rl::po::value(&c.request_timeout)->default_value(c.request_timeout),
+       "seconds before a sample request is sent again")  //
+      ("weights-every", rl::po::value(&c.weights_every)->default_value(c.weights_every),
+       "updates between weight broadcasts")  //
+      ("checkpoint-every", rl::po::value(&c.checkpoint_every)->default_value(c.checkpoint_every),
+       "updates between checkpoints")  //
+      ("max-updates", rl::po::value(&c.max_updates)->default_value(c.max_updates),
+       "stop after this many updates (0: until stopped)")  //
+      ("stats-hz", rl::po::value(&c.stats_hz)->default_value(c.stats_hz),
+       "stats messages per second");
+  rl::po::variables_map vm;
+  if (!rl::ParseOptions(argc, argv, "learner",
+                        "Usage: learner [options]\n"
+                        "Trains a DQN on batches sampled from the replay daemon, broadcasts its "
+                        "weights and writes checkpoints.",
+                        desc, &vm)) {
+    return 0;
+  }
+  d.hidden = ParseWidths(hidden);
+  rl::InstallStopHandlers();
+  rl::Bus bus(common.MakeBusConfig("learner"));
+  rl::learner::Learner learner(c, &bus);
+  std::printf("learner: ready (%s)\n", learner.dqn().online().Architecture().c_str());
+  std::fflush(stdout);
+  learner.Run();
+  std::printf("learner: stopped after %lld updates\n", static_cast<long long>(learner.updates()));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return rl::RunMain("learner", Main, argc, argv); }

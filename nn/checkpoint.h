@@ -1,0 +1,49 @@
+// Binary checkpoint files: a network's architecture and parameters plus training metadata.
+//
+// Layout (all integers and floats little-endian):
+//   char[8]  magic "RLCKPT01"
+//   u32      format version (1)
+//   u64      total file size in bytes, CRC included
+//   u32 n, char[n]   architecture string (Sequential::Architecture())
+//   i64      update        i64 env_steps     f64 wall_seconds     u64 run_id
+//   u32 n, char[n]   note (free-form, e.g. the run's configuration)
+//   u64 n, f32[n]    parameters in Sequential::GetFlat() order
+//   u32      CRC-32 (IEEE) of every byte before it
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rl::nn {
+
+/// Training progress stored with the parameters.
+struct CheckpointMeta {
+  int64_t update = 0;       ///< Learner updates (gradient steps) done.
+  int64_t env_steps = 0;    ///< Environment steps consumed.
+  double wall_seconds = 0;  ///< Training wall-clock time, seconds.
+  uint64_t run_id = 0;      ///< Identifies the training run.
+  std::string note;         ///< Free-form text, e.g. the configuration of the run.
+};
+
+/// A network in a form that can be rebuilt: BuildFromArchitecture(architecture) then
+/// SetFlat(params).
+struct Checkpoint {
+  std::string architecture;
+  CheckpointMeta meta;
+  std::vector<float> params;
+};
+
+/// Writes `ckpt` to `path` atomically: into "<path>.tmp.<pid>", flushed and fsync'ed, then renamed
+/// over `path`, then the directory is fsync'ed. Readers see either the old file or the complete
+/// new one. Throws std::runtime_error naming the path and the errno text on failure, after
+/// removing the temporary file.
+void SaveCheckpoint(const std::string& path, const Checkpoint& ckpt);
+
+/// Reads and verifies a checkpoint. Throws std::runtime_error naming the path and the reason:
+/// cannot open, not a checkpoint file (wrong magic), unsupported version, truncated, corrupted
+/// (checksum mismatch or inconsistent lengths), or a parameter count that does not match the
+/// architecture.
+Checkpoint LoadCheckpoint(const std::string& path);
+
+}  // namespace rl::nn

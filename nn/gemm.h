@@ -1,0 +1,68 @@
+// Internal matrix-product kernel used by the layers for batched products. Not part of the public
+// API: layers call it, everyone else uses Eigen expressions.
+//
+// Eigen's general product reaches about 70 GFLOP/s on the 84x120 by 120x128 products of the DQN
+// MLP. This kernel packs the left operand into panels of a few SIMD registers' height and keeps a
+// panel-height x kNr block of the result in registers while it walks the shared dimension, which
+// is about 25% faster on those shapes and handles transposed operands through strides, so that
+// no transposed copy of a weight or activation matrix is ever made.
+#pragma once
+
+#include <cstdint>
+
+#include "nn/tensor.h"
+
+namespace rl::nn::internal {
+
+/// A read-only strided view: element (i, j) is data[i * row_stride + j * col_stride].
+struct ConstView {
+  const float* data;
+  int rows;
+  int cols;
+  int64_t row_stride;
+  int64_t col_stride;
+
+  ConstView Transposed() const { return {data, cols, rows, col_stride, row_stride}; }
+};
+
+/// A writable strided view, as ConstView.
+struct MutView {
+  float* data;
+  int rows;
+  int cols;
+  int64_t row_stride;
+  int64_t col_stride;
+
+  MutView Transposed() const { return {data, cols, rows, col_stride, row_stride}; }
+};
+
+inline ConstView View(const Matrix& m) {
+  return {m.data(), static_cast<int>(m.rows()), static_cast<int>(m.cols()), 1, m.rows()};
+}
+inline MutView View(Matrix* m) {
+  return {m->data(), static_cast<int>(m->rows()), static_cast<int>(m->cols()), 1, m->rows()};
+}
+
+/// Whether Gemm() is expected to beat Eigen for an (m x k) * (k x n) product. False for
+/// matrix-vector products and tiny problems, where packing does not pay off.
+bool PreferGemm(int m, int n, int k);
+
+/// Element-wise steps applied to each result of Gemm() before it is stored, in this order.
+struct Epilogue {
+  const float* row_bias = nullptr;  ///< c.rows floats; row_bias[i] is added to row i of c.
+  bool relu = false;                ///< Store max(result, 0) (a fused ReLU forward).
+  /// Laid out like c (same strides): store 0 where mask <= 0 (a fused ReLU backward, the mask
+  /// being the ReLU's output).
+  const float* mask = nullptr;
+};
+
+/// c = a * b (accumulate == false) or c += a * b (accumulate == true), followed by `epilogue`.
+/// `c` must not overlap `a`, `b` or the mask. `workspace` is scratch space; it only grows, so
+/// repeated calls with the same shapes do not allocate. O(m n k).
+void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& epilogue,
+          Vector* workspace);
+
+/// out[i] += sum_j g(i, j) for a column-major g (the bias gradient of a batch). O(rows cols).
+void AddRowSums(const Matrix& g, float* out);
+
+}  // namespace rl::nn::internal

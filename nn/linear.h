@@ -1,0 +1,63 @@
+// Fully connected layer y = W x + b.
+#pragma once
+
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "nn/layer.h"
+#include "nn/tensor.h"
+
+namespace rl::nn {
+
+/// y = W x + b for a batch x of `in` x batch; W is out x in, b is out x 1.
+///
+/// Forward() keeps a pointer to x for Backward() (see Layer). Batched products go through a
+/// register-blocked kernel, single columns through Eigen's matrix-vector product; neither
+/// allocates once the batch size is stable.
+class Linear : public Layer {
+ public:
+  /// Initialises W and b like PyTorch's nn.Linear: every entry ~ U(-1/sqrt(in), 1/sqrt(in)),
+  /// W first (in storage order), then b. `in` and `out` must be positive.
+  Linear(int in, int out, std::mt19937* rng);
+  /// A layer with the given parameters; `bias` must be weight.rows() x 1.
+  Linear(Matrix weight, Matrix bias);
+
+  const Matrix& Forward(const Matrix& x) override;
+  const Matrix& Backward(const Matrix& grad_out) override;
+  std::vector<Param> Params() override;
+  std::string Describe() const override;
+  std::unique_ptr<Layer> Clone() const override;
+  int input_size() const override { return static_cast<int>(weight_.cols()); }
+  int output_size() const override { return static_cast<int>(weight_.rows()); }
+
+  Matrix& weight() { return weight_; }
+  const Matrix& weight() const { return weight_; }
+  Matrix& bias() { return bias_; }
+  const Matrix& bias() const { return bias_; }
+  const Matrix& weight_grad() const { return weight_grad_; }
+  const Matrix& bias_grad() const { return bias_grad_; }
+
+  /// Fuses a ReLU that follows this layer into its forward pass: Forward() then returns
+  /// max(W x + b, 0). Set by Sequential, which then skips the ReLU's own pass.
+  void set_fused_output_relu(bool on) { fused_output_relu_ = on; }
+  /// Fuses the backward pass of a ReLU that precedes this layer: Backward() then returns the
+  /// gradient with respect to the ReLU's input, zero wherever this layer's input (the ReLU's
+  /// output) is 0. Set by Sequential, which then skips the ReLU's Backward().
+  void set_fused_input_relu_grad(bool on) { fused_input_relu_grad_ = on; }
+
+ private:
+  Matrix weight_;                  // out x in
+  Matrix bias_;                    // out x 1
+  Matrix weight_grad_;             // out x in
+  Matrix bias_grad_;               // out x 1
+  Matrix output_;                  // out x batch
+  Matrix grad_input_;              // in x batch
+  const Matrix* input_ = nullptr;  // The x of the last Forward().
+  Vector workspace_;               // Scratch space of the product kernel.
+  bool fused_output_relu_ = false;
+  bool fused_input_relu_grad_ = false;
+};
+
+}  // namespace rl::nn

@@ -1,0 +1,126 @@
+#include "nn/optimizers.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "common/check.h"
+
+namespace rl::nn {
+namespace {
+
+// Zero-initialised state tensors shaped like the parameters.
+std::vector<Matrix> ZerosLike(const std::vector<Param>& params) {
+  std::vector<Matrix> out;
+  out.reserve(params.size());
+  for (const Param& p : params) out.push_back(Matrix::Zero(p.value->rows(), p.value->cols()));
+  return out;
+}
+
+void Require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument(what);
+}
+
+}  // namespace
+
+Optimizer::Optimizer(std::vector<Param> params, float lr)
+    : params_(std::move(params)), learning_rate_(lr) {
+  Require(lr >= 0.0f, "learning rate must be >= 0, got " + std::to_string(lr));
+  for (const Param& p : params_) {
+    RL_CHECK(p.value != nullptr && p.grad != nullptr && p.value->rows() == p.grad->rows() &&
+             p.value->cols() == p.grad->cols())
+        << "parameter " << p.name << " needs a gradient of the same shape";
+  }
+}
+
+Adam::Adam(std::vector<Param> params, float lr, float beta1, float beta2, float eps)
+    : Optimizer(std::move(params), lr), beta1_(beta1), beta2_(beta2), eps_(eps) {
+  Require(beta1 >= 0.0f && beta1 < 1.0f,
+          "Adam beta1 must be in [0, 1), got " + std::to_string(beta1));
+  Require(beta2 >= 0.0f && beta2 < 1.0f,
+          "Adam beta2 must be in [0, 1), got " + std::to_string(beta2));
+  Require(eps >= 0.0f, "Adam eps must be >= 0, got " + std::to_string(eps));
+  m_ = ZerosLike(this->params());
+  v_ = ZerosLike(this->params());
+}
+
+void Adam::Step() {
+  ++step_count_;
+  const double t = static_cast<double>(step_count_);
+  const auto bias_correction1 = static_cast<float>(1.0 - std::pow(double{beta1_}, t));
+  const auto bias_correction2 = static_cast<float>(1.0 - std::pow(double{beta2_}, t));
+  const float step_size = learning_rate() / bias_correction1;
+  const float inv_sqrt_bc2 = 1.0f / std::sqrt(bias_correction2);
+  const std::vector<Param>& ps = params();
+  for (size_t i = 0; i < ps.size(); ++i) {
+    auto g = ps[i].grad->array();
+    auto m = m_[i].array();
+    auto v = v_[i].array();
+    m = beta1_ * m + (1.0f - beta1_) * g;
+    v = beta2_ * v + (1.0f - beta2_) * g.square();
+    ps[i].value->array() -= step_size * m / (v.sqrt() * inv_sqrt_bc2 + eps_);
+  }
+}
+
+RmsProp::RmsProp(std::vector<Param> params, float lr, float alpha, float eps, bool centered,
+                 float momentum)
+    : Optimizer(std::move(params), lr),
+      alpha_(alpha),
+      eps_(eps),
+      centered_(centered),
+      momentum_(momentum) {
+  Require(alpha >= 0.0f && alpha <= 1.0f,
+          "RmsProp alpha must be in [0, 1], got " + std::to_string(alpha));
+  Require(eps >= 0.0f, "RmsProp eps must be >= 0, got " + std::to_string(eps));
+  Require(momentum >= 0.0f, "RmsProp momentum must be >= 0, got " + std::to_string(momentum));
+  square_avg_ = ZerosLike(this->params());
+  if (centered_) grad_avg_ = ZerosLike(this->params());
+  if (momentum_ > 0.0f) momentum_buf_ = ZerosLike(this->params());
+}
+
+void RmsProp::Step() {
+  const float lr = learning_rate();
+  const std::vector<Param>& ps = params();
+  for (size_t i = 0; i < ps.size(); ++i) {
+    auto g = ps[i].grad->array();
+    auto s = square_avg_[i].array();
+    auto p = ps[i].value->array();
+    s = alpha_ * s + (1.0f - alpha_) * g.square();
+    if (centered_) {
+      auto a = grad_avg_[i].array();
+      a = alpha_ * a + (1.0f - alpha_) * g;
+      // s - a^2 is a variance; clamp the rounding error that can make it slightly negative.
+      const auto denom = (s - a.square()).max(0.0f).sqrt() + eps_;
+      if (momentum_ > 0.0f) {
+        auto buf = momentum_buf_[i].array();
+        buf = momentum_ * buf + g / denom;
+        p -= lr * buf;
+      } else {
+        p -= lr * g / denom;
+      }
+    } else {
+      const auto denom = s.sqrt() + eps_;
+      if (momentum_ > 0.0f) {
+        auto buf = momentum_buf_[i].array();
+        buf = momentum_ * buf + g / denom;
+        p -= lr * buf;
+      } else {
+        p -= lr * g / denom;
+      }
+    }
+  }
+}
+
+float ClipGradNorm(const std::vector<Param>& params, float max_norm) {
+  double sum_sq = 0.0;
+  for (const Param& p : params) sum_sq += static_cast<double>(p.grad->squaredNorm());
+  const auto norm = static_cast<float>(std::sqrt(sum_sq));
+  if (norm > max_norm) {
+    const float scale = max_norm / (norm + 1e-6f);
+    for (const Param& p : params) *p.grad *= scale;
+  }
+  return norm;
+}
+
+}  // namespace rl::nn

@@ -1,0 +1,114 @@
+#!/usr/bin/env bash
+# Builds and runs the benchmarks in bench/ and prints one JSON object per line (bench, value,
+# unit, min/median/max over repeats). Where the PyTorch peer in ../shared/bench/peer can run
+# (Debian's python3 with python3-torch), it measures the same things in the same run, and each
+# of our lines gains "peer" (the peer's median) and "ratio" (how many times faster ours is).
+#
+# Usage: scripts/bench.sh [--no-setup] [--build-dir DIR] [--skip-goal] [--skip-peer]
+# Environment: REPEATS (5), SECONDS_PER (1.0, per measurement), GOAL_SEEDS ("1 2 3"),
+#              PEER_REPEATS (3), PEER_DQN (1: also time the peer's full CartPole DQN run).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+cd "$root"
+setup=1 build_dir="$root/build" skip_goal=0 skip_peer=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --no-setup) setup=0 ;;
+    --build-dir) build_dir="$2"; shift ;;
+    --skip-goal) skip_goal=1 ;;
+    --skip-peer) skip_peer=1 ;;
+    -h|--help) sed -n '2,11p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "bench.sh: unknown option '$1'" >&2; exit 2 ;;
+  esac
+  shift
+done
+repeats=${REPEATS:-5}
+seconds=${SECONDS_PER:-1.0}
+[ "$setup" -eq 0 ] || scripts/setup.sh --build-dir "$build_dir" >&2
+bin="$build_dir/bin"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+# Runs a command in its own network namespace when possible (LCM multicast on lo only).
+isolated() {
+  if [ "$(id -u)" -eq 0 ] && command -v unshare >/dev/null; then
+    unshare -n bash -c 'ip link set lo up && ip route add 224.0.0.0/4 dev lo && exec "$@"' _ "$@"
+  else
+    "$@"
+  fi
+}
+
+ours="$work/ours.jsonl"
+echo "bench: ours" >&2
+"$bin/bench_env" "$repeats" "$seconds" >> "$ours"
+"$bin/bench_actor" "$repeats" "$seconds" >> "$ours"
+"$bin/bench_learner" "$repeats" "$seconds" >> "$ours"
+isolated "$bin/bench_replay" "$repeats" "$seconds" >> "$ours"
+
+# Time from launch to goal for CartPole, start-up and evaluation included.
+if [ "$skip_goal" -eq 0 ]; then
+  times=()
+  solved=0
+  for seed in ${GOAL_SEEDS:-1 2 3}; do
+    echo "bench: launch cartpole, seed $seed" >&2
+    start=$(date +%s.%N)
+    if isolated "$root/scripts/launch.sh" cartpole --no-setup --build-dir "$build_dir" \
+        --seed "$seed" --time-budget 300 --out "$work/run-$seed" > "$work/run-$seed.log" 2>&1; then
+      solved=$((solved + 1))
+    fi
+    end=$(date +%s.%N)
+    times+=("$(awk -v a="$start" -v b="$end" 'BEGIN{printf "%.3f", b - a}')")
+  done
+  printf '%s\n' "${times[@]}" | sort -g | awk -v n="${#times[@]}" -v solved="$solved" '
+    {v[NR]=$1} END {med = (n % 2) ? v[(n+1)/2] : (v[n/2] + v[n/2+1]) / 2;
+      printf "{\"bench\": \"cartpole_time_to_goal\", \"value\": %.2f, \"unit\": \"s\", \"min\": %.2f, \"median\": %.2f, \"max\": %.2f, \"repeats\": %d, \"solved\": %d, \"goal\": 475, \"actors\": 4}\n", med, v[1], med, v[n], n, solved}' >> "$ours"
+fi
+
+# The PyTorch peer, in the same run.
+peer_dir="$root/../shared/bench/peer"
+py=/usr/bin/python3
+peer="$work/peer.jsonl"
+: > "$peer"
+if [ "$skip_peer" -eq 0 ] && [ -f "$peer_dir/micro.py" ] && "$py" -c 'import torch' 2>/dev/null; then
+  for r in $(seq "${PEER_REPEATS:-3}"); do
+    echo "bench: peer micro, repeat $r" >&2
+    (cd "$peer_dir" && "$py" micro.py --only env,mlp,actor --threads 1 --min-time 2 --tag "r$r") >> "$peer"
+  done
+  if [ "${PEER_DQN:-1}" = 1 ] && [ "$skip_goal" -eq 0 ]; then
+    echo "bench: peer DQN on CartPole (500,000 steps)" >&2
+    start=$(date +%s.%N)
+    (cd "$peer_dir" && "$py" dqn_peer.py --total-timesteps 500000 --seed 1 --threads 1 \
+      --progress-every 0) > "$work/peer_dqn.json" 2>/dev/null || true
+    end=$(date +%s.%N)
+    echo "{\"bench\": \"peer_dqn_wall\", \"rate\": $(awk -v a="$start" -v b="$end" 'BEGIN{printf "%.3f", b - a}')}" >> "$peer"
+  fi
+else
+  echo "bench: the PyTorch peer cannot run here (no python3-torch); our figures only" >&2
+fi
+
+# Join: our line + the peer's median for the same measurement.
+"$py" - "$ours" "$peer" <<'PY'
+import json, statistics, sys
+ours = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
+peer = [json.loads(l) for l in open(sys.argv[2]) if l.strip().startswith("{")]
+def peer_rates(pred):
+    return [p["rate"] for p in peer if pred(p)]
+match = {
+    "cartpole_env_steps": (lambda o: lambda p: p["bench"] == "env_steps", "higher"),
+    "actor_steps": (lambda o: lambda p: p["bench"] == "actor_steps" and p.get("threads") == 1, "higher"),
+    "learner_updates_mlp": (lambda o: lambda p: p["bench"] == "updates" and p.get("net") == "mlp"
+                            and p.get("batch") == o.get("batch") and p.get("threads") == 1, "higher"),
+    "cartpole_time_to_goal": (lambda o: lambda p: p["bench"] == "peer_dqn_wall", "lower"),
+}
+for o in ours:
+    m = match.get(o["bench"])
+    if m:
+        rates = peer_rates(m[0](o))
+        if rates:
+            p = statistics.median(rates)
+            o["peer"] = round(p, 3)
+            o["ratio"] = round(o["value"] / p if m[1] == "higher" else p / o["value"], 2)
+            if o["bench"] == "cartpole_time_to_goal":
+                o["peer_note"] = "wall time of the peer's full 500,000-step CleanRL DQN run"
+    print(json.dumps(o))
+PY

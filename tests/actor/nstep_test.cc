@@ -1,0 +1,81 @@
+#include "actor/nstep.h"
+
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace rl::actor {
+namespace {
+
+struct Out {
+  float obs0;
+  int action;
+  float reward;
+  float discount;
+  float next0;
+};
+
+// Feeds steps with observation [t] -> [t+1] and reward rewards[t]; returns what was emitted.
+std::vector<Out> Run(int n, double gamma, const std::vector<double>& rewards, bool terminate,
+                     bool truncate) {
+  NStepAccumulator acc(n, gamma, 1);
+  std::vector<Out> out;
+  auto sink = [&out](const Transition& t) {
+    out.push_back({t.obs[0], t.action, t.reward, t.discount, t.next_obs[0]});
+  };
+  for (size_t t = 0; t < rewards.size(); ++t) {
+    const float o = static_cast<float>(t);
+    const float next = static_cast<float>(t + 1);
+    const bool last = t + 1 == rewards.size();
+    acc.Add(std::span<const float>(&o, 1), static_cast<int>(t), rewards[t],
+            std::span<const float>(&next, 1), last && terminate, last && truncate, sink);
+  }
+  return out;
+}
+
+TEST(NStepTest, OneStepIsThePlainTransition) {
+  auto out = Run(1, 0.9, {1.0, 2.0}, false, false);
+  ASSERT_EQ(out.size(), 2U);
+  EXPECT_FLOAT_EQ(out[0].reward, 1.0f);
+  EXPECT_FLOAT_EQ(out[0].discount, 0.9f);
+  EXPECT_FLOAT_EQ(out[0].next0, 1.0f);
+  EXPECT_EQ(out[1].action, 1);
+}
+
+TEST(NStepTest, ThreeStepReturnsAreDiscountedSums) {
+  auto out = Run(3, 0.5, {1.0, 2.0, 3.0, 4.0}, false, false);
+  ASSERT_EQ(out.size(), 2U);
+  EXPECT_FLOAT_EQ(out[0].obs0, 0.0f);
+  EXPECT_FLOAT_EQ(out[0].reward, 1.0f + 0.5f * 2.0f + 0.25f * 3.0f);
+  EXPECT_FLOAT_EQ(out[0].discount, 0.125f);
+  EXPECT_FLOAT_EQ(out[0].next0, 3.0f);
+  EXPECT_FLOAT_EQ(out[1].reward, 2.0f + 0.5f * 3.0f + 0.25f * 4.0f);
+  EXPECT_FLOAT_EQ(out[1].next0, 4.0f);
+}
+
+TEST(NStepTest, ATerminationFlushesEveryPendingStepWithZeroDiscount) {
+  auto out = Run(3, 0.5, {1.0, 2.0}, true, false);
+  ASSERT_EQ(out.size(), 2U);
+  EXPECT_FLOAT_EQ(out[0].reward, 1.0f + 0.5f * 2.0f);
+  EXPECT_FLOAT_EQ(out[0].discount, 0.0f);
+  EXPECT_FLOAT_EQ(out[1].reward, 2.0f);
+  EXPECT_FLOAT_EQ(out[1].discount, 0.0f);
+}
+
+TEST(NStepTest, ATruncationIsNotATerminalAndBootstrapsFromTheLastObservation) {
+  auto out = Run(3, 0.5, {1.0, 2.0}, false, true);
+  ASSERT_EQ(out.size(), 2U);
+  EXPECT_FLOAT_EQ(out[0].reward, 2.0f);
+  EXPECT_FLOAT_EQ(out[0].discount, 0.25f);  // two steps left before the cut
+  EXPECT_FLOAT_EQ(out[0].next0, 2.0f);
+  EXPECT_FLOAT_EQ(out[1].discount, 0.5f);
+  EXPECT_FLOAT_EQ(out[1].next0, 2.0f);
+}
+
+TEST(NStepTest, RefusesBadParameters) {
+  EXPECT_THROW(NStepAccumulator(0, 0.9, 1), std::invalid_argument);
+  EXPECT_THROW(NStepAccumulator(1, 1.5, 1), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rl::actor

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Malformed, truncated, foreign-run and invalid messages on every channel are counted and dropped
+# by every process, and no process crashes.
+source "$(dirname "$0")/lib.sh"
+isolate "$@"
+dir=$(scratch)
+launch cartpole --out "$dir/run" --actors 2 --seed 3 --goal 1000000 --time-budget 120 \
+  > "$dir/launch.log" 2>&1 &
+launch_pid=$!
+wait_line "$dir/launch.log" "running; logs in" 60
+run="$dir/run"
+"$bin/inject" --run-id "$(run_setting "$run" run-id)" --lcm-url "$(run_setting "$run" lcm-url)" \
+  --lcm-bulk-url "$(run_setting "$run" lcm-bulk-url)" --count 20 --timeout 30 \
+  --roles replay,learner,actor,evaluator || fail "the processes did not count every bad message"
+# Every process is still alive and still working.
+while read -r role pid; do
+  kill -0 "$pid" 2>/dev/null || fail "$role (pid $pid) died"
+done < "$run/pids"
+kill -INT "$launch_pid"
+set +e
+wait "$launch_pid"
+status=$?
+set -e
+[ "$status" -eq 130 ] || fail "launch exited with $status after Ctrl-C, expected 130"
+while read -r role pid; do
+  kill -0 "$pid" 2>/dev/null && fail "$role (pid $pid) survived the stop"
+done < "$run/pids"
+grep -q "stopped" "$run/logs/replay.log" "$run/logs/learner.log" || fail "no clean stop"
+[ -s "$run/report/index.html" ] || fail "no report after Ctrl-C"
+echo "PASS: every bad message counted and dropped; clean stop"

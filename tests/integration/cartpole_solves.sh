@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# The whole pipeline (replay, learner, evaluator, 4 actors) solves CartPole-v1: an evaluation
+# over 100 greedy episodes (epsilon 0.05) reaches a mean of at least 475.
+source "$(dirname "$0")/lib.sh"
+isolate "$@"
+dir=$(scratch)
+set +e
+launch cartpole --out "$dir/run" --actors 4 --seed 1 --time-budget 240 > "$dir/launch.log" 2>&1
+status=$?
+set -e
+cat "$dir/launch.log" | tail -20
+[ "$status" -eq 0 ] || fail "launch exited with $status"
+jsonl="$dir/run/eval.jsonl"
+[ -s "$jsonl" ] || fail "no eval.jsonl"
+best=$(grep -o '"mean":[-0-9.e+]*' "$jsonl" | cut -d: -f2 | sort -g | tail -1)
+awk -v b="$best" 'BEGIN{exit !(b >= 475)}' || fail "best evaluation mean $best < 475"
+grep '"mean":'"$best" "$jsonl" | grep -q '"episodes":100' || fail "the best evaluation did not use 100 episodes"
+grep -q '<img' "$dir/run/report/index.html" || fail "the report has no learning curve"
+ls "$dir/run/checkpoints"/ckpt-*.bin >/dev/null || fail "no checkpoints"
+for role in replay learner evaluator actor-0; do
+  [ -s "$dir/run/logs/$role.log" ] || fail "no log of $role"
+done
+echo "PASS: solved with best evaluation mean $best"

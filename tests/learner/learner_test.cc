@@ -1,0 +1,137 @@
+#include "learner/learner.h"
+
+#include <filesystem>
+#include <random>
+#include <set>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "common/channels.h"
+#include "nn/checkpoint.h"
+#include "rlmsg/checkpoint_t.hpp"
+#include "rlmsg/sample_request_t.hpp"
+#include "rlmsg/weights_chunk_t.hpp"
+
+namespace rl::learner {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Runs a Learner against a stand-in replay on the same in-process bus: every request is answered
+// with random CartPole-shaped transitions. The first delivery of request 0 is "lost", and no
+// request is answered until the learner has sent request 0 again, so the retry must happen.
+class LearnerTest : public ::testing::Test {
+ protected:
+  LearnerTest() : dir_(fs::temp_directory_path() / ("learner_test_" + std::to_string(getpid()))) {
+    fs::remove_all(dir_);
+    BusConfig c;
+    c.url = c.bulk_url = "memq://";
+    c.run_id = 9;
+    c.sender = "learner";
+    bus_ = std::make_unique<Bus>(c);
+    bus_->Subscribe<rlmsg::sample_request_t>(
+        channels::kSampleRequest, [this](const rlmsg::sample_request_t& r) { Answer(r); });
+    bus_->Subscribe<rlmsg::checkpoint_t>(
+        channels::kCheckpoint,
+        [this](const rlmsg::checkpoint_t& m) { announced_.push_back(m.path); });
+    bus_->Subscribe<rlmsg::weights_chunk_t>(
+        channels::kWeights,
+        [this](const rlmsg::weights_chunk_t& m) { versions_.insert(m.version); }, Port::kBulk);
+  }
+  ~LearnerTest() override { fs::remove_all(dir_); }
+
+  void Answer(const rlmsg::sample_request_t& r) {
+    ++requests_seen_;
+    if (r.request_id == 0 && !dropped_first_) {
+      dropped_first_ = true;
+      return;
+    }
+    if (!retried_) {
+      if (r.request_id != 0) {
+        held_.push_back(r);
+        return;
+      }
+      retried_ = true;
+      Reply(r);
+      for (const auto& h : held_) Reply(h);
+      return;
+    }
+    Reply(r);
+  }
+
+  void Reply(const rlmsg::sample_request_t& r) {
+    rlmsg::sample_batch_t b{};
+    b.requester = r.header.sender;
+    b.request_id = r.request_id;
+    b.obs_size = 4;
+    b.count = r.batch_size;
+    b.num_values = 4 * b.count;
+    std::normal_distribution<float> normal;
+    for (int i = 0; i < b.num_values; ++i) {
+      b.obs.push_back(normal(rng_));
+      b.next_obs.push_back(normal(rng_));
+    }
+    for (int i = 0; i < b.count; ++i) {
+      b.action.push_back(i % 2);
+      b.reward.push_back(1.0f);
+      b.discount.push_back(0.99f);
+      b.index.push_back(i);
+      b.weight.push_back(1.0f);
+    }
+    b.replay_size = 1000;
+    b.total_inserts = 1234;
+    bus_->Publish(channels::kSamples, &b, Port::kBulk);
+  }
+
+  fs::path dir_;
+  std::unique_ptr<Bus> bus_;
+  std::mt19937 rng_{1};
+  bool dropped_first_ = false;
+  bool retried_ = false;
+  std::vector<rlmsg::sample_request_t> held_;
+  int requests_seen_ = 0;
+  std::vector<std::string> announced_;
+  std::set<int64_t> versions_;
+};
+
+TEST_F(LearnerTest, TrainsBroadcastsWeightsAndWritesLoadableCheckpoints) {
+  LearnerConfig c;
+  c.batch_size = 32;
+  c.max_updates = 30;
+  c.weights_every = 10;
+  c.checkpoint_every = 10;
+  c.request_timeout = 0.05;
+  c.out_dir = dir_.string();
+  Learner learner(c, bus_.get());
+  learner.Run();
+  bus_->Handle(0);
+  EXPECT_EQ(learner.updates(), 30);
+  // The lost request was sent again, with the same id.
+  EXPECT_TRUE(retried_);
+  EXPECT_GE(requests_seen_, 31);
+  // Version 0 (the initial network) and every tenth update.
+  EXPECT_TRUE(versions_.count(0));
+  EXPECT_TRUE(versions_.count(10));
+  EXPECT_TRUE(versions_.count(20));
+  // Checkpoints at 10, 20, 30 and a last one when the run ends.
+  ASSERT_EQ(announced_.size(), 4U);
+  const nn::Checkpoint ckpt = nn::LoadCheckpoint(announced_[1]);
+  EXPECT_EQ(ckpt.meta.update, 20);
+  EXPECT_EQ(ckpt.meta.env_steps, 1234);
+  EXPECT_EQ(ckpt.meta.run_id, 9U);
+  EXPECT_EQ(ckpt.architecture, learner.dqn().online().Architecture());
+  // The last checkpoint holds the final parameters.
+  std::vector<float> flat;
+  learner.dqn().online().GetFlat(&flat);
+  EXPECT_EQ(nn::LoadCheckpoint(announced_.back()).params, flat);
+}
+
+TEST(LearnerConfigTest, RefusesBadSettings) {
+  LearnerConfig c;
+  c.requests_in_flight = 0;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rl::learner

@@ -1,0 +1,79 @@
+// The learner's update and the actors' single-observation inference must not touch the heap once
+// shapes are stable.
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "nn/losses.h"
+#include "nn/optimizers.h"
+#include "nn/sequential.h"
+#include "tests/nn/allocation_counter.h"
+#include "tests/nn/gradient_check.h"
+
+namespace rl::nn {
+namespace {
+
+using testing::AllocationCount;
+using testing::AllocationCountingAvailable;
+
+TEST(AllocationTest, CounterSeesAllocations) {
+  if (!AllocationCountingAvailable()) GTEST_SKIP() << "allocation counting unavailable";
+  const int64_t before = AllocationCount();
+  auto* v = new std::vector<float>(100);
+  Matrix m(50, 50);
+  delete v;
+  EXPECT_GE(AllocationCount() - before, 3);
+}
+
+TEST(AllocationTest, PredictAndArgmaxDoNotAllocateAfterTheFirstCall) {
+  if (!AllocationCountingAvailable()) GTEST_SKIP() << "allocation counting unavailable";
+  std::mt19937 rng(0);
+  Sequential net = MakeMlp(4, {120, 84}, 2, &rng);
+  const float obs[4] = {0.1f, -0.2f, 0.03f, 0.5f};
+  net.Predict(obs, 4);
+  const int64_t before = AllocationCount();
+  int sum = 0;
+  for (int i = 0; i < 100; ++i) {
+    sum += net.Argmax(obs, 4);
+    sum += static_cast<int>(net.Predict(obs, 4)(0, 0) > 0.0f);
+  }
+  EXPECT_EQ(AllocationCount() - before, 0) << sum;
+}
+
+TEST(AllocationTest, DqnUpdateDoesNotAllocateOnceShapesAreStable) {
+  if (!AllocationCountingAvailable()) GTEST_SKIP() << "allocation counting unavailable";
+  std::mt19937 rng(0);
+  constexpr int kBatch = 128;
+  Sequential online = MakeMlp(4, {120, 84}, 2, &rng);
+  Sequential target = online;
+  const std::vector<Param> params = online.Params();
+  Adam adam(params, 1e-3f);
+  const Matrix obs = testing::RandomMatrix(4, kBatch, &rng);
+  const Matrix next_obs = testing::RandomMatrix(4, kBatch, &rng);
+  Vector q_taken(kBatch);
+  Vector td_target(kBatch);
+  Vector grad;
+  Matrix grad_q(2, kBatch);
+  auto update = [&] {
+    const Matrix& q_next = target.Forward(next_obs);
+    for (int j = 0; j < kBatch; ++j) td_target[j] = 1.0f + 0.99f * q_next.col(j).maxCoeff();
+    const Matrix& q = online.Forward(obs);
+    for (int j = 0; j < kBatch; ++j) q_taken[j] = q(j % 2, j);
+    HuberLoss(q_taken, td_target, &grad);
+    grad_q.setZero();
+    for (int j = 0; j < kBatch; ++j) grad_q(j % 2, j) = grad[j];
+    online.ZeroGrad();
+    online.Backward(grad_q);
+    ClipGradNorm(params, 10.0f);
+    adam.Step();
+    target.SoftUpdateFrom(online, 0.005f);
+  };
+  update();
+  const int64_t before = AllocationCount();
+  for (int i = 0; i < 10; ++i) update();
+  EXPECT_EQ(AllocationCount() - before, 0);
+}
+
+}  // namespace
+}  // namespace rl::nn

@@ -1,0 +1,128 @@
+#include "nn/gemm.h"
+
+#include <array>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "tests/nn/gradient_check.h"
+
+namespace rl::nn::internal {
+namespace {
+
+using testing::RandomMatrix;
+
+// Compares Gemm with Eigen for c (m x n) = op(a) * op(b) (+ bias) over every combination of
+// transposed operands, transposed output, accumulation and bias.
+void CheckAgainstEigen(int m, int n, int k) {
+  std::mt19937 rng(static_cast<unsigned>(m * 10007 + n * 101 + k));
+  Vector workspace;
+  const Matrix a = RandomMatrix(m, k, &rng);
+  const Matrix a_t = a.transpose();
+  const Matrix b = RandomMatrix(k, n, &rng);
+  const Matrix b_t = b.transpose();
+  const Matrix bias = RandomMatrix(m, 1, &rng);
+  const Matrix start = RandomMatrix(m, n, &rng);
+  const Matrix product = a * b;
+  for (int mode = 0; mode < 32; ++mode) {
+    const bool trans_a = (mode & 1) != 0;
+    const bool trans_b = (mode & 2) != 0;
+    const bool trans_c = (mode & 4) != 0;
+    const bool accumulate = (mode & 8) != 0;
+    const bool with_bias = (mode & 16) != 0;
+    Matrix c = start;
+    Matrix c_t = start.transpose();
+    const ConstView va = trans_a ? View(a_t).Transposed() : View(a);
+    const ConstView vb = trans_b ? View(b_t).Transposed() : View(b);
+    const MutView vc = trans_c ? View(&c_t).Transposed() : View(&c);
+    Epilogue epilogue;
+    epilogue.row_bias = with_bias ? bias.data() : nullptr;
+    Gemm(va, vb, vc, accumulate, epilogue, &workspace);
+    Matrix expected = product;
+    if (with_bias) expected.colwise() += bias.col(0);
+    if (accumulate) expected += start;
+    const Matrix got = trans_c ? Matrix(c_t.transpose()) : c;
+    const float tol = 1e-5f * static_cast<float>(k + 1);
+    EXPECT_LE((got - expected).cwiseAbs().maxCoeff(), tol)
+        << m << "x" << k << " * " << k << "x" << n << " mode " << mode;
+  }
+}
+
+TEST(GemmTest, MatchesEigenOnRaggedShapes) {
+  for (int m : {1, 2, 3, 4, 5, 8, 17, 24, 25, 84}) {
+    for (int n : {1, 2, 5, 8, 13, 32}) {
+      for (int k : {1, 4, 9, 33}) CheckAgainstEigen(m, n, k);
+    }
+  }
+}
+
+TEST(GemmTest, MatchesEigenOnTheCartPoleShapes) {
+  CheckAgainstEigen(120, 128, 4);
+  CheckAgainstEigen(84, 128, 120);
+  CheckAgainstEigen(84, 120, 128);
+  CheckAgainstEigen(120, 128, 84);
+}
+
+TEST(GemmTest, MatchesEigenWhenTheSharedDimensionSpansSeveralSlices) {
+  CheckAgainstEigen(30, 9, 600);
+}
+
+// The fused activation steps: relu(a * b + bias), and a * b zeroed where a mask is not positive,
+// on every code path (dot products, panels, transposed output, several slices of k).
+TEST(GemmTest, EpilogueAppliesReluAndMask) {
+  for (const auto& [m, n, k] : {std::array<int, 3>{2, 16, 9}, std::array<int, 3>{30, 17, 40},
+                                std::array<int, 3>{5, 40, 7}, std::array<int, 3>{12, 9, 300}}) {
+    std::mt19937 rng(static_cast<unsigned>(m + n + k));
+    Vector workspace;
+    const Matrix a = RandomMatrix(m, k, &rng);
+    const Matrix b = RandomMatrix(k, n, &rng);
+    const Matrix bias = RandomMatrix(m, 1, &rng);
+    const Matrix mask = RandomMatrix(m, n, &rng);
+    Matrix with_bias = a * b;
+    with_bias.colwise() += bias.col(0);
+
+    Matrix c(m, n);
+    Epilogue relu;
+    relu.row_bias = bias.data();
+    relu.relu = true;
+    Gemm(View(a), View(b), View(&c), /*accumulate=*/false, relu, &workspace);
+    EXPECT_LE((c - Matrix(with_bias.cwiseMax(0.0f))).cwiseAbs().maxCoeff(), 1e-4f)
+        << m << "x" << n << "x" << k;
+    EXPECT_EQ(c.minCoeff(), 0.0f);
+
+    Epilogue masked;
+    masked.mask = mask.data();
+    Gemm(View(a), View(b), View(&c), /*accumulate=*/false, masked, &workspace);
+    const Matrix expected = (mask.array() > 0.0f).select(a * b, 0.0f);
+    EXPECT_LE((c - expected).cwiseAbs().maxCoeff(), 1e-4f) << m << "x" << n << "x" << k;
+  }
+}
+
+TEST(GemmTest, EmptySharedDimensionGivesBiasOrKeepsTheAccumulator) {
+  Vector workspace;
+  const Matrix a(3, 0);
+  const Matrix b(0, 2);
+  Matrix c = Matrix::Constant(3, 2, 7.0f);
+  Gemm(View(a), View(b), View(&c), /*accumulate=*/true, {}, &workspace);
+  EXPECT_TRUE(c.isApprox(Matrix::Constant(3, 2, 7.0f)));
+  const float bias[3] = {1.0f, 2.0f, 3.0f};
+  Epilogue epilogue;
+  epilogue.row_bias = bias;
+  Gemm(View(a), View(b), View(&c), /*accumulate=*/false, epilogue, &workspace);
+  EXPECT_EQ(c(2, 1), 3.0f);
+  EXPECT_EQ(c(0, 0), 1.0f);
+}
+
+TEST(AddRowSumsTest, AddsTheSumOfEachRowAcrossTheBatch) {
+  std::mt19937 rng(5);
+  for (int rows : {1, 7, 8, 63, 64, 65, 120, 130}) {
+    const Matrix g = RandomMatrix(rows, 37, &rng);
+    Matrix out = RandomMatrix(rows, 1, &rng);
+    const Matrix expected = out + g.rowwise().sum();
+    AddRowSums(g, out.data());
+    EXPECT_LE((out - expected).cwiseAbs().maxCoeff(), 1e-4f) << rows << " rows";
+  }
+}
+
+}  // namespace
+}  // namespace rl::nn::internal

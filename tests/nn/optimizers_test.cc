@@ -1,0 +1,191 @@
+#include "nn/optimizers.h"
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <random>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "nn/linear.h"
+#include "nn/losses.h"
+
+namespace rl::nn {
+namespace {
+
+// A 2x1 parameter with its gradient, fed known gradients step by step.
+struct TwoFloats {
+  Matrix value = (Matrix(2, 1) << 1.0f, -2.0f).finished();
+  Matrix grad = Matrix::Zero(2, 1);
+  std::vector<Param> params() { return {{"p", &value, &grad}}; }
+  void SetGrad(float a, float b) { grad << a, b; }
+};
+
+// Expected values below come from PyTorch's update rules evaluated in double precision for
+// p0 = (1, -2) and gradients g1 = (0.5, -0.1), then g2 = (0.2, 0.3).
+TEST(AdamTest, FirstTwoStepsMatchPyTorchUpdateRule) {
+  TwoFloats p;
+  Adam adam(p.params(), /*lr=*/0.1f);
+  p.SetGrad(0.5f, -0.1f);
+  adam.Step();
+  // Step 1: m_hat = g and v_hat = g^2, so p -= lr * sign(g) (up to eps).
+  EXPECT_NEAR(p.value(0), 0.900000002, 1e-6);
+  EXPECT_NEAR(p.value(1), -1.90000001, 1e-6);
+  p.SetGrad(0.2f, 0.3f);
+  adam.Step();
+  EXPECT_NEAR(p.value(0), 0.8101424839029282, 1e-5);
+  EXPECT_NEAR(p.value(1), -1.9494189911200654, 1e-5);
+  EXPECT_EQ(adam.step_count(), 2);
+}
+
+struct RmsCase {
+  bool centered;
+  float momentum;
+  double step1[2];
+  double step2[2];
+};
+
+TEST(RmsPropTest, FirstTwoStepsMatchPyTorchUpdateRule) {
+  const RmsCase cases[] = {
+      {false,
+       0.0f,
+       {0.900000019999996, -1.9000000999999},
+       {0.8626998346269039, -1.9949158695451294}},
+      {true,
+       0.0f,
+       {0.899496238676095, -1.8994963194840784},
+       {0.8618787112241529, -1.9946045995978066}},
+      {false,
+       0.9f,
+       {0.900000019999996, -1.9000000999999},
+       {0.7726998526269003, -1.9049159595450393}},
+      {true,
+       0.9f,
+       {0.899496238676095, -1.8994963194840784},
+       {0.7714253260326385, -1.9041512871334771}},
+  };
+  for (const RmsCase& c : cases) {
+    SCOPED_TRACE(::testing::Message() << "centered " << c.centered << " momentum " << c.momentum);
+    TwoFloats p;
+    RmsProp rms(p.params(), /*lr=*/0.01f, /*alpha=*/0.99f, /*eps=*/1e-8f, c.centered, c.momentum);
+    p.SetGrad(0.5f, -0.1f);
+    rms.Step();
+    EXPECT_NEAR(p.value(0), c.step1[0], 1e-5);
+    EXPECT_NEAR(p.value(1), c.step1[1], 1e-5);
+    p.SetGrad(0.2f, 0.3f);
+    rms.Step();
+    EXPECT_NEAR(p.value(0), c.step2[0], 1e-5);
+    EXPECT_NEAR(p.value(1), c.step2[1], 1e-5);
+  }
+}
+
+TEST(OptimizerTest, LearningRateCanBeChangedAndZeroFreezesParameters) {
+  TwoFloats p;
+  Adam adam(p.params(), 0.1f);
+  EXPECT_FLOAT_EQ(adam.learning_rate(), 0.1f);
+  adam.set_learning_rate(0.0f);
+  EXPECT_EQ(adam.learning_rate(), 0.0f);
+  p.SetGrad(1.0f, 1.0f);
+  adam.Step();
+  EXPECT_FLOAT_EQ(p.value(0), 1.0f);
+  EXPECT_FLOAT_EQ(p.value(1), -2.0f);
+}
+
+TEST(OptimizerTest, RejectsInvalidHyperparameters) {
+  TwoFloats p;
+  EXPECT_THROW(Adam(p.params(), -1.0f), std::invalid_argument);
+  EXPECT_THROW(Adam(p.params(), 1e-3f, 1.0f), std::invalid_argument);
+  EXPECT_THROW(Adam(p.params(), 1e-3f, 0.9f, 1.5f), std::invalid_argument);
+  EXPECT_THROW(RmsProp(p.params(), 1e-2f, 1.5f), std::invalid_argument);
+  EXPECT_THROW(RmsProp(p.params(), 1e-2f, 0.99f, 1e-8f, false, -0.5f), std::invalid_argument);
+}
+
+// Minimises 0.5 * |p - c|^2 (gradient p - c) from p0 = (1, -2) to c = (-3, 4).
+template <typename Opt, typename... Args>
+Matrix MinimiseQuadratic(int steps, Args... args) {
+  TwoFloats p;
+  const Matrix c = (Matrix(2, 1) << -3.0f, 4.0f).finished();
+  Opt opt(p.params(), args...);
+  for (int i = 0; i < steps; ++i) {
+    p.grad = p.value - c;
+    opt.Step();
+  }
+  return p.value - c;
+}
+
+TEST(AdamTest, MinimisesAQuadratic) {
+  EXPECT_LT(MinimiseQuadratic<Adam>(2000, 0.05f).norm(), 1e-2f);
+}
+
+TEST(RmsPropTest, MinimisesAQuadraticPlainCenteredAndWithMomentum) {
+  EXPECT_LT(MinimiseQuadratic<RmsProp>(3000, 0.01f).norm(), 5e-2f);
+  EXPECT_LT(MinimiseQuadratic<RmsProp>(3000, 0.01f, 0.99f, 1e-8f, true).norm(), 5e-2f);
+  EXPECT_LT(MinimiseQuadratic<RmsProp>(3000, 0.001f, 0.99f, 1e-8f, false, 0.9f).norm(), 5e-2f);
+}
+
+// Fits y = 2x - 1 with one Linear unit and MSE; returns (w, b).
+template <typename Opt>
+std::pair<float, float> FitLine(float lr) {
+  std::mt19937 rng(1);
+  Linear layer(1, 1, &rng);
+  Matrix x(1, 32);
+  Vector y(32);
+  for (int i = 0; i < 32; ++i) {
+    x(0, i) = -1.0f + 2.0f * static_cast<float>(i) / 31.0f;
+    y[i] = 2.0f * x(0, i) - 1.0f;
+  }
+  Opt opt(layer.Params(), lr);
+  Vector grad;
+  for (int step = 0; step < 2000; ++step) {
+    const Vector pred = layer.Forward(x).row(0).transpose();
+    MseLoss(pred, y, &grad);
+    for (Param& p : layer.Params()) p.grad->setZero();
+    layer.Backward(grad.transpose());
+    opt.Step();
+  }
+  return {layer.weight()(0, 0), layer.bias()(0, 0)};
+}
+
+TEST(AdamTest, FitsALinearRegression) {
+  const auto [w, b] = FitLine<Adam>(0.05f);
+  EXPECT_NEAR(w, 2.0f, 1e-2f);
+  EXPECT_NEAR(b, -1.0f, 1e-2f);
+}
+
+TEST(RmsPropTest, FitsALinearRegression) {
+  const auto [w, b] = FitLine<RmsProp>(0.005f);
+  EXPECT_NEAR(w, 2.0f, 5e-2f);
+  EXPECT_NEAR(b, -1.0f, 5e-2f);
+}
+
+TEST(ClipGradNormTest, ScalesGradientsDownToMaxNormAndReturnsTheOriginalNorm) {
+  Matrix v1 = Matrix::Zero(1, 1);
+  Matrix g1 = (Matrix(1, 1) << 3.0f).finished();
+  Matrix v2 = Matrix::Zero(1, 1);
+  Matrix g2 = (Matrix(1, 1) << -4.0f).finished();
+  const std::vector<Param> params = {{"a", &v1, &g1}, {"b", &v2, &g2}};
+  EXPECT_FLOAT_EQ(ClipGradNorm(params, 1.0f), 5.0f);
+  EXPECT_NEAR(g1(0), 0.6f, 1e-6f);
+  EXPECT_NEAR(g2(0), -0.8f, 1e-6f);
+}
+
+TEST(ClipGradNormTest, LeavesSmallGradientsAlone) {
+  Matrix v = Matrix::Zero(2, 1);
+  Matrix g = (Matrix(2, 1) << 3.0f, 4.0f).finished();
+  const std::vector<Param> params = {{"a", &v, &g}};
+  EXPECT_FLOAT_EQ(ClipGradNorm(params, 10.0f), 5.0f);
+  EXPECT_EQ(g(0), 3.0f);
+  EXPECT_EQ(g(1), 4.0f);
+}
+
+TEST(ClipGradNormTest, ReportsANonFiniteNormWithoutTouchingGradients) {
+  Matrix v = Matrix::Zero(2, 1);
+  Matrix g = (Matrix(2, 1) << std::numeric_limits<float>::quiet_NaN(), 4.0f).finished();
+  const std::vector<Param> params = {{"a", &v, &g}};
+  EXPECT_TRUE(std::isnan(ClipGradNorm(params, 1.0f)));
+  EXPECT_EQ(g(1), 4.0f);
+}
+
+}  // namespace
+}  // namespace rl::nn

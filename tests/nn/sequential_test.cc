@@ -1,0 +1,281 @@
+#include "nn/sequential.h"
+
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "nn/activations.h"
+#include "nn/linear.h"
+#include "nn/losses.h"
+#include "tests/nn/gradient_check.h"
+
+namespace rl::nn {
+namespace {
+
+using testing::ExpectGradientsClose;
+using testing::NumericalGradient;
+using testing::RandomMatrix;
+
+constexpr char kCartPoleArch[] = "linear(4,120),relu,linear(120,84),relu,linear(84,2)";
+
+std::vector<float> Flat(const Sequential& net) {
+  std::vector<float> flat;
+  net.GetFlat(&flat);
+  return flat;
+}
+
+TEST(SequentialTest, MakeMlpBuildsTheCartPoleNetwork) {
+  std::mt19937 rng(0);
+  Sequential net = MakeMlp(4, {120, 84}, 2, &rng);
+  EXPECT_EQ(net.Architecture(), kCartPoleArch);
+  EXPECT_EQ(net.NumParams(), 4 * 120 + 120 + 120 * 84 + 84 + 84 * 2 + 2);
+  EXPECT_EQ(net.InputSize(), 4);
+  EXPECT_EQ(net.OutputSize(), 2);
+  const std::vector<Param> params = net.Params();
+  ASSERT_EQ(params.size(), 6u);
+  EXPECT_EQ(params[0].name, "0.weight");
+  EXPECT_EQ(params[1].name, "0.bias");
+  EXPECT_EQ(params[2].name, "2.weight");
+  EXPECT_EQ(params[5].name, "4.bias");
+  EXPECT_EQ(params[2].value->rows(), 84);
+  EXPECT_EQ(params[2].value->cols(), 120);
+}
+
+TEST(SequentialTest, ArchitectureRoundTripsThroughBuildFromArchitecture) {
+  std::mt19937 rng(0);
+  for (const std::string& arch :
+       {std::string(kCartPoleArch), std::string("linear(3,5),tanh,linear(5,1)"),
+        std::string("linear(7,7)")}) {
+    const Sequential net = BuildFromArchitecture(arch, &rng);
+    EXPECT_EQ(net.Architecture(), arch);
+  }
+  EXPECT_EQ(BuildFromArchitecture(" linear( 4 , 8 ) , relu ,linear(8,2)", &rng).Architecture(),
+            "linear(4,8),relu,linear(8,2)");
+}
+
+TEST(SequentialTest, SameSeedBuildsIdenticalNetworks) {
+  std::mt19937 rng_a(42);
+  std::mt19937 rng_b(42);
+  EXPECT_EQ(Flat(BuildFromArchitecture(kCartPoleArch, &rng_a)),
+            Flat(MakeMlp(4, {120, 84}, 2, &rng_b)));
+}
+
+TEST(SequentialTest, MalformedArchitecturesThrowWithTheOffendingLayer) {
+  std::mt19937 rng(0);
+  const std::pair<std::string, std::string> cases[] = {
+      {"", "no layers"},
+      {"linear(4)", "needs linear(in,out)"},
+      {"linear(4,8", "unbalanced"},
+      {"linear(4,8))", "unbalanced"},
+      {"conv(3,4)", "unknown layer 0 'conv'"},
+      {"linear(4,8),relu(1)", "takes no arguments"},
+      {"linear(4,8),,relu", "layer 1 is empty"},
+      {"linear(4,-8)", "'-8' is not a positive integer"},
+      {"linear(a,8)", "'a' is not a positive integer"},
+      {"linear(4,8)x", "text after ')'"},
+      {"linear(4,8),relu,linear(7,2)", "expects 7 inputs but the previous layer produces 8"},
+  };
+  for (const auto& [arch, message] : cases) {
+    try {
+      BuildFromArchitecture(arch, &rng);
+      ADD_FAILURE() << "no exception for '" << arch << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos)
+          << "'" << arch << "' gave: " << e.what();
+    }
+  }
+}
+
+TEST(SequentialTest, GetFlatSetFlatRoundTrip) {
+  std::mt19937 rng(1);
+  Sequential a = MakeMlp(3, {5}, 2, &rng);
+  Sequential b = MakeMlp(3, {5}, 2, &rng);
+  const std::vector<float> flat_a = Flat(a);
+  ASSERT_EQ(flat_a.size(), static_cast<size_t>(a.NumParams()));
+  // Column-major weight of layer 0 first, then its bias.
+  EXPECT_EQ(flat_a[1], a.Params()[0].value->data()[1]);
+  EXPECT_EQ(flat_a[15], (*a.Params()[1].value)(0, 0));
+  EXPECT_NE(Flat(b), flat_a);
+  b.SetFlat(flat_a.data(), flat_a.size());
+  EXPECT_EQ(Flat(b), flat_a);
+  const Matrix x = RandomMatrix(3, 4, &rng);
+  EXPECT_EQ(Matrix(a.Forward(x)), b.Forward(x));
+}
+
+TEST(SequentialTest, SetFlatRejectsTheWrongSize) {
+  std::mt19937 rng(1);
+  Sequential net = MakeMlp(3, {5}, 2, &rng);
+  std::vector<float> flat = Flat(net);
+  flat.push_back(0.0f);
+  EXPECT_THROW(net.SetFlat(flat.data(), flat.size()), std::invalid_argument);
+}
+
+TEST(SequentialTest, CopyParamsFromCopiesValuesAndKeepsParamPointers) {
+  std::mt19937 rng(2);
+  Sequential online = MakeMlp(4, {8}, 2, &rng);
+  Sequential target = MakeMlp(4, {8}, 2, &rng);
+  const Matrix* before = target.Params()[0].value;
+  target.CopyParamsFrom(online);
+  EXPECT_EQ(Flat(target), Flat(online));
+  EXPECT_EQ(target.Params()[0].value, before);
+}
+
+TEST(SequentialTest, CopyParamsFromAbortsOnADifferentArchitecture) {
+  std::mt19937 rng(2);
+  Sequential a = MakeMlp(4, {8}, 2, &rng);
+  Sequential b = MakeMlp(4, {9}, 2, &rng);
+  EXPECT_DEATH(a.CopyParamsFrom(b), "same architecture");
+}
+
+TEST(SequentialTest, SoftUpdateFromBlendsParameters) {
+  std::mt19937 rng(3);
+  Sequential online = MakeMlp(4, {8}, 2, &rng);
+  Sequential target = MakeMlp(4, {8}, 2, &rng);
+  const std::vector<float> a = Flat(target);
+  const std::vector<float> b = Flat(online);
+  target.SoftUpdateFrom(online, 0.25f);
+  const std::vector<float> blended = Flat(target);
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(blended[i], 0.25f * b[i] + 0.75f * a[i], 1e-6f);
+  target.SoftUpdateFrom(online, 1.0f);
+  EXPECT_EQ(Flat(target), b);
+}
+
+TEST(SequentialTest, CopiesAreDeepAndIndependent) {
+  std::mt19937 rng(4);
+  Sequential net = MakeMlp(4, {8}, 2, &rng);
+  Sequential copy(net);
+  EXPECT_EQ(copy.Architecture(), net.Architecture());
+  EXPECT_EQ(Flat(copy), Flat(net));
+  copy.Params()[0].value->setZero();
+  EXPECT_NE(Flat(copy), Flat(net));
+  Sequential assigned;
+  assigned = net;
+  EXPECT_EQ(Flat(assigned), Flat(net));
+  Sequential moved = std::move(assigned);
+  EXPECT_EQ(Flat(moved), Flat(net));
+}
+
+TEST(SequentialTest, PredictAndArgmaxMatchTheBatchedForward) {
+  std::mt19937 rng(5);
+  Sequential net = MakeMlp(4, {120, 84}, 2, &rng);
+  const Matrix x = RandomMatrix(4, 128, &rng, 2.0f);
+  const Matrix q = net.Forward(x);
+  for (int j = 0; j < x.cols(); ++j) {
+    const Matrix& single = net.Predict(x.col(j).data(), 4);
+    ASSERT_EQ(single.rows(), 2);
+    ASSERT_EQ(single.cols(), 1);
+    EXPECT_NEAR(single(0, 0), q(0, j), 1e-5f);
+    EXPECT_NEAR(single(1, 0), q(1, j), 1e-5f);
+    Eigen::Index best = 0;
+    q.col(j).maxCoeff(&best);
+    EXPECT_EQ(net.Argmax(x.col(j).data(), 4), best);
+  }
+}
+
+TEST(SequentialTest, ArgmaxPicksTheFirstOfTiedMaxima) {
+  Sequential net;
+  net.Add(std::make_unique<Linear>(Matrix::Zero(3, 2), (Matrix(3, 1) << 1, 3, 3).finished()));
+  const float obs[2] = {0.5f, -0.5f};
+  EXPECT_EQ(net.Argmax(obs, 2), 1);
+}
+
+TEST(SequentialTest, AddRejectsMismatchedLayerSizes) {
+  std::mt19937 rng(0);
+  Sequential net;
+  net.Add(std::make_unique<Linear>(4, 8, &rng));
+  net.Add(std::make_unique<ReLU>());
+  EXPECT_THROW(net.Add(std::make_unique<Linear>(7, 2, &rng)), std::invalid_argument);
+}
+
+// Back-propagates the gathered-action loss of DQN through an MLP: the loss only sees Q(s_j, a_j).
+void CheckEndToEndGradients(bool huber) {
+  std::mt19937 rng(13);
+  Sequential net = MakeMlp(3, {8, 6}, 2, &rng);
+  const int batch = 5;
+  Matrix x = RandomMatrix(3, batch, &rng, 2.0f);
+  const int actions[batch] = {0, 1, 1, 0, 1};
+  const Vector target = RandomMatrix(batch, 1, &rng, 2.0f);
+  const Vector weights = RandomMatrix(batch, 1, &rng, 0.5f).array() + 1.0f;
+  Vector pred(batch);
+  auto loss_with_grad = [&](Vector* grad) {
+    const Matrix& q = net.Forward(x);
+    for (int j = 0; j < batch; ++j) pred[j] = q(actions[j], j);
+    return huber ? HuberLoss(pred, target, grad, 1.0f, &weights)
+                 : MseLoss(pred, target, grad, &weights);
+  };
+  auto loss = [&] { return static_cast<double>(loss_with_grad(nullptr)); };
+
+  Vector grad;
+  loss_with_grad(&grad);
+  Matrix grad_q = Matrix::Zero(2, batch);
+  for (int j = 0; j < batch; ++j) grad_q(actions[j], j) = grad[j];
+  net.ZeroGrad();
+  const Matrix dx = net.Backward(grad_q);
+
+  ExpectGradientsClose(dx, NumericalGradient(loss, &x), "input");
+  for (const Param& p : net.Params()) {
+    const Matrix analytic = *p.grad;
+    ExpectGradientsClose(analytic, NumericalGradient(loss, p.value), p.name);
+  }
+}
+
+TEST(SequentialTest, MlpGradientsThroughWeightedHuberMatchFiniteDifferences) {
+  CheckEndToEndGradients(/*huber=*/true);
+}
+
+TEST(SequentialTest, MlpGradientsThroughWeightedMseMatchFiniteDifferences) {
+  CheckEndToEndGradients(/*huber=*/false);
+}
+
+// Sequential fuses ReLUs into neighbouring Linear layers; running clones of the same layers one
+// by one (clones are never fused) must give the same outputs and gradients.
+TEST(SequentialTest, FusedReluGivesTheSameResultsAsSeparateLayers) {
+  std::mt19937 rng(21);
+  for (const std::string& arch : {std::string("linear(5,24),relu,linear(24,17),relu,linear(17,3)"),
+                                  std::string("relu,linear(5,9),relu,linear(9,4),relu")}) {
+    for (int batch : {1, 3, 16}) {
+      SCOPED_TRACE(arch + " batch " + std::to_string(batch));
+      Sequential net = BuildFromArchitecture(arch, &rng);
+      std::vector<std::unique_ptr<Layer>> layers;
+      for (int i = 0; i < net.num_layers(); ++i) layers.push_back(net.layer(i).Clone());
+      const Matrix x = RandomMatrix(5, batch, &rng);
+      const Matrix grad_out = RandomMatrix(net.OutputSize(), batch, &rng);
+
+      const Matrix* h = &x;
+      for (auto& layer : layers) h = &layer->Forward(*h);
+      const Matrix* g = &grad_out;
+      for (size_t i = layers.size(); i-- > 0;) g = &layers[i]->Backward(*g);
+
+      EXPECT_TRUE(net.Forward(x).isApprox(*h, 1e-5f));
+      net.ZeroGrad();
+      EXPECT_TRUE(net.Backward(grad_out).isApprox(*g, 1e-5f));
+      std::vector<Param> expected;
+      for (auto& layer : layers) {
+        for (const Param& p : layer->Params()) expected.push_back(p);
+      }
+      const std::vector<Param> got = net.Params();
+      ASSERT_EQ(got.size(), expected.size());
+      for (size_t i = 0; i < got.size(); ++i) {
+        EXPECT_TRUE(got[i].grad->isApprox(*expected[i].grad, 1e-5f)) << got[i].name;
+      }
+    }
+  }
+}
+
+TEST(SequentialTest, ZeroGradClearsAllGradients) {
+  std::mt19937 rng(6);
+  Sequential net = MakeMlp(3, {4}, 2, &rng);
+  const Matrix x = RandomMatrix(3, 2, &rng);
+  net.Forward(x);
+  net.Backward(Matrix::Ones(2, 2));
+  EXPECT_FALSE(net.Params()[0].grad->isZero());
+  net.ZeroGrad();
+  for (const Param& p : net.Params()) EXPECT_TRUE(p.grad->isZero()) << p.name;
+}
+
+}  // namespace
+}  // namespace rl::nn

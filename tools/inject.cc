@@ -1,0 +1,282 @@
+// inject: sends bad messages on every channel of a run and checks that every process counted and
+// dropped them (the integration test of robustness).
+//
+// For each channel it sends `count` messages of each kind: random bytes, truncated real messages,
+// well-formed messages of another run, and well-formed messages of this run with invalid content.
+// Then it waits until the stats of each expected role show at least the drops its subscriptions
+// imply, and exits 0; 1 if they do not within --timeout seconds.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "common/channels.h"
+#include "common/clock.h"
+#include "common/options.h"
+#include "common/shutdown.h"
+
+namespace {
+
+struct Drops {
+  int64_t malformed = 0, foreign = 0, invalid = 0;
+  double seen = 0;
+};
+
+template <class Msg>
+std::vector<uint8_t> Encode(Msg m, int64_t run_id) {
+  m.header.run_id = run_id;
+  m.header.sender = "inject";
+  std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+// One channel: a well-formed message of the channel's type, and one with invalid content.
+struct Target {
+  std::string channel;
+  rl::Port port;
+  std::function<std::vector<uint8_t>(int64_t run_id)> good;
+  std::function<std::vector<uint8_t>(int64_t run_id)> invalid;
+};
+
+rlmsg::transition_batch_t Transitions() {
+  rlmsg::transition_batch_t m{};
+  m.obs_size = 4;
+  m.count = 1;
+  m.num_values = 4;
+  m.obs = m.next_obs = {0, 0, 0, 0};
+  m.action = {0};
+  m.reward = {1};
+  m.discount = {0.99f};
+  m.episode_id = {0};
+  m.priority = {0};
+  return m;
+}
+
+rlmsg::sample_batch_t Samples() {
+  rlmsg::sample_batch_t m{};
+  m.requester = "learner";
+  m.obs_size = 4;
+  m.count = 1;
+  m.num_values = 4;
+  m.obs = m.next_obs = {0, 0, 0, 0};
+  m.action = {0};
+  m.reward = {1};
+  m.discount = {0.99f};
+  m.index = {0};
+  m.weight = {1};
+  return m;
+}
+
+rlmsg::weights_chunk_t Chunk() {
+  rlmsg::weights_chunk_t m{};
+  m.version = 1;
+  m.architecture = "linear(4,2)";
+  m.total_size = 2;
+  m.chunk_index = 0;
+  m.num_chunks = 1;
+  m.offset = 0;
+  m.count = 2;
+  m.data = {0, 0};
+  return m;
+}
+
+std::vector<Target> Targets() {
+  const float nan = std::nanf("");
+  std::vector<Target> t;
+  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
+               [](int64_t r) { return Encode(Transitions(), r); },
+               [nan](int64_t r) {
+                 auto m = Transitions();
+                 m.reward[0] = nan;
+                 return Encode(m, r);
+               }});
+  t.push_back({rl::channels::kSampleRequest, rl::Port::kMain,
+               [](int64_t r) {
+                 rlmsg::sample_request_t m{};
+                 m.batch_size = 1;
+                 m.request_id = 1'000'000'000;
+                 return Encode(m, r);
+               },
+               [](int64_t r) {
+                 rlmsg::sample_request_t m{};
+                 m.batch_size = -5;
+                 return Encode(m, r);
+               }});
+  t.push_back({rl::channels::kSamples, rl::Port::kBulk,
+               [](int64_t r) { return Encode(Samples(), r); },
+               [nan](int64_t r) {
+                 auto m = Samples();
+                 m.obs[2] = nan;
+                 return Encode(m, r);
+               }});
+  t.push_back({rl::channels::kWeights, rl::Port::kBulk,
+               [](int64_t r) { return Encode(Chunk(), r); },
+               [](int64_t r) {
+                 auto m = Chunk();
+                 m.chunk_index = 3;
+                 return Encode(m, r);
+               }});
+  t.push_back({rl::channels::kFlow, rl::Port::kMain,
+               [](int64_t r) {
+                 rlmsg::flow_control_t m{};
+                 m.insert_allowed = 1;
+                 return Encode(m, r);
+               },
+               [](int64_t r) {
+                 rlmsg::flow_control_t m{};
+                 m.insert_allowed = 7;
+                 return Encode(m, r);
+               }});
+  t.push_back({rl::channels::kCheckpoint, rl::Port::kMain,
+               [](int64_t r) {
+                 rlmsg::checkpoint_t m{};
+                 m.path = "/nonexistent/ckpt.bin";
+                 return Encode(m, r);
+               },
+               [](int64_t r) {
+                 rlmsg::checkpoint_t m{};  // empty path
+                 return Encode(m, r);
+               }});
+  // Channels nobody subscribes to in a given role still get the garbage.
+  for (const char* ch : {rl::channels::kEval, rl::channels::kStatsActor, rl::channels::kStatsReplay,
+                         rl::channels::kStatsLearner, rl::channels::kStatsEvaluator}) {
+    t.push_back({ch, rl::Port::kMain, [](int64_t r) { return Encode(Transitions(), r); },
+                 [](int64_t r) { return Encode(Transitions(), r); }});
+  }
+  return t;
+}
+
+// Channels each role subscribes to (what its drop counters must reflect).
+const std::map<std::string, std::vector<std::string>>& RoleChannels() {
+  static const std::map<std::string, std::vector<std::string>> m = {
+      {"replay", {rl::channels::kTransitions, rl::channels::kSampleRequest}},
+      {"learner", {rl::channels::kSamples}},
+      {"actor", {rl::channels::kWeights, rl::channels::kFlow}},
+      {"evaluator", {rl::channels::kCheckpoint}},
+  };
+  return m;
+}
+
+int Main(int argc, char** argv) {
+  rl::CommonOptions common;
+  int count = 20;
+  double timeout = 30;
+  std::string roles = "replay,learner,actor,evaluator";
+  uint64_t seed = 1;
+  rl::po::options_description desc("Options");
+  rl::AddCommonOptions(&desc, &common);
+  desc.add_options()  //
+      ("count", rl::po::value(&count)->default_value(count),
+       "messages of each kind per channel")                                                    //
+      ("roles", rl::po::value(&roles)->default_value(roles), "roles whose drops are checked")  //
+      ("timeout", rl::po::value(&timeout)->default_value(timeout),
+       "seconds to wait for the stats to show the drops")  //
+      ("seed", rl::po::value(&seed)->default_value(seed), "seed of the random bytes");
+  rl::po::variables_map vm;
+  if (!rl::ParseOptions(argc, argv, "inject",
+                        "Usage: inject [options]\n"
+                        "Sends malformed, truncated, foreign and invalid messages on every channel "
+                        "of a run and checks that every process counted and dropped them.",
+                        desc, &vm)) {
+    return 0;
+  }
+  rl::InstallStopHandlers();
+  rl::Bus bus(common.MakeBusConfig("inject"));
+  std::map<std::string, Drops> drops;  // by role
+  auto track = [&drops](const std::string& sender, int64_t m, int64_t f, int64_t i) {
+    const std::string role = sender.rfind("actor-", 0) == 0 ? "actor" : sender;
+    Drops& d = drops[role];
+    // Several actors: keep the smallest counts, so every actor must have dropped enough.
+    if (role == "actor" && d.seen > 0) {
+      d.malformed = std::min(d.malformed, m);
+      d.foreign = std::min(d.foreign, f);
+      d.invalid = std::min(d.invalid, i);
+    } else {
+      d.malformed = m;
+      d.foreign = f;
+      d.invalid = i;
+    }
+    d.seen = rl::MonoSeconds();
+  };
+  bus.Subscribe<rlmsg::stats_actor_t>(rl::channels::kStatsActor, [&](const auto& s) {
+    track(s.header.sender, s.dropped_malformed, s.dropped_foreign, s.dropped_invalid);
+  });
+  bus.Subscribe<rlmsg::stats_replay_t>(rl::channels::kStatsReplay, [&](const auto& s) {
+    track(s.header.sender, s.dropped_malformed, s.dropped_foreign, s.dropped_invalid);
+  });
+  bus.Subscribe<rlmsg::stats_learner_t>(rl::channels::kStatsLearner, [&](const auto& s) {
+    track(s.header.sender, s.dropped_malformed, s.dropped_foreign, s.dropped_invalid);
+  });
+  bus.Subscribe<rlmsg::stats_evaluator_t>(rl::channels::kStatsEvaluator, [&](const auto& s) {
+    track(s.header.sender, s.dropped_malformed, s.dropped_foreign, s.dropped_invalid);
+  });
+
+  // Send, paced (1 ms apart), so that nothing is lost on the way.
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> byte(0, 255), length(1, 300);
+  const int64_t foreign_run = common.run_id ^ 0x5A5A5A5A5A5ALL;
+  int sent = 0;
+  for (const Target& t : Targets()) {
+    for (int k = 0; k < count; ++k) {
+      std::vector<uint8_t> junk(static_cast<size_t>(length(rng)));
+      for (auto& b : junk) b = static_cast<uint8_t>(byte(rng));
+      bus.PublishRaw(t.channel, junk.data(), junk.size(), t.port);
+      std::vector<uint8_t> good = t.good(common.run_id);
+      good.resize(good.size() / 2);
+      bus.PublishRaw(t.channel, good.data(), good.size(), t.port);
+      std::vector<uint8_t> foreign = t.good(foreign_run);
+      bus.PublishRaw(t.channel, foreign.data(), foreign.size(), t.port);
+      std::vector<uint8_t> invalid = t.invalid(common.run_id);
+      bus.PublishRaw(t.channel, invalid.data(), invalid.size(), t.port);
+      sent += 4;
+      bus.Handle(1);
+    }
+  }
+  std::printf("inject: sent %d bad messages\n", sent);
+  std::fflush(stdout);
+
+  // Wait for every role's counters to reach what its subscriptions imply.
+  std::set<std::string> expected;
+  std::stringstream ss(roles);
+  for (std::string r; std::getline(ss, r, ',');) expected.insert(r);
+  const double deadline = rl::MonoSeconds() + timeout;
+  const double sent_at = rl::MonoSeconds();
+  while (rl::MonoSeconds() < deadline && !rl::StopRequested()) {
+    bus.Handle(100);
+    bool all = true;
+    for (const std::string& role : expected) {
+      const auto it = drops.find(role);
+      const int64_t n = count * static_cast<int64_t>(RoleChannels().at(role).size());
+      if (it == drops.end() || it->second.seen < sent_at || it->second.malformed < 2 * n ||
+          it->second.foreign < n || it->second.invalid < n) {
+        all = false;
+      }
+    }
+    if (all) break;
+  }
+  int status = 0;
+  for (const std::string& role : expected) {
+    const int64_t n = count * static_cast<int64_t>(RoleChannels().at(role).size());
+    const Drops d = drops.count(role) ? drops.at(role) : Drops{};
+    const bool ok = d.malformed >= 2 * n && d.foreign >= n && d.invalid >= n;
+    std::printf("inject: %-9s malformed %lld/%lld foreign %lld/%lld invalid %lld/%lld %s\n",
+                role.c_str(), static_cast<long long>(d.malformed), static_cast<long long>(2 * n),
+                static_cast<long long>(d.foreign), static_cast<long long>(n),
+                static_cast<long long>(d.invalid), static_cast<long long>(n),
+                ok ? "ok" : "MISSING");
+    if (!ok) status = 1;
+  }
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return rl::RunMain("inject", Main, argc, argv); }

@@ -1,0 +1,183 @@
+// monitor: the live view of a run for the launch script.
+//
+// Listens to every process's stats and the evaluator's results, prints a progress line, and
+// exits when the run is over: 0 when an evaluation reached the goal, 1 when the time budget ran
+// out, 3 when the replay, the learner or the evaluator went silent, 130 on SIGINT/SIGTERM.
+#include <unistd.h>
+
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include "common/channels.h"
+#include "common/clock.h"
+#include "common/options.h"
+#include "common/shutdown.h"
+#include "rlmsg/eval_result_t.hpp"
+#include "rlmsg/stats_actor_t.hpp"
+#include "rlmsg/stats_evaluator_t.hpp"
+#include "rlmsg/stats_learner_t.hpp"
+#include "rlmsg/stats_replay_t.hpp"
+
+namespace {
+
+struct View {
+  std::map<std::string, rlmsg::stats_actor_t> actors;  // by sender
+  std::map<std::string, double> actor_seen;
+  rlmsg::stats_replay_t replay{};
+  rlmsg::stats_learner_t learner{};
+  rlmsg::stats_evaluator_t evaluator{};
+  double replay_seen = 0, learner_seen = 0, evaluator_seen = 0;
+  bool have_eval = false;
+  rlmsg::eval_result_t last_eval{};
+  double best_eval = -1e300;
+  bool goal_reached = false;
+};
+
+std::string Thousands(int64_t v) {
+  std::string s = std::to_string(v);
+  for (int i = static_cast<int>(s.size()) - 3; i > (v < 0 ? 1 : 0); i -= 3)
+    s.insert(static_cast<size_t>(i), ",");
+  return s;
+}
+
+std::string ProgressLine(const View& v, double elapsed, double now) {
+  int64_t steps = 0, episodes = 0, lost = 0, dropped = 0;
+  double ret = 0;
+  int live = 0, paused = 0;
+  for (const auto& [name, a] : v.actors) {
+    steps += a.env_steps;
+    episodes += a.episodes;
+    lost += a.lost;
+    dropped += a.dropped_malformed + a.dropped_foreign + a.dropped_invalid;
+    if (now - v.actor_seen.at(name) < 3.0) {
+      ++live;
+      ret += a.mean_return;
+      paused += a.paused;
+    }
+  }
+  lost += v.replay.lost + v.learner.lost + v.evaluator.lost;
+  dropped += v.replay.dropped_malformed + v.replay.dropped_foreign + v.replay.dropped_invalid +
+             v.learner.dropped_malformed + v.learner.dropped_foreign + v.learner.dropped_invalid +
+             v.evaluator.dropped_malformed + v.evaluator.dropped_foreign +
+             v.evaluator.dropped_invalid;
+  char eval[96] = "eval -";
+  if (v.have_eval) {
+    std::snprintf(eval, sizeof(eval), "eval %.1f (best %.1f)", v.last_eval.mean, v.best_eval);
+  }
+  char line[512];
+  std::snprintf(line, sizeof(line),
+                "[%6.1fs] steps %s  episodes %s  return %.1f  %s  learner %.0f upd/s (%s)  "
+                "replay %s  actors %d%s  lost %lld  dropped %lld",
+                elapsed, Thousands(steps).c_str(), Thousands(episodes).c_str(),
+                live > 0 ? ret / live : 0.0, eval, v.learner.updates_per_second,
+                Thousands(v.learner.updates).c_str(), Thousands(v.replay.size).c_str(), live,
+                paused > 0 ? " (paused)" : "", static_cast<long long>(lost),
+                static_cast<long long>(dropped));
+  return line;
+}
+
+int Main(int argc, char** argv) {
+  rl::CommonOptions common;
+  double goal = 475;
+  double time_budget = 600;
+  double stale_seconds = 20;
+  double print_seconds = 1;
+  rl::po::options_description desc("Options");
+  rl::AddCommonOptions(&desc, &common);
+  desc.add_options()                                                                            //
+      ("goal", rl::po::value(&goal)->default_value(goal), "evaluation mean that ends the run")  //
+      ("time-budget", rl::po::value(&time_budget)->default_value(time_budget),
+       "seconds after which the run ends unsolved")  //
+      ("stale-seconds", rl::po::value(&stale_seconds)->default_value(stale_seconds),
+       "a replay, learner or evaluator silent this long ends the run")  //
+      ("print-seconds", rl::po::value(&print_seconds)->default_value(print_seconds),
+       "seconds between progress lines");
+  rl::po::variables_map vm;
+  if (!rl::ParseOptions(argc, argv, "monitor",
+                        "Usage: monitor [options]\n"
+                        "Shows a run's progress from its stats messages and exits when the goal is "
+                        "reached (0), the time budget is spent (1) or a process went silent (3).",
+                        desc, &vm)) {
+    return 0;
+  }
+  rl::InstallStopHandlers();
+  rl::Bus bus(common.MakeBusConfig("monitor"));
+  View v;
+  bus.Subscribe<rlmsg::stats_actor_t>(rl::channels::kStatsActor,
+                                      [&v](const rlmsg::stats_actor_t& s) {
+                                        v.actors[s.header.sender] = s;
+                                        v.actor_seen[s.header.sender] = rl::MonoSeconds();
+                                      });
+  bus.Subscribe<rlmsg::stats_replay_t>(rl::channels::kStatsReplay,
+                                       [&v](const rlmsg::stats_replay_t& s) {
+                                         v.replay = s;
+                                         v.replay_seen = rl::MonoSeconds();
+                                       });
+  bus.Subscribe<rlmsg::stats_learner_t>(rl::channels::kStatsLearner,
+                                        [&v](const rlmsg::stats_learner_t& s) {
+                                          v.learner = s;
+                                          v.learner_seen = rl::MonoSeconds();
+                                        });
+  bus.Subscribe<rlmsg::stats_evaluator_t>(rl::channels::kStatsEvaluator,
+                                          [&v](const rlmsg::stats_evaluator_t& s) {
+                                            v.evaluator = s;
+                                            v.evaluator_seen = rl::MonoSeconds();
+                                          });
+  bus.Subscribe<rlmsg::eval_result_t>(rl::channels::kEval, [&](const rlmsg::eval_result_t& e) {
+    v.have_eval = true;
+    v.last_eval = e;
+    v.best_eval = std::max(v.best_eval, e.mean);
+    std::printf("evaluation: update %lld, env steps %lld: mean %.1f +- %.1f over %d episodes%s\n",
+                static_cast<long long>(e.update), static_cast<long long>(e.env_steps), e.mean,
+                e.std, e.episodes, e.mean >= goal ? " -- goal reached" : "");
+    std::fflush(stdout);
+    if (e.mean >= goal) v.goal_reached = true;
+  });
+  std::printf("monitor: ready\n");
+  std::fflush(stdout);
+
+  const bool tty = isatty(STDOUT_FILENO) != 0;
+  const double start = rl::MonoSeconds();
+  double next_print = start + print_seconds;
+  int status = 1;
+  while (true) {
+    bus.Handle(100);
+    const double now = rl::MonoSeconds();
+    const double elapsed = now - start;
+    if (v.goal_reached) {
+      status = 0;
+      break;
+    }
+    if (rl::StopRequested()) {
+      status = 130;
+      break;
+    }
+    if (elapsed >= time_budget) {
+      std::printf("\nmonitor: time budget of %.0f s spent\n", time_budget);
+      status = 1;
+      break;
+    }
+    const char* silent = nullptr;
+    if (v.replay_seen > 0 && now - v.replay_seen > stale_seconds) silent = "replay";
+    if (v.learner_seen > 0 && now - v.learner_seen > stale_seconds) silent = "learner";
+    if (v.evaluator_seen > 0 && now - v.evaluator_seen > stale_seconds) silent = "evaluator";
+    if (silent != nullptr) {
+      std::printf("\nmonitor: the %s has been silent for %.0f s\n", silent, stale_seconds);
+      status = 3;
+      break;
+    }
+    if (now >= next_print) {
+      std::printf(tty ? "\r%s\033[K" : "%s\n", ProgressLine(v, elapsed, now).c_str());
+      std::fflush(stdout);
+      next_print = now + print_seconds;
+    }
+  }
+  std::printf("%s%s\n", tty ? "\r" : "",
+              ProgressLine(v, rl::MonoSeconds() - start, rl::MonoSeconds()).c_str());
+  return status;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return rl::RunMain("monitor", Main, argc, argv); }
