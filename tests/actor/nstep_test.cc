@@ -16,7 +16,7 @@ struct Out {
 };
 
 // Feeds steps with observation [t] -> [t+1] and reward rewards[t]; returns what was emitted.
-std::vector<Out> Run(int n, double gamma, const std::vector<double>& rewards, bool terminate,
+std::vector<Out> Feed(int n, double gamma, const std::vector<double>& rewards, bool terminate,
                      bool truncate) {
   NStepAccumulator acc(n, gamma, 1);
   std::vector<Out> out;
@@ -34,7 +34,7 @@ std::vector<Out> Run(int n, double gamma, const std::vector<double>& rewards, bo
 }
 
 TEST(NStepTest, OneStepIsThePlainTransition) {
-  auto out = Run(1, 0.9, {1.0, 2.0}, false, false);
+  auto out = Feed(1, 0.9, {1.0, 2.0}, false, false);
   ASSERT_EQ(out.size(), 2U);
   EXPECT_FLOAT_EQ(out[0].reward, 1.0f);
   EXPECT_FLOAT_EQ(out[0].discount, 0.9f);
@@ -43,7 +43,7 @@ TEST(NStepTest, OneStepIsThePlainTransition) {
 }
 
 TEST(NStepTest, ThreeStepReturnsAreDiscountedSums) {
-  auto out = Run(3, 0.5, {1.0, 2.0, 3.0, 4.0}, false, false);
+  auto out = Feed(3, 0.5, {1.0, 2.0, 3.0, 4.0}, false, false);
   ASSERT_EQ(out.size(), 2U);
   EXPECT_FLOAT_EQ(out[0].obs0, 0.0f);
   EXPECT_FLOAT_EQ(out[0].reward, 1.0f + 0.5f * 2.0f + 0.25f * 3.0f);
@@ -54,7 +54,7 @@ TEST(NStepTest, ThreeStepReturnsAreDiscountedSums) {
 }
 
 TEST(NStepTest, ATerminationFlushesEveryPendingStepWithZeroDiscount) {
-  auto out = Run(3, 0.5, {1.0, 2.0}, true, false);
+  auto out = Feed(3, 0.5, {1.0, 2.0}, true, false);
   ASSERT_EQ(out.size(), 2U);
   EXPECT_FLOAT_EQ(out[0].reward, 1.0f + 0.5f * 2.0f);
   EXPECT_FLOAT_EQ(out[0].discount, 0.0f);
@@ -63,7 +63,7 @@ TEST(NStepTest, ATerminationFlushesEveryPendingStepWithZeroDiscount) {
 }
 
 TEST(NStepTest, ATruncationIsNotATerminalAndBootstrapsFromTheLastObservation) {
-  auto out = Run(3, 0.5, {1.0, 2.0}, false, true);
+  auto out = Feed(3, 0.5, {1.0, 2.0}, false, true);
   ASSERT_EQ(out.size(), 2U);
   EXPECT_FLOAT_EQ(out[0].reward, 2.0f);
   EXPECT_FLOAT_EQ(out[0].discount, 0.25f);  // two steps left before the cut
