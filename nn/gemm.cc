@@ -138,6 +138,43 @@ constexpr auto KernelTable(std::integer_sequence<int, V...> /*unused*/) {
 }
 constexpr auto kKernels = KernelTable(std::make_integer_sequence<int, kMaxVecs>{});
 
+// Shuffle indices for one stage of an in-register kLanes x kLanes transpose: rows i and i + B
+// (i without bit B) swap their off-diagonal B x B blocks.
+template <int B, bool kSecond>
+constexpr std::array<int, kLanes> SwapBlockIndices() {
+  std::array<int, kLanes> idx{};
+  for (int l = 0; l < kLanes; ++l) {
+    if (!kSecond) {
+      idx[l] = (l & B) == 0 ? l : kLanes + l - B;
+    } else {
+      idx[l] = (l & B) == 0 ? l + B : kLanes + l;
+    }
+  }
+  return idx;
+}
+
+template <int B, bool kSecond, int... I>
+inline Vec SwapBlocks(Vec x, Vec y, std::integer_sequence<int, I...> /*unused*/) {
+  constexpr std::array<int, kLanes> kIdx = SwapBlockIndices<B, kSecond>();
+  return __builtin_shufflevector(x, y, kIdx[I]...);
+}
+
+template <int B>
+inline void TransposeStages(Vec* rows) {
+  if constexpr (B >= 1) {
+    constexpr auto kSeq = std::make_integer_sequence<int, kLanes>{};
+#pragma GCC unroll 16
+    for (int i = 0; i < kLanes; ++i) {
+      if ((i & B) != 0) continue;
+      const Vec x = rows[i];
+      const Vec y = rows[i | B];
+      rows[i] = SwapBlocks<B, false>(x, y, kSeq);
+      rows[i | B] = SwapBlocks<B, true>(x, y, kSeq);
+    }
+    TransposeStages<B / 2>(rows);
+  }
+}
+
 // Copies rows [i0, i0 + rows) and columns [p0, p0 + k) of `a` into `dst` as k steps of `mr` floats
 // (zero beyond `rows`).
 void PackPanel(const ConstView& a, int i0, int rows, int p0, int k, int mr, float* dst) {
@@ -150,10 +187,31 @@ void PackPanel(const ConstView& a, int i0, int rows, int p0, int k, int mr, floa
     }
     return;
   }
-  // Transposed operand: walk each source row contiguously and scatter it into the panel.
+  // Transposed operand. With contiguous rows, transpose kLanes x kLanes tiles in registers...
+  int i_done = 0;
+  int p_done = 0;
+  if (a.col_stride == 1) {
+    i_done = rows - rows % kLanes;
+    p_done = k - k % kLanes;
+    for (int ib = 0; ib < i_done; ib += kLanes) {
+      const float* src = a.data + (i0 + ib) * a.row_stride + p0;
+      for (int pb = 0; pb < p_done; pb += kLanes) {
+        Vec tile[kLanes];
+#pragma GCC unroll 16
+        for (int r = 0; r < kLanes; ++r) tile[r] = Load(src + r * a.row_stride + pb);
+        TransposeStages<kLanes / 2>(tile);
+#pragma GCC unroll 16
+        for (int t = 0; t < kLanes; ++t)
+          Store(dst + static_cast<int64_t>(pb + t) * mr + ib, tile[t]);
+      }
+    }
+  }
+  // ... and copy what is left one element at a time, walking each source row contiguously.
   for (int i = 0; i < rows; ++i) {
     const float* src = a.data + (i0 + i) * a.row_stride + p0 * a.col_stride;
-    for (int p = 0; p < k; ++p) dst[static_cast<int64_t>(p) * mr + i] = src[p * a.col_stride];
+    for (int p = i < i_done ? p_done : 0; p < k; ++p) {
+      dst[static_cast<int64_t>(p) * mr + i] = src[p * a.col_stride];
+    }
   }
   for (int i = rows; i < mr; ++i) {
     for (int p = 0; p < k; ++p) dst[static_cast<int64_t>(p) * mr + i] = 0.0f;
@@ -255,12 +313,14 @@ inline Vec Fold(Vec x, Vec y) {
   return FoldShuffle<G, false>(x, y, kSeq) + FoldShuffle<G, true>(x, y, kSeq);
 }
 
-template <int G>
-inline void FoldLevels(Vec* v, int count) {
+// Folds kCount vectors of groups of G lanes into kCount / 2 vectors of groups of G / 2, down to
+// single lanes.
+template <int G, int kCount>
+inline void FoldLevels(Vec* v) {
   if constexpr (G > 1) {
 #pragma GCC unroll 16
-    for (int i = 0; i < count / 2; ++i) v[i] = Fold<G>(v[2 * i], v[2 * i + 1]);
-    FoldLevels<G / 2>(v, count / 2);
+    for (int i = 0; i < kCount / 2; ++i) v[i] = Fold<G>(v[2 * i], v[2 * i + 1]);
+    FoldLevels<G / 2, kCount / 2>(v);
   }
 }
 
@@ -271,7 +331,7 @@ inline Vec ReduceLanes(const Vec* v) {
   Vec w[kLanes];
 #pragma GCC unroll 16
   for (int l = 0; l < kLanes; ++l) w[l] = v[BitReverse(l, Log2(kLanes))];
-  FoldLevels<kLanes>(w, kLanes);
+  FoldLevels<kLanes, kLanes>(w);
   return w[0];
 }
 

@@ -27,6 +27,11 @@ class Layer {
   /// gradients and returns d(loss)/d(input) (an internal buffer).
   virtual const Matrix& Backward(const Matrix& grad_out) = 0;
 
+  /// As Backward() for a layer whose input gradient nobody needs (the first layer of a network):
+  /// ADDS the parameter gradients; layers may skip computing d(loss)/d(input). The default calls
+  /// Backward().
+  virtual void BackwardParams(const Matrix& grad_out) { Backward(grad_out); }
+
   /// The trainable tensors, in a fixed order. Names carry no layer index (e.g. "weight"); the
   /// network prefixes them.
   virtual std::vector<Param> Params() { return {}; }

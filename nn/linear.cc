@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "common/check.h"
@@ -58,18 +59,15 @@ const Matrix& Linear::Forward(const Matrix& x) {
   return output_;
 }
 
-const Matrix& Linear::Backward(const Matrix& grad_out) {
+void Linear::AccumulateParamGrads(const Matrix& grad_out) {
   RL_CHECK(input_ != nullptr) << Describe() << ": Backward() before Forward()";
   const Matrix& x = *input_;
   RL_CHECK(grad_out.rows() == weight_.rows() && grad_out.cols() == x.cols())
       << Describe() << " got an output gradient of " << grad_out.rows() << "x" << grad_out.cols()
       << " for a batch of " << x.cols();
-  const auto out = static_cast<int>(weight_.rows());
-  const auto in = static_cast<int>(weight_.cols());
-  const auto batch = static_cast<int>(x.cols());
-
   // dW += dY x^T.
-  if (internal::PreferGemm(out, in, batch)) {
+  if (internal::PreferGemm(static_cast<int>(weight_.rows()), static_cast<int>(weight_.cols()),
+                           static_cast<int>(x.cols()))) {
     internal::Gemm(internal::View(grad_out), internal::View(x).Transposed(),
                    internal::View(&weight_grad_), /*accumulate=*/true, {}, &workspace_);
   } else {
@@ -77,11 +75,21 @@ const Matrix& Linear::Backward(const Matrix& grad_out) {
   }
   // db += sum over the batch of dY.
   internal::AddRowSums(grad_out, bias_grad_.data());
+}
+
+void Linear::BackwardParams(const Matrix& grad_out) { AccumulateParamGrads(grad_out); }
+
+const Matrix& Linear::Backward(const Matrix& grad_out) {
+  AccumulateParamGrads(grad_out);
   // dx = W^T dY, times the derivative of a fused preceding ReLU (1 where its output x > 0).
+  const Matrix& x = *input_;
+  const auto out = static_cast<int>(weight_.rows());
+  const auto in = static_cast<int>(weight_.cols());
+  const auto batch = static_cast<int>(x.cols());
   grad_input_.resize(in, batch);
   if (internal::PreferGemm(in, batch, out)) {
     internal::Epilogue epilogue;
-    (void)0;
+    if (fused_input_relu_grad_) epilogue.mask = x.data();
     internal::Gemm(internal::View(weight_).Transposed(), internal::View(grad_out),
                    internal::View(&grad_input_), /*accumulate=*/false, epilogue, &workspace_);
   } else {

@@ -26,6 +26,7 @@ class Linear : public Layer {
 
   const Matrix& Forward(const Matrix& x) override;
   const Matrix& Backward(const Matrix& grad_out) override;
+  void BackwardParams(const Matrix& grad_out) override;
   std::vector<Param> Params() override;
   std::string Describe() const override;
   std::unique_ptr<Layer> Clone() const override;
@@ -48,6 +49,9 @@ class Linear : public Layer {
   void set_fused_input_relu_grad(bool on) { fused_input_relu_grad_ = on; }
 
  private:
+  // Adds dW and db for `grad_out` and the input of the last Forward().
+  void AccumulateParamGrads(const Matrix& grad_out);
+
   Matrix weight_;                  // out x in
   Matrix bias_;                    // out x 1
   Matrix weight_grad_;             // out x in

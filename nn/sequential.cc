@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cstring>
 #include <stdexcept>
 #include <utility>
 
@@ -79,6 +78,16 @@ const Matrix& Sequential::Backward(const Matrix& grad_out) {
     if (!fused_backward_[i]) g = &layers_[i]->Backward(*g);
   }
   return *g;
+}
+
+void Sequential::BackwardParams(const Matrix& grad_out) {
+  const Matrix* g = &grad_out;
+  for (size_t i = layers_.size(); i-- > 1;) {
+    if (!fused_backward_[i]) g = &layers_[i]->Backward(*g);
+  }
+  // A fused ReLU in front still needs its mask applied by the layer after it, so only an unfused
+  // first layer can skip the input gradient.
+  if (!layers_.empty() && !fused_backward_[0]) layers_[0]->BackwardParams(*g);
 }
 
 void Sequential::ZeroGrad() {

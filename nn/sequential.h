@@ -23,10 +23,10 @@ class ReLU;
 /// layers). Optimizers hold such pointers, so update a target network with CopyParamsFrom().
 /// Not thread-safe: give each thread its own copy.
 ///
-/// A ReLU between Linear layers is fused into them: the preceding Linear applies it to its output
-/// and the following Linear masks its input gradient, which saves two passes over the
-/// activations. Results are the same; calling a fused layer's Forward() or Backward() directly
-/// through layer() gives the fused result.
+/// ReLUs next to Linear layers are fused into them: a Linear followed by a ReLU applies it to its
+/// output, and a Linear preceded by a ReLU masks its input gradient, which saves two passes over
+/// the activations. Results are the same; calling a fused layer's Forward() or Backward()
+/// directly through layer() gives the fused result.
 class Sequential {
  public:
   Sequential() = default;
@@ -47,6 +47,9 @@ class Sequential {
   /// Back-propagates d(loss)/d(output) of the last Forward(); ADDS into the parameter gradients
   /// and returns d(loss)/d(input).
   const Matrix& Backward(const Matrix& grad_out);
+  /// As Backward() but without d(loss)/d(input), which training does not need: saves the
+  /// input-gradient product of the first layer.
+  void BackwardParams(const Matrix& grad_out);
   /// Sets every parameter gradient to zero.
   void ZeroGrad();
 

@@ -190,21 +190,24 @@ int Main(int argc, char** argv) {
   }
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("inject"));
-  std::map<std::string, Drops> drops;  // by role
-  auto track = [&drops](const std::string& sender, int64_t m, int64_t f, int64_t i) {
-    const std::string role = sender.rfind("actor-", 0) == 0 ? "actor" : sender;
-    Drops& d = drops[role];
-    // Several actors: keep the smallest counts, so every actor must have dropped enough.
-    if (role == "actor" && d.seen > 0) {
-      d.malformed = std::min(d.malformed, m);
-      d.foreign = std::min(d.foreign, f);
-      d.invalid = std::min(d.invalid, i);
-    } else {
-      d.malformed = m;
-      d.foreign = f;
-      d.invalid = i;
+  std::map<std::string, Drops> by_sender;  // the newest counts of each process
+  auto track = [&by_sender](const std::string& sender, int64_t m, int64_t f, int64_t i) {
+    by_sender[sender] = Drops{m, f, i, rl::MonoSeconds()};
+  };
+  // Per role, the smallest counts of its processes: every actor must have dropped enough.
+  auto role_drops = [&by_sender]() {
+    std::map<std::string, Drops> drops;
+    for (const auto& [sender, d] : by_sender) {
+      const std::string role = sender.rfind("actor-", 0) == 0 ? "actor" : sender;
+      auto [it, fresh] = drops.try_emplace(role, d);
+      if (!fresh) {
+        it->second.malformed = std::min(it->second.malformed, d.malformed);
+        it->second.foreign = std::min(it->second.foreign, d.foreign);
+        it->second.invalid = std::min(it->second.invalid, d.invalid);
+        it->second.seen = std::min(it->second.seen, d.seen);
+      }
     }
-    d.seen = rl::MonoSeconds();
+    return drops;
   };
   bus.Subscribe<rlmsg::stats_actor_t>(rl::channels::kStatsActor, [&](const auto& s) {
     track(s.header.sender, s.dropped_malformed, s.dropped_foreign, s.dropped_invalid);
@@ -251,6 +254,7 @@ int Main(int argc, char** argv) {
   const double sent_at = rl::MonoSeconds();
   while (rl::MonoSeconds() < deadline && !rl::StopRequested()) {
     bus.Handle(100);
+    const auto drops = role_drops();
     bool all = true;
     for (const std::string& role : expected) {
       const auto it = drops.find(role);
@@ -263,6 +267,7 @@ int Main(int argc, char** argv) {
     if (all) break;
   }
   int status = 0;
+  const auto drops = role_drops();
   for (const std::string& role : expected) {
     const int64_t n = count * static_cast<int64_t>(RoleChannels().at(role).size());
     const Drops d = drops.count(role) ? drops.at(role) : Drops{};

@@ -2,7 +2,7 @@
 # SIGKILL of one actor in the middle of a run: the run goes on and still reaches the goal.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
-dir=$(scratch)
+scratch
 launch cartpole --out "$dir/run" --actors 4 --seed 2 --time-budget 240 > "$dir/launch.log" 2>&1 &
 launch_pid=$!
 # Mid-run: the learner has trained (its first checkpoint has been scored).

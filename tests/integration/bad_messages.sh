@@ -3,10 +3,14 @@
 # by every process, and no process crashes.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
-dir=$(scratch)
+scratch
+# Job control gives the run its own process group, as a terminal would, so that the Ctrl-C below
+# reaches every process of the run (without it, bash starts background jobs ignoring SIGINT).
+set -m
 launch cartpole --out "$dir/run" --actors 2 --seed 3 --goal 1000000 --time-budget 120 \
   > "$dir/launch.log" 2>&1 &
 launch_pid=$!
+set +m
 wait_line "$dir/launch.log" "running; logs in" 60
 run="$dir/run"
 "$bin/inject" --run-id "$(run_setting "$run" run-id)" --lcm-url "$(run_setting "$run" lcm-url)" \
@@ -16,7 +20,7 @@ run="$dir/run"
 while read -r role pid; do
   kill -0 "$pid" 2>/dev/null || fail "$role (pid $pid) died"
 done < "$run/pids"
-kill -INT "$launch_pid"
+kill -INT -- "-$launch_pid"  # Ctrl-C: SIGINT to the run's process group
 set +e
 wait "$launch_pid"
 status=$?

@@ -3,7 +3,7 @@
 # over 100 greedy episodes (epsilon 0.05) reaches a mean of at least 475.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
-dir=$(scratch)
+scratch
 set +e
 launch cartpole --out "$dir/run" --actors 4 --seed 1 --time-budget 240 > "$dir/launch.log" 2>&1
 status=$?
@@ -12,9 +12,11 @@ cat "$dir/launch.log" | tail -20
 [ "$status" -eq 0 ] || fail "launch exited with $status"
 jsonl="$dir/run/eval.jsonl"
 [ -s "$jsonl" ] || fail "no eval.jsonl"
-best=$(grep -o '"mean":[-0-9.e+]*' "$jsonl" | cut -d: -f2 | sort -g | tail -1)
+best=$(best_mean "$jsonl")
+[ -n "$best" ] || fail "no evaluation in $jsonl"
 awk -v b="$best" 'BEGIN{exit !(b >= 475)}' || fail "best evaluation mean $best < 475"
-grep '"mean":'"$best" "$jsonl" | grep -q '"episodes":100' || fail "the best evaluation did not use 100 episodes"
+grep -E '"mean": *'"$best"'[,}]' "$jsonl" | grep -Eq '"episodes": *100[,}]' ||
+  fail "the best evaluation did not use 100 episodes"
 grep -q '<img' "$dir/run/report/index.html" || fail "the report has no learning curve"
 ls "$dir/run/checkpoints"/ckpt-*.bin >/dev/null || fail "no checkpoints"
 for role in replay learner evaluator actor-0; do

@@ -20,13 +20,24 @@ isolate() {
   fi
 }
 
-# A fresh scratch folder, removed on exit unless RL_KEEP is set.
+# Makes a fresh scratch folder $dir, removed on exit (after stopping any process of the test
+# still running) unless RL_KEEP is set.
 scratch() {
-  local d
-  d=$(mktemp -d "${TMPDIR:-/tmp}/rl-it-XXXXXX")
-  [ -n "${RL_KEEP:-}" ] || trap "rm -rf '$d'" EXIT
-  echo "$d"
+  dir=$(mktemp -d "${TMPDIR:-/tmp}/rl-it-XXXXXX")
+  trap 'cleanup' EXIT
 }
+cleanup() {
+  local pids
+  pids=$(jobs -p)
+  [ -z "$pids" ] || kill $pids 2>/dev/null || true
+  wait 2>/dev/null || true
+  # Whatever a launch left behind (it stops its processes itself; this is the safety net).
+  cat "$dir"/*/pids 2>/dev/null | awk '{print $2}' | xargs -r kill -KILL 2>/dev/null || true
+  [ -n "${RL_KEEP:-}" ] || rm -rf "$dir" 2>/dev/null || true
+}
+
+# The best evaluation mean in an eval.jsonl.
+best_mean() { grep -Eo '"mean": *[-0-9.e+]+' "$1" | grep -Eo '[-0-9.e+]+$' | sort -g | tail -1; }
 
 # Waits (bounded) until FILE has a line matching PATTERN.
 wait_line() {  # wait_line FILE PATTERN TIMEOUT_SECONDS

@@ -4,7 +4,7 @@
 # runs forced onto the same port do hear each other (their processes count foreign messages).
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
-dir=$(scratch)
+scratch
 
 pair() {  # pair NAME [extra launch options]: two concurrent runs; prints their monitors' last lines
   local name=$1

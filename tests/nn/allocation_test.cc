@@ -64,7 +64,7 @@ TEST(AllocationTest, DqnUpdateDoesNotAllocateOnceShapesAreStable) {
     grad_q.setZero();
     for (int j = 0; j < kBatch; ++j) grad_q(j % 2, j) = grad[j];
     online.ZeroGrad();
-    online.Backward(grad_q);
+    online.BackwardParams(grad_q);
     ClipGradNorm(params, 10.0f);
     adam.Step();
     target.SoftUpdateFrom(online, 0.005f);
@@ -73,6 +73,13 @@ TEST(AllocationTest, DqnUpdateDoesNotAllocateOnceShapesAreStable) {
   const int64_t before = AllocationCount();
   for (int i = 0; i < 10; ++i) update();
   EXPECT_EQ(AllocationCount() - before, 0);
+  // The full backward pass too.
+  online.Forward(obs);
+  online.Backward(grad_q);
+  const int64_t after_warmup = AllocationCount();
+  online.Forward(obs);
+  online.Backward(grad_q);
+  EXPECT_EQ(AllocationCount() - after_warmup, 0);
 }
 
 }  // namespace

@@ -235,9 +235,9 @@ TEST(SequentialTest, MlpGradientsThroughWeightedMseMatchFiniteDifferences) {
 // by one (clones are never fused) must give the same outputs and gradients.
 TEST(SequentialTest, FusedReluGivesTheSameResultsAsSeparateLayers) {
   std::mt19937 rng(21);
-  for (const std::string& arch : {std::string("linear(5,24),relu,linear(24,17),relu,linear(17,3)"),
+  for (const std::string& arch : {std::string("linear(5,40),relu,linear(40,33),relu,linear(33,3)"),
                                   std::string("relu,linear(5,9),relu,linear(9,4),relu")}) {
-    for (int batch : {1, 3, 16}) {
+    for (int batch : {1, 3, 16, 37}) {
       SCOPED_TRACE(arch + " batch " + std::to_string(batch));
       Sequential net = BuildFromArchitecture(arch, &rng);
       std::vector<std::unique_ptr<Layer>> layers;
@@ -262,6 +262,27 @@ TEST(SequentialTest, FusedReluGivesTheSameResultsAsSeparateLayers) {
       for (size_t i = 0; i < got.size(); ++i) {
         EXPECT_TRUE(got[i].grad->isApprox(*expected[i].grad, 1e-5f)) << got[i].name;
       }
+    }
+  }
+}
+
+TEST(SequentialTest, BackwardParamsAccumulatesTheSameGradientsAsBackward) {
+  std::mt19937 rng(8);
+  for (const std::string& arch : {std::string(kCartPoleArch), std::string("relu,linear(4,9)")}) {
+    SCOPED_TRACE(arch);
+    Sequential net = BuildFromArchitecture(arch, &rng);
+    Sequential copy = net;
+    const Matrix x = RandomMatrix(4, 32, &rng);
+    const Matrix grad_out = RandomMatrix(net.OutputSize(), 32, &rng);
+    net.Forward(x);
+    net.Backward(grad_out);
+    copy.Forward(x);
+    copy.BackwardParams(grad_out);
+    copy.BackwardParams(grad_out);
+    const std::vector<Param> expected = net.Params();
+    const std::vector<Param> got = copy.Params();
+    for (size_t i = 0; i < got.size(); ++i) {
+      EXPECT_TRUE(got[i].grad->isApprox(2 * *expected[i].grad, 1e-5f)) << got[i].name;
     }
   }
 }
