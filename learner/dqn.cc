@@ -94,7 +94,7 @@ UpdateResult Dqn::Update(const BatchView& b) {
   grad_q_.setZero(num_actions_, n);
   for (int i = 0; i < n; ++i) grad_q_(b.action[i], i) = loss_grad_[i];
   online_.ZeroGrad();
-  online_.Backward(grad_q_);
+  online_.BackwardParams(grad_q_);  // parameter gradients only: no input gradient needed
   if (config_.max_grad_norm > 0) {
     result.grad_norm = nn::ClipGradNorm(params_, config_.max_grad_norm);
   }
