@@ -49,6 +49,7 @@ Actor::Actor(ActorConfig config, Bus* bus)
   }
   random_action_ = std::uniform_int_distribution<int>(0, num_actions_ - 1);
   epsilon_ = config_.exploration.Epsilon(config_.actor_id, config_.num_actors, 0);
+  annealed_ = config_.exploration.mode == "linear";
   batch_.actor_id = config_.actor_id;
   batch_.obs_size = obs_size_;
 
@@ -132,7 +133,9 @@ int Actor::StepEnvs() {
     }
   }
   env_steps_ += static_cast<int64_t>(slots_.size());
-  epsilon_ = config_.exploration.Epsilon(config_.actor_id, config_.num_actors, env_steps_);
+  if (annealed_) {
+    epsilon_ = config_.exploration.Epsilon(config_.actor_id, config_.num_actors, env_steps_);
+  }
   return static_cast<int>(slots_.size());
 }
 

@@ -98,6 +98,7 @@ class Actor {
 
   bool insert_allowed_ = true;
   double epsilon_ = 1.0;
+  bool annealed_ = false;  // epsilon changes with the step count (linear mode)
   int64_t env_steps_ = 0;
   int64_t episodes_ = 0;
   int64_t published_ = 0;

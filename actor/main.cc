@@ -57,8 +57,9 @@ int Main(int argc, char** argv) {
   std::printf("actor-%d: ready (epsilon %.5f)\n", c.actor_id, actor.epsilon());
   std::fflush(stdout);
   actor.Run();
-  std::printf("actor-%d: stopped after %lld steps, %lld episodes\n", c.actor_id,
-              static_cast<long long>(actor.env_steps()), static_cast<long long>(actor.episodes()));
+  std::printf("actor-%d: stopped after %lld steps, %lld episodes, weights %lld\n", c.actor_id,
+              static_cast<long long>(actor.env_steps()), static_cast<long long>(actor.episodes()),
+              static_cast<long long>(actor.weights_version()));
   return 0;
 }
 

@@ -1,5 +1,6 @@
 #include "actor/nstep.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -11,6 +12,8 @@ NStepAccumulator::NStepAccumulator(int n, double gamma, int obs_size)
   if (!(gamma >= 0.0 && gamma <= 1.0)) throw std::invalid_argument("gamma must be in [0, 1]");
   if (obs_size < 1) throw std::invalid_argument("observation size must be >= 1");
   next_obs_.resize(static_cast<size_t>(obs_size));
+  steps_.resize(static_cast<size_t>(n));
+  for (Pending& p : steps_) p.obs.resize(static_cast<size_t>(obs_size));
 }
 
 void NStepAccumulator::Add(std::span<const float> obs, int action, double reward,
@@ -19,13 +22,16 @@ void NStepAccumulator::Add(std::span<const float> obs, int action, double reward
   if (static_cast<int>(obs.size()) != obs_size_ || static_cast<int>(next_obs.size()) != obs_size_) {
     throw std::invalid_argument("observation size differs from the accumulator's");
   }
-  steps_.push_back(Pending{std::vector<float>(obs.begin(), obs.end()), action, reward});
-  next_obs_.assign(next_obs.begin(), next_obs.end());
+  Pending& p = At(count_++);
+  std::copy(obs.begin(), obs.end(), p.obs.begin());
+  p.action = action;
+  p.reward = reward;
+  std::copy(next_obs.begin(), next_obs.end(), next_obs_.begin());
   if (terminated) {
-    while (!steps_.empty()) EmitOldest(/*bootstrap=*/false, sink);
+    while (count_ > 0) EmitOldest(/*bootstrap=*/false, sink);
   } else if (truncated) {
-    while (!steps_.empty()) EmitOldest(/*bootstrap=*/true, sink);
-  } else if (static_cast<int>(steps_.size()) == n_) {
+    while (count_ > 0) EmitOldest(/*bootstrap=*/true, sink);
+  } else if (count_ == n_) {
     EmitOldest(/*bootstrap=*/true, sink);
   }
 }
@@ -33,19 +39,20 @@ void NStepAccumulator::Add(std::span<const float> obs, int action, double reward
 void NStepAccumulator::EmitOldest(bool bootstrap, const Sink& sink) {
   double ret = 0.0;
   double scale = 1.0;
-  for (const Pending& p : steps_) {
-    ret += scale * p.reward;
+  for (int k = 0; k < count_; ++k) {
+    ret += scale * At(k).reward;
     scale *= gamma_;
   }
   // scale is now gamma^k with k the number of pending steps.
   Transition t;
-  t.obs = steps_.front().obs;
-  t.action = steps_.front().action;
+  t.obs = At(0).obs;
+  t.action = At(0).action;
   t.reward = static_cast<float>(ret);
   t.discount = bootstrap ? static_cast<float>(scale) : 0.0f;
   t.next_obs = next_obs_;
   sink(t);
-  steps_.pop_front();
+  head_ = (head_ + 1) % n_;
+  --count_;
 }
 
 }  // namespace rl::actor

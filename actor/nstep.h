@@ -7,7 +7,6 @@
 // observation. With n = 1 this is the one-step transition of DQN.
 #pragma once
 
-#include <deque>
 #include <functional>
 #include <span>
 #include <vector>
@@ -34,14 +33,16 @@ class NStepAccumulator {
            bool terminated, bool truncated, const Sink& sink);
 
   // Steps waiting for their n-step return.
-  int pending() const { return static_cast<int>(steps_.size()); }
+  int pending() const { return count_; }
 
  private:
+  // A ring of n preallocated steps, so that stepping allocates nothing.
   struct Pending {
     std::vector<float> obs;
-    int action;
-    double reward;
+    int action = 0;
+    double reward = 0;
   };
+  Pending& At(int k) { return steps_[static_cast<size_t>((head_ + k) % n_)]; }
   // Emits the oldest pending step with the return of all pending steps; `bootstrap` says
   // whether the last observation is bootstrapped from (discount gamma^k) or not (0).
   void EmitOldest(bool bootstrap, const Sink& sink);
@@ -49,7 +50,9 @@ class NStepAccumulator {
   int n_;
   double gamma_;
   int obs_size_;
-  std::deque<Pending> steps_;
+  std::vector<Pending> steps_;
+  int head_ = 0;   // oldest pending step
+  int count_ = 0;  // pending steps
   std::vector<float> next_obs_;
 };
 

@@ -7,6 +7,7 @@
 
 #include "common/check.h"
 #include "nn/gemm.h"
+#include "nn/gemv.h"
 #include "nn/init.h"
 
 namespace rl::nn {
@@ -45,7 +46,10 @@ const Matrix& Linear::Forward(const Matrix& x) {
   const auto out = static_cast<int>(weight_.rows());
   const auto batch = static_cast<int>(x.cols());
   output_.resize(out, batch);
-  if (internal::PreferGemm(out, batch, static_cast<int>(weight_.cols()))) {
+  if (batch == 1) {
+    internal::Gemv(weight_.data(), out, static_cast<int>(weight_.cols()), x.data(), bias_.data(),
+                   fused_output_relu_, output_.data());
+  } else if (internal::PreferGemm(out, batch, static_cast<int>(weight_.cols()))) {
     internal::Epilogue epilogue;
     epilogue.row_bias = bias_.data();
     epilogue.relu = fused_output_relu_;
