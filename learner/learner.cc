@@ -28,6 +28,7 @@ void LearnerConfig::Validate() const {
   if (!(request_timeout > 0)) throw std::invalid_argument("request-timeout must be > 0");
   if (weights_every < 1) throw std::invalid_argument("weights-every must be >= 1");
   if (checkpoint_every < 1) throw std::invalid_argument("checkpoint-every must be >= 1");
+  if (keep_checkpoints < 0) throw std::invalid_argument("keep-checkpoints must be >= 0");
   if (!(stats_hz > 0)) throw std::invalid_argument("stats-hz must be > 0");
 }
 
@@ -111,6 +112,14 @@ std::string Learner::Checkpoint() {
   ckpt.meta.note = config_.env_id;
   dqn_.online().GetFlat(&ckpt.params);
   nn::SaveCheckpoint(path, ckpt);
+  // Keep the newest keep_checkpoints files; older ones have been scored or skipped by now.
+  if (written_.empty() || written_.back() != path) written_.push_back(path);
+  while (config_.keep_checkpoints > 0 &&
+         static_cast<int>(written_.size()) > config_.keep_checkpoints) {
+    std::error_code ignored;
+    std::filesystem::remove(written_.front(), ignored);
+    written_.pop_front();
+  }
 
   rlmsg::checkpoint_t announce{};
   announce.path = path;

@@ -26,6 +26,7 @@ struct LearnerConfig {
   double request_timeout = 2.0;        // seconds before a request is sent again
   int weights_every = 100;             // updates between weight broadcasts
   int checkpoint_every = 1000;         // updates between checkpoints
+  int keep_checkpoints = 0;            // newest checkpoint files kept on disk (0: all)
   std::string out_dir = ".";           // checkpoints go to <out_dir>/checkpoints/
   int64_t max_updates = 0;             // stop after this many updates (0: until stopped)
   double stats_hz = 4.0;               // stats messages per second
@@ -74,6 +75,7 @@ class Learner {
   int64_t request_timeouts_ = 0;
   int64_t stale_replies_ = 0;
   std::vector<float> flat_;
+  std::deque<std::string> written_;  // checkpoint files on disk, oldest first
 
   // Stats since the last stats message.
   double loss_sum_ = 0, q_sum_ = 0;

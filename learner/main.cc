@@ -66,6 +66,8 @@ int Main(int argc, char** argv) {
        "updates between weight broadcasts")  //
       ("checkpoint-every", rl::po::value(&c.checkpoint_every)->default_value(c.checkpoint_every),
        "updates between checkpoints")  //
+      ("keep-checkpoints", rl::po::value(&c.keep_checkpoints)->default_value(c.keep_checkpoints),
+       "newest checkpoint files kept on disk (0: all)")  //
       ("max-updates", rl::po::value(&c.max_updates)->default_value(c.max_updates),
        "stop after this many updates (0: until stopped)")  //
       ("stats-hz", rl::po::value(&c.stats_hz)->default_value(c.stats_hz),

@@ -1,5 +1,6 @@
 #include "learner/learner.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 #include <set>
@@ -125,6 +126,24 @@ TEST_F(LearnerTest, TrainsBroadcastsWeightsAndWritesLoadableCheckpoints) {
   std::vector<float> flat;
   learner.dqn().online().GetFlat(&flat);
   EXPECT_EQ(nn::LoadCheckpoint(announced_.back()).params, flat);
+}
+
+TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFiles) {
+  LearnerConfig c;
+  c.batch_size = 8;
+  c.max_updates = 50;
+  c.checkpoint_every = 10;
+  c.keep_checkpoints = 2;
+  c.request_timeout = 0.05;
+  c.out_dir = dir_.string();
+  Learner learner(c, bus_.get());
+  learner.Run();
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir_ / "checkpoints")) {
+    left.push_back(e.path().filename().string());
+  }
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"ckpt-000000040.bin", "ckpt-000000050.bin"}));
 }
 
 TEST(LearnerConfigTest, RefusesBadSettings) {
