@@ -9,16 +9,10 @@
 
 #include "common/check.h"
 #include "envs/raster.h"
+#include "envs/rng.h"
 
 namespace rl::envs {
 namespace {
-
-// Draws a double uniform in [low, high) from 53 random bits, as numpy's Generator.uniform does:
-// low + (high - low) * u with u = (bits >> 11) * 2^-53.
-double Uniform(std::mt19937_64& rng, double low, double high) {
-  const double u = static_cast<double>(rng() >> 11) * 0x1.0p-53;
-  return low + (high - low) * u;
-}
 
 // Drawing geometry of the reference, in pixels of the 600x400 surface before its vertical flip
 // (so y grows upwards from the bottom edge).
@@ -57,24 +51,21 @@ CartPole::CartPole(const CartPoleConfig& config)
 }
 
 void CartPole::Reset(uint64_t seed) {
-  std::seed_seq seq{static_cast<uint32_t>(seed), static_cast<uint32_t>(seed >> 32)};
-  rng_.seed(seq);
+  SeedRng(seed, rng_);
   rng_seeded_ = true;
   SampleInitialState();
 }
 
 void CartPole::Reset() {
   if (!rng_seeded_) {
-    std::random_device device;
-    std::seed_seq seq{device(), device(), device(), device()};
-    rng_.seed(seq);
+    SeedRngRandomly(rng_);
     rng_seeded_ = true;
   }
   SampleInitialState();
 }
 
 void CartPole::SampleInitialState() {
-  for (double& v : state_) v = Uniform(rng_, config_.reset_low, config_.reset_high);
+  for (double& v : state_) v = UniformDouble(rng_, config_.reset_low, config_.reset_high);
   steps_beyond_terminated_.reset();
   has_state_ = true;
   UpdateObservation();

@@ -8,6 +8,10 @@
 
 namespace rl::envs {
 
+StepResult Env::StepContinuous(std::span<const float> /*action*/) {
+  throw std::logic_error("discrete env");
+}
+
 void Env::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
   RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
   if (width <= 0 || height <= 0) {

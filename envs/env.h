@@ -18,13 +18,18 @@ struct StepResult {
   bool truncated = false;
 };
 
-/// Static description of an environment (shapes and registration data).
+/// Static description of an environment (shapes and registration data). An env is either
+/// discrete (num_actions > 0, action_dim == 0; use Step) or continuous (num_actions == 0,
+/// action_dim > 0; use StepContinuous).
 struct EnvSpec {
   std::string id;           // Registered id, e.g. "CartPole-v1".
   int observation_size;     // Number of float32 values in observation().
-  int num_actions;          // Discrete actions are 0 .. num_actions - 1.
+  int num_actions;          // Discrete actions are 0 .. num_actions - 1; 0 for continuous envs.
   int max_episode_steps;    // Time limit applied by the registry (TimeLimit).
   double reward_threshold;  // Average return at which the task counts as solved.
+  int action_dim = 0;       // Size of a continuous action vector; 0 for discrete envs.
+  float action_low = 0;     // Bounds of every component of a continuous action (a box); the env
+  float action_high = 0;    // clips values outside them. Both 0 for discrete envs.
 };
 
 /// One environment instance. Not thread-safe: an instance is used by one thread at a time. Each
@@ -43,9 +48,14 @@ class Env {
   /// seed after a seeded one). Before any seeded Reset, the RNG is seeded from std::random_device.
   virtual void Reset() = 0;
 
-  /// Advances one step. Throws std::invalid_argument for an action outside [0, num_actions), and
-  /// std::logic_error if Reset was never called.
+  /// Advances one step of a discrete env. Throws std::invalid_argument for an action outside
+  /// [0, num_actions), and std::logic_error if Reset was never called or the env is continuous.
   virtual StepResult Step(int action) = 0;
+
+  /// Advances one step of a continuous env with an action of spec().action_dim floats. Throws
+  /// std::invalid_argument for an action of the wrong size, std::logic_error if Reset was never
+  /// called. The default (for discrete envs) throws std::logic_error("discrete env").
+  virtual StepResult StepContinuous(std::span<const float> action);
 
   /// Current observation (observation_size float32 values). Valid until the next Reset or Step.
   virtual std::span<const float> observation() const = 0;

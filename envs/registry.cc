@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "envs/box2d/lunar_lander.h"
 #include "envs/cartpole.h"
 #include "envs/time_limit.h"
 
@@ -21,6 +22,15 @@ constexpr std::array kRegistrations = {
     Registration{"CartPole-v1",
                  []() -> std::unique_ptr<Env> {
                    return std::make_unique<TimeLimit>(std::make_unique<CartPole>(), 500);
+                 }},
+    Registration{"LunarLander-v3",
+                 []() -> std::unique_ptr<Env> {
+                   return std::make_unique<TimeLimit>(std::make_unique<LunarLander>(), 1000);
+                 }},
+    Registration{"LunarLanderContinuous-v3",
+                 []() -> std::unique_ptr<Env> {
+                   return std::make_unique<TimeLimit>(
+                       std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true}), 1000);
                  }},
 };
 

@@ -10,7 +10,9 @@
 namespace rl::envs {
 
 /// Creates a fresh, not yet reset env for a registered id. "CartPole-v1" gives
-/// TimeLimit(CartPole, 500). Throws std::invalid_argument naming the known ids for an unknown id.
+/// TimeLimit(CartPole, 500); "LunarLander-v3" and "LunarLanderContinuous-v3" give
+/// TimeLimit(LunarLander, 1000). Throws std::invalid_argument naming the known ids for an unknown
+/// id.
 std::unique_ptr<Env> MakeEnv(const std::string& id);
 
 /// The registered ids, sorted.

@@ -26,8 +26,13 @@ void TimeLimit::Reset() {
   elapsed_steps_ = 0;
 }
 
-StepResult TimeLimit::Step(int action) {
-  StepResult result = env_->Step(action);
+StepResult TimeLimit::Step(int action) { return Count(env_->Step(action)); }
+
+StepResult TimeLimit::StepContinuous(std::span<const float> action) {
+  return Count(env_->StepContinuous(action));
+}
+
+StepResult TimeLimit::Count(StepResult result) {
   ++elapsed_steps_;
   if (elapsed_steps_ >= spec_.max_episode_steps) result.truncated = true;
   return result;

@@ -29,6 +29,8 @@ class TimeLimit : public Env {
   void Reset() override;
   /// Steps the wrapped env; if it throws, the step counter is unchanged.
   StepResult Step(int action) override;
+  /// The same for continuous actions (forwarded to the wrapped env's StepContinuous).
+  StepResult StepContinuous(std::span<const float> action) override;
 
   std::span<const float> observation() const override { return env_->observation(); }
   void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override;
@@ -43,6 +45,9 @@ class TimeLimit : public Env {
   const Env& wrapped_env() const { return *env_; }
 
  private:
+  // Counts a step the wrapped env completed and sets truncated at the limit.
+  StepResult Count(StepResult result);
+
   std::unique_ptr<Env> env_;
   EnvSpec spec_;
   int64_t elapsed_steps_ = 0;

@@ -91,8 +91,8 @@ fi
 import json, statistics, sys
 ours = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
 peer = [json.loads(l) for l in open(sys.argv[2]) if l.strip().startswith("{")]
-def peer_rates(pred):
-    return [p["rate"] for p in peer if pred(p)]
+def peer_lines(pred):
+    return [p for p in peer if "rate" in p and pred(p)]
 match = {
     "cartpole_env_steps": (lambda o: lambda p: p["bench"] == "env_steps", "higher"),
     "actor_steps": (lambda o: lambda p: p["bench"] == "actor_steps" and p.get("threads") == 1, "higher"),
@@ -103,10 +103,13 @@ match = {
 for o in ours:
     m = match.get(o["bench"])
     if m:
-        rates = peer_rates(m[0](o))
-        if rates:
-            p = statistics.median(rates)
+        lines = peer_lines(m[0](o))
+        if lines:
+            p = statistics.median([l["rate"] for l in lines])
             o["peer"] = round(p, 3)
+            o["peer_repeats"] = len(lines)
+            if lines[0].get("blas"):
+                o["peer_blas"] = lines[0]["blas"]
             o["ratio"] = round(o["value"] / p if m[1] == "higher" else p / o["value"], 2)
             if o["bench"] == "cartpole_time_to_goal":
                 o["peer_note"] = "wall time of the peer's full 500,000-step CleanRL DQN run"

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <span>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -56,6 +57,19 @@ TEST(EnvTest, DefaultRenderSizedRejectsEmptySizes) {
   std::vector<uint8_t> rgb;
   EXPECT_THROW(env.RenderSized(0, 1, &rgb), std::invalid_argument);
   EXPECT_THROW(env.RenderSized(3, -1, &rgb), std::invalid_argument);
+}
+
+TEST(EnvTest, DiscreteSpecsHaveNoContinuousActionsAndStepContinuousThrows) {
+  TwoToneEnv env;
+  EXPECT_EQ(env.spec().action_dim, 0);
+  EXPECT_EQ(env.spec().action_low, 0.0f);
+  EXPECT_EQ(env.spec().action_high, 0.0f);
+  try {
+    env.StepContinuous(std::array<float, 2>{0, 0});
+    FAIL() << "expected std::logic_error";
+  } catch (const std::logic_error& e) {
+    EXPECT_EQ(std::string(e.what()), "discrete env");
+  }
 }
 
 }  // namespace

@@ -129,6 +129,66 @@ TEST(TimeLimitTest, InvalidActionThrowsWithoutCountingAStep) {
   EXPECT_EQ(env.elapsed_steps(), 0);
 }
 
+// A continuous scripted env: one float action, which must be finite; never terminates.
+class ScriptedContinuousEnv : public Env {
+ public:
+  const EnvSpec& spec() const override { return spec_; }
+  void Reset(uint64_t) override {}
+  void Reset() override {}
+  StepResult Step(int) override { throw std::logic_error("continuous env"); }
+  StepResult StepContinuous(std::span<const float> action) override {
+    if (action.size() != 1) throw std::invalid_argument("ScriptedContinuousEnv: one value");
+    last_action = action[0];
+    return StepResult{.reward = action[0]};
+  }
+  std::span<const float> observation() const override { return observation_; }
+  void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override {
+    rgb->assign(3, 0);
+    *width = 1;
+    *height = 1;
+  }
+
+  float last_action = 0;
+
+ private:
+  EnvSpec spec_{.id = "ScriptedContinuous-v0",
+                .observation_size = 1,
+                .num_actions = 0,
+                .max_episode_steps = 1000,
+                .reward_threshold = 0,
+                .action_dim = 1,
+                .action_low = -2,
+                .action_high = 2};
+  std::array<float, 1> observation_{};
+};
+
+TEST(TimeLimitTest, ForwardsContinuousStepsAndCountsThem) {
+  auto inner = std::make_unique<ScriptedContinuousEnv>();
+  ScriptedContinuousEnv* scripted = inner.get();
+  TimeLimit env(std::move(inner), 2);
+  EXPECT_EQ(env.spec().action_dim, 1);
+  EXPECT_EQ(env.spec().action_low, -2.0f);
+  EXPECT_EQ(env.spec().action_high, 2.0f);
+  env.Reset(0);
+  const StepResult first = env.StepContinuous(std::array<float, 1>{1.5f});
+  EXPECT_EQ(first.reward, 1.5);
+  EXPECT_EQ(scripted->last_action, 1.5f);
+  EXPECT_FALSE(first.truncated);
+  // A rejected action is not counted.
+  EXPECT_THROW(env.StepContinuous(std::array<float, 2>{0, 0}), std::invalid_argument);
+  EXPECT_THROW(env.Step(0), std::logic_error);
+  EXPECT_EQ(env.elapsed_steps(), 1);
+  EXPECT_TRUE(env.StepContinuous(std::array<float, 1>{0}).truncated);
+  EXPECT_EQ(env.elapsed_steps(), 2);
+}
+
+TEST(TimeLimitTest, ContinuousStepOnADiscreteEnvThrowsWithoutCounting) {
+  TimeLimit env(std::make_unique<ScriptedEnv>(0), 3);
+  env.Reset(0);
+  EXPECT_THROW(env.StepContinuous(std::array<float, 1>{0}), std::logic_error);
+  EXPECT_EQ(env.elapsed_steps(), 0);
+}
+
 TEST(TimeLimitTest, RejectsANullEnvAndANonPositiveLimit) {
   EXPECT_THROW(TimeLimit(nullptr, 10), std::invalid_argument);
   EXPECT_THROW(TimeLimit(std::make_unique<ScriptedEnv>(0), 0), std::invalid_argument);
