@@ -40,6 +40,10 @@ Actor::Actor(ActorConfig config, Bus* bus)
   config_.Validate();
   for (int j = 0; j < config_.envs_per_actor; ++j) {
     auto env = envs::MakeEnv(config_.env_id);
+    if (env->spec().action_dim > 0 || env->spec().num_actions < 1) {
+      throw std::invalid_argument(config_.env_id +
+                                  " has continuous actions; the DQN actor needs discrete ones");
+    }
     obs_size_ = env->spec().observation_size;
     num_actions_ = env->spec().num_actions;
     env->Reset(TrainingSeed(config_.seed, config_.actor_id, j));

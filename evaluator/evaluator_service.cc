@@ -1,5 +1,7 @@
 #include "evaluator/evaluator_service.h"
 
+#include "evaluator/video.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdarg>
@@ -49,8 +51,8 @@ void EvaluatorConfig::Validate() const {
   if (std::isinf(goal)) throw std::invalid_argument("goal must be finite");
 }
 
-EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
-                               double epsilon, uint64_t first_seed) {
+nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env_id,
+                                 nn::CheckpointMeta* meta) {
   // Load and build; every failure is a refusal with a reason.
   nn::Checkpoint ckpt = nn::LoadCheckpoint(path);
   std::mt19937 init_rng(0);  // the initial weights are overwritten by the checkpoint's
@@ -70,15 +72,23 @@ EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_i
   const std::string misfit =
       CheckNetworkFitsEnv(net.InputSize(), net.OutputSize(), envs::MakeEnv(env_id)->spec());
   if (!misfit.empty()) throw std::runtime_error("checkpoint " + path + ": " + misfit);
+  if (meta != nullptr) *meta = ckpt.meta;
+  return net;
+}
+
+EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
+                               double epsilon, uint64_t first_seed) {
+  nn::CheckpointMeta meta;
+  nn::Sequential net = LoadPolicyNetwork(path, env_id, &meta);
 
   // Score.
   const double start = MonoSeconds();
   const EvalScore score = ScorePolicy(&net, env_id, episodes, epsilon, first_seed);
   EvalRecord r;
   r.checkpoint = FileName(path);
-  r.update = ckpt.meta.update;
-  r.env_steps = ckpt.meta.env_steps;
-  r.wall_seconds = ckpt.meta.wall_seconds;
+  r.update = meta.update;
+  r.env_steps = meta.env_steps;
+  r.wall_seconds = meta.wall_seconds;
   r.mean = score.mean;
   r.std = score.std;
   r.min = score.min;
@@ -217,6 +227,9 @@ bool EvaluatorService::ScorePending() {
   last_mean_ = record.mean;
   records_.push_back(record);
   scored_keys_.insert({record.checkpoint, record.update});
+  if (config_.videos && !report_dir_.empty() && record.mean > best_video_mean_) {
+    RecordVideo(announced.path, record);
+  }
 
   // Persist: the line first (the history), then the report.
   if (!jsonl_path_.empty()) {
@@ -251,6 +264,26 @@ bool EvaluatorService::ScorePending() {
   return reached;
 }
 
+void EvaluatorService::RecordVideo(const std::string& path, const EvalRecord& record) {
+  try {
+    nn::Sequential net = LoadPolicyNetwork(path, config_.env_id);
+    const VideoResult v = RecordGreedyVideo(
+        &net, config_.env_id, config_.seed_base, config_.video_width, config_.video_height,
+        config_.video_fps, (std::filesystem::path(report_dir_) / kBestVideo).string());
+    best_video_mean_ = record.mean;
+    char caption[256];
+    std::snprintf(caption, sizeof(caption),
+                  "Greedy episode (epsilon 0, seed %llu) of the best checkpoint, %s (update %lld, "
+                  "evaluation mean %.1f): return %.1f over %d frames.",
+                  static_cast<unsigned long long>(config_.seed_base), record.checkpoint.c_str(),
+                  static_cast<long long>(record.update), record.mean, v.episode_return, v.frames);
+    video_caption_ = caption;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "evaluator: no video: %s\n", e.what());
+    std::fflush(stderr);
+  }
+}
+
 void EvaluatorService::WriteReportNow() {
   if (report_dir_.empty()) return;
   ReportInfo info;
@@ -258,6 +291,10 @@ void EvaluatorService::WriteReportNow() {
   info.run_name = run_name_;
   info.run_id = bus_->config().run_id;
   info.goal = goal_;
+  if (!video_caption_.empty()) {
+    info.video_file = kBestVideo;
+    info.video_caption = video_caption_;
+  }
   info.run_config = config_.run_config_text;
   info.eval_settings = eval_settings_;
   info.checkpoints_skipped = skipped_;

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <set>
@@ -24,6 +25,8 @@
 #include "common/lcm_bus.h"
 #include "evaluator/report.h"
 #include "evaluator/scorer.h"
+#include "nn/checkpoint.h"
+#include "nn/sequential.h"
 #include "rlmsg/checkpoint_t.hpp"
 
 namespace rl::evaluator {
@@ -40,10 +43,19 @@ struct EvaluatorConfig {
   std::string run_config_text;        // shown in the report
   std::string run_name;               // shown in the report's title; empty: out_dir's folder name
   double stats_period_seconds = 0.3;  // stats_evaluator_t period (about 3 Hz)
+  bool videos = false;    // record a greedy episode of every new best checkpoint (report/)
+  int video_width = 360;  // video frame size in pixels
+  int video_height = 240;
+  double video_fps = 30;  // frames per second of the videos
 
   /// Throws std::invalid_argument saying what is wrong.
   void Validate() const;
 };
+
+/// Loads a checkpoint file and builds its network; fills *meta when not null. Throws
+/// std::runtime_error with the reason when the file is refused (see ScoreCheckpointFile).
+nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env_id,
+                                 nn::CheckpointMeta* meta = nullptr);
 
 /// Loads a checkpoint file, builds its network and scores it on `env_id` (see ScorePolicy).
 /// The record's update, env_steps and wall_seconds come from the file's metadata. Throws
@@ -82,6 +94,8 @@ class EvaluatorService {
 
   /// Rewrites out_dir/report/ (no-op without out_dir). Logs, never throws.
   void WriteReportNow();
+  /// Records report/best.webm, a greedy episode of the checkpoint at `path`.
+  void RecordVideo(const std::string& path, const EvalRecord& record);
 
   /// Publishes stats_evaluator_t now.
   void PublishStats();
@@ -123,6 +137,8 @@ class EvaluatorService {
   int64_t scored_ = 0;
   int64_t skipped_ = 0;
   int64_t refused_ = 0;
+  double best_video_mean_ = -std::numeric_limits<double>::infinity();
+  std::string video_caption_;  // empty until a video was recorded
   int64_t duplicates_ = 0;
   double last_mean_ = 0;
   bool busy_ = false;

@@ -68,6 +68,14 @@ int Main(int argc, char** argv) {
        "CartPole-v1)")  //
       ("stop-at-goal", rl::po::bool_switch(&config.stop_at_goal),
        "exit (status 0) right after a checkpoint reaches the goal")  //
+      ("videos", rl::po::value(&config.videos)->default_value(config.videos),
+       "record a greedy episode of every new best checkpoint as report/best.webm (1/0)")  //
+      ("video-width", rl::po::value(&config.video_width)->default_value(config.video_width),
+       "video frame width in pixels")  //
+      ("video-height", rl::po::value(&config.video_height)->default_value(config.video_height),
+       "video frame height in pixels")  //
+      ("video-fps", rl::po::value(&config.video_fps)->default_value(config.video_fps),
+       "video frames per second")  //
       ("run-config", rl::po::value(&run_config_file),
        "text file shown in the report as the run's config (default: the --config file)");
 

@@ -359,6 +359,13 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
        "time\" width=\"720\" height=\"380\"></figure>\n";
   h += "</section>\n";
 
+  // The greedy policy at work.
+  if (!info.video_file.empty()) {
+    h += "<section>\n<h2>Greedy policy</h2>\n<figure><video src=\"" + HtmlEscape(info.video_file) +
+         "\" controls autoplay loop muted playsinline width=\"480\"></video><figcaption>" +
+         HtmlEscape(info.video_caption) + "</figcaption></figure>\n</section>\n";
+  }
+
   // Table of every checkpoint, newest first.
   h += "<section>\n<h2>Checkpoints</h2>\n";
   if (records.empty()) {

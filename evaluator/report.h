@@ -54,12 +54,15 @@ struct ReportInfo {
   std::string eval_settings;  // one line on how checkpoints were scored (episodes, epsilon, seeds)
   int64_t checkpoints_skipped = 0;  // announced but superseded before scoring
   int64_t checkpoints_refused = 0;  // files that failed to load or did not fit the env
+  std::string video_file;           // a video in the report folder to show (empty: none)
+  std::string video_caption;        // what the video shows
 };
 
 /// Names of the files WriteReport writes into `dir`.
 inline constexpr char kReportIndex[] = "index.html";
 inline constexpr char kCurveEnvSteps[] = "curve_env_steps.svg";
 inline constexpr char kCurveWallTime[] = "curve_wall_time.svg";
+inline constexpr char kBestVideo[] = "best.webm";
 
 /// Writes dir/index.html, dir/curve_env_steps.svg and dir/curve_wall_time.svg (creating dir if
 /// needed). Each file is written to a temporary file in dir, synced and renamed over the old

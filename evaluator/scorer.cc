@@ -69,6 +69,9 @@ EvalScore ScoreGreedyPolicy(const GreedyPolicy& greedy, const std::string& env_i
 }
 
 std::string CheckNetworkFitsEnv(int input_size, int output_size, const envs::EnvSpec& spec) {
+  if (spec.action_dim > 0) {
+    return spec.id + " has continuous actions; a Q-network scores discrete ones only";
+  }
   std::string why;
   if (input_size != spec.observation_size) {
     why = "network input size " + std::to_string(input_size) + " does not match " + spec.id +

@@ -124,6 +124,24 @@ TEST_F(ActorTest, PublishesStatsWithItsCounters) {
   EXPECT_DOUBLE_EQ(stats[0].epsilon, 0.4);
 }
 
+TEST_F(ActorTest, RefusesAnEnvWithContinuousActions) {
+  config_.env_id = "LunarLanderContinuous-v3";
+  EXPECT_THROW(Actor(config_, &bus_), std::invalid_argument);
+}
+
+TEST_F(ActorTest, ActsInLunarLanderWithItsEightObservationsAndFourActions) {
+  config_.env_id = "LunarLander-v3";
+  Actor actor(config_, &bus_);
+  for (int i = 0; i < 64; ++i) actor.StepEnvs();
+  bus_.Handle(0);
+  ASSERT_FALSE(batches_.empty());
+  EXPECT_EQ(batches_[0].obs_size, 8);
+  for (int32_t a : batches_[0].action) {
+    EXPECT_GE(a, 0);
+    EXPECT_LT(a, 4);
+  }
+}
+
 TEST(ActorConfigTest, RefusesAnActorIdOutsideTheRun) {
   ActorConfig c;
   c.num_actors = 2;

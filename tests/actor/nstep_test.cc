@@ -17,7 +17,7 @@ struct Out {
 
 // Feeds steps with observation [t] -> [t+1] and reward rewards[t]; returns what was emitted.
 std::vector<Out> Feed(int n, double gamma, const std::vector<double>& rewards, bool terminate,
-                     bool truncate) {
+                      bool truncate) {
   NStepAccumulator acc(n, gamma, 1);
   std::vector<Out> out;
   auto sink = [&out](const Transition& t) {

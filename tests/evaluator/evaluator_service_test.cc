@@ -72,7 +72,7 @@ class EvaluatorServiceTest : public ::testing::Test {
   }
 
   void Announce(const std::string& path, int64_t update) {
-    rlmsg::checkpoint_t m;
+    rlmsg::checkpoint_t m{};
     m.path = path;
     m.update = update;
     m.env_steps = update * 4;
@@ -138,6 +138,27 @@ TEST_F(EvaluatorServiceTest, ScoresAnAnnouncedCheckpointAndPublishesTheResult) {
   EXPECT_DOUBLE_EQ(stats_.back().best_mean, r.mean);
   EXPECT_DOUBLE_EQ(stats_.back().last_mean, r.mean);
   EXPECT_EQ(service.FinalLine().rfind("evaluator: goal not reached (best ", 0), 0U);
+}
+
+TEST_F(EvaluatorServiceTest, RecordsAVideoOfEachNewBestCheckpointAndShowsItInTheReport) {
+  EvaluatorConfig c = Config();
+  c.videos = true;
+  c.video_width = 96;
+  c.video_height = 64;
+  EvaluatorService service(c, &bus_, nullptr);
+  Announce(WriteCheckpoint(100), 100);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  const std::string video = service.report_dir() + "/best.webm";
+  ASSERT_TRUE(std::filesystem::exists(video));
+  EXPECT_GT(std::filesystem::file_size(video), 100U);
+  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  EXPECT_NE(html.find("<video src=\"best.webm\""), std::string::npos);
+  EXPECT_NE(html.find("ckpt_100.bin (update 100"), std::string::npos);
+  // The same policy scores the same: no new best, so the video stays that of update 100.
+  Announce(WriteCheckpoint(200), 200);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 2; }));
+  EXPECT_NE(ReadFile(service.report_dir() + "/index.html").find("ckpt_100.bin (update 100"),
+            std::string::npos);
 }
 
 TEST_F(EvaluatorServiceTest, RefusesACorruptedCheckpointAndStillScoresTheNextGoodOne) {
@@ -240,7 +261,7 @@ TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsTheHistoryAndIgnoresRepeats) 
   ASSERT_NE(second.best(), nullptr);
 
   // Announcing the scored checkpoint again changes nothing.
-  rlmsg::checkpoint_t m;
+  rlmsg::checkpoint_t m{};
   m.path = path;
   m.update = 40;
   ASSERT_TRUE(bus2.Publish(channels::kCheckpoint, &m));

@@ -1,0 +1,63 @@
+#include "evaluator/video.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "envs/registry.h"
+#include "evaluator/scorer.h"
+
+namespace rl::evaluator {
+
+VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, uint64_t seed,
+                              int width, int height, double fps, const std::string& path) {
+  auto env = envs::MakeEnv(env_id);
+  const std::string misfit = CheckNetworkFitsEnv(net->InputSize(), net->OutputSize(), env->spec());
+  if (!misfit.empty()) throw std::invalid_argument(misfit);
+  // The encoder wants even frame sizes.
+  width += width % 2;
+  height += height % 2;
+  const std::string tmp = path + ".tmp.webm";
+  cv::VideoWriter writer(tmp, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('V', 'P', '8', '0'), fps,
+                         cv::Size(width, height));
+  if (!writer.isOpened()) {
+    throw std::runtime_error("cannot open a WebM (VP8) encoder for " + tmp +
+                             " (OpenCV built without FFmpeg?)");
+  }
+  VideoResult result;
+  result.width = width;
+  result.height = height;
+  std::vector<uint8_t> rgb;
+  cv::Mat bgr(height, width, CV_8UC3);
+  auto write_frame = [&] {
+    env->RenderSized(width, height, &rgb);
+    const cv::Mat frame(height, width, CV_8UC3, rgb.data());
+    cv::cvtColor(frame, bgr, cv::COLOR_RGB2BGR);
+    writer.write(bgr);
+    ++result.frames;
+  };
+  env->Reset(seed);
+  write_frame();
+  while (true) {
+    const auto obs = env->observation();
+    const envs::StepResult r = env->Step(net->Argmax(obs.data(), static_cast<int>(obs.size())));
+    result.episode_return += r.reward;
+    write_frame();
+    if (r.terminated || r.truncated) break;
+  }
+  writer.release();
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw std::runtime_error("cannot write video " + path);
+  }
+  return result;
+}
+
+}  // namespace rl::evaluator

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# The pipeline learns LunarLander-v3 (Box2D): within a bounded time, an evaluation over 100
+# episodes (epsilon 0.05) beats a mean return of 0 (a random policy scores about -200), and the
+# report holds a video of the greedy policy. The full goal of 200 takes longer than CI allows;
+# scripts/bench.sh measures it.
+source "$(dirname "$0")/lib.sh"
+isolate "$@"
+scratch
+set +e
+launch lunar_lander --out "$dir/run" --actors 4 --seed 1 --goal 0 --time-budget 300 \
+  > "$dir/launch.log" 2>&1
+status=$?
+set -e
+tail -6 "$dir/launch.log"
+[ "$status" -eq 0 ] || fail "launch exited with $status"
+best=$(best_mean "$dir/run/eval.jsonl")
+awk -v b="$best" 'BEGIN{exit !(b >= 0)}' || fail "best evaluation mean $best < 0"
+[ -s "$dir/run/report/best.webm" ] || fail "no video of the greedy policy"
+grep -q '<video src="best.webm"' "$dir/run/report/index.html" || fail "the report shows no video"
+echo "PASS: LunarLander learned to a mean of $best"
