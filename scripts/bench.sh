@@ -64,6 +64,21 @@ if [ "$skip_goal" -eq 0 ]; then
       printf "{\"bench\": \"cartpole_time_to_goal\", \"value\": %.2f, \"unit\": \"s\", \"min\": %.2f, \"median\": %.2f, \"max\": %.2f, \"repeats\": %d, \"solved\": %d, \"goal\": 475, \"actors\": 4}\n", med, v[1], med, v[n], n, solved}' >> "$ours"
 fi
 
+# LunarLander: wall time and env steps until an evaluation mean of 200 (the "solved" mark).
+if [ "$skip_goal" -eq 0 ]; then
+  for seed in ${LUNAR_SEEDS:-1}; do
+    echo "bench: launch lunar_lander, seed $seed" >&2
+    start=$(date +%s.%N)
+    ok=0
+    isolated "$root/scripts/launch.sh" lunar_lander --no-setup --build-dir "$build_dir" \
+      --seed "$seed" --time-budget 900 --out "$work/lunar-$seed" > "$work/lunar-$seed.log" 2>&1 && ok=1
+    end=$(date +%s.%N)
+    steps=$(awk -F'"env_steps": ' '/"mean": *(2[0-9][0-9]|[3-9][0-9][0-9])/{split($2,a,","); print a[1]; exit}' \
+      "$work/lunar-$seed/eval.jsonl" 2>/dev/null)
+    echo "{\"bench\": \"lunar_lander_time_to_200\", \"value\": $(awk -v a="$start" -v b="$end" 'BEGIN{printf "%.1f", b - a}'), \"unit\": \"s\", \"seed\": $seed, \"solved\": $ok, \"env_steps\": ${steps:-null}, \"actors\": 4}" >> "$ours"
+  done
+fi
+
 # The PyTorch peer, in the same run.
 peer_dir="$root/../shared/bench/peer"
 py=/usr/bin/python3
