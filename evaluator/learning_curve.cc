@@ -1,5 +1,7 @@
 #include "evaluator/learning_curve.h"
 
+#include "evaluator/report.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -22,33 +24,6 @@ constexpr double kLeft = 72;
 constexpr double kRight = 24;
 constexpr double kTop = 40;
 constexpr double kBottom = 56;
-
-std::string Escape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size());
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 // A coordinate with one decimal.
 std::string Num(double v) {
@@ -179,10 +154,10 @@ std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveSt
        "\" font-family=\"-apple-system, 'Segoe UI', Helvetica, Arial, sans-serif\" "
        "font-size=\"12\" fill=\"" +
        kTextColor + "\">\n";
-  s += "<title>" + Escape(style.title) + "</title>\n";
+  s += "<title>" + HtmlEscape(style.title) + "</title>\n";
   s += "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n";
   s += "<text x=\"" + Num(kLeft) + "\" y=\"22\" font-size=\"14\" font-weight=\"600\">" +
-       Escape(style.title) + "</text>\n";
+       HtmlEscape(style.title) + "</text>\n";
 
   // Legend, top right.
   {
@@ -221,11 +196,11 @@ std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveSt
   for (double t : x_ticks) {
     const std::string label = style.x_kind == XAxisKind::kCount ? CountLabel(t) : Plain(t);
     s += "<text x=\"" + Num(sx(t)) + "\" y=\"" + Num(sy.p0 + 16) + "\" text-anchor=\"middle\">" +
-         Escape(label) + "</text>";
+         HtmlEscape(label) + "</text>";
   }
   for (double t : y_ticks) {
     s += "<text x=\"" + Num(sx.p0 - 8) + "\" y=\"" + Num(sy(t) + 4) + "\" text-anchor=\"end\">" +
-         Escape(Plain(t)) + "</text>";
+         HtmlEscape(Plain(t)) + "</text>";
   }
   s += "</g>\n";
 
@@ -233,9 +208,9 @@ std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveSt
   s += "<path d=\"M" + Num(sx.p0) + "," + Num(sy.p1) + " V" + Num(sy.p0) + " H" + Num(sx.p1) +
        "\" fill=\"none\" stroke=\"" + kAxisColor + "\" stroke-width=\"1\"/>\n";
   s += "<text x=\"" + Num((sx.p0 + sx.p1) / 2) + "\" y=\"" + Num(h - 14) +
-       "\" text-anchor=\"middle\">" + Escape(x_label) + "</text>\n";
+       "\" text-anchor=\"middle\">" + HtmlEscape(x_label) + "</text>\n";
   s += "<text transform=\"translate(18," + Num((sy.p0 + sy.p1) / 2) +
-       ") rotate(-90)\" text-anchor=\"middle\">" + Escape(style.y_label) + "</text>\n";
+       ") rotate(-90)\" text-anchor=\"middle\">" + HtmlEscape(style.y_label) + "</text>\n";
 
   // The band of plus/minus one std, then the mean line and its points.
   if (!points.empty()) {
@@ -277,7 +252,7 @@ std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveSt
          Num(sx.p1) + "\" y2=\"" + Num(gy) + "\" stroke=\"" + kGoalColor +
          "\" stroke-width=\"1.5\" stroke-dasharray=\"6 4\"/>\n";
     s += "<text x=\"" + Num(sx.p0 + 6) + "\" y=\"" + Num(gy - 5) + "\" font-size=\"11\" fill=\"" +
-         kGoalColor + "\">goal " + Escape(GoalLabel(style.goal)) + "</text>\n";
+         kGoalColor + "\">goal " + HtmlEscape(GoalLabel(style.goal)) + "</text>\n";
   }
   s += "</svg>\n";
   return s;
