@@ -73,9 +73,10 @@ if [ "$skip_goal" -eq 0 ]; then
     isolated "$root/scripts/launch.sh" lunar_lander --no-setup --build-dir "$build_dir" \
       --seed "$seed" --time-budget 900 --out "$work/lunar-$seed" > "$work/lunar-$seed.log" 2>&1 && ok=1
     end=$(date +%s.%N)
+    n_actors=$(sed -n 's/^# actors = \([0-9]*\).*/\1/p' "$work/lunar-$seed/config.ini" 2>/dev/null)
     steps=$(awk -F'"env_steps": ' '/"mean": *(2[0-9][0-9]|[3-9][0-9][0-9])/{split($2,a,","); print a[1]; exit}' \
       "$work/lunar-$seed/eval.jsonl" 2>/dev/null)
-    echo "{\"bench\": \"lunar_lander_time_to_200\", \"value\": $(awk -v a="$start" -v b="$end" 'BEGIN{printf "%.1f", b - a}'), \"unit\": \"s\", \"seed\": $seed, \"solved\": $ok, \"env_steps\": ${steps:-null}, \"actors\": 4}" >> "$ours"
+    echo "{\"bench\": \"lunar_lander_time_to_200\", \"value\": $(awk -v a="$start" -v b="$end" 'BEGIN{printf "%.1f", b - a}'), \"unit\": \"s\", \"seed\": $seed, \"solved\": $ok, \"env_steps\": ${steps:-null}, \"actors\": ${n_actors:-null}}" >> "$ours"
   done
 fi
 

@@ -6,7 +6,8 @@
 # Usage: scripts/launch.sh PRESET [options]
 #   PRESET                 a preset in configs/ (cartpole, ...)
 #   --out DIR              run folder (default runs/<preset>-<timestamp>)
-#   --actors N             actor processes on this host (default 4)
+#   --actors N             actor processes on this host (default: the preset's top-level
+#                          "actors = N", else 4)
 #   --num-actors N         actors in the whole run, for the Ape-X epsilons (default: --actors)
 #   --time-budget SECONDS  stop unsolved after this long (default 600)
 #   --goal SCORE           evaluation mean that ends the run (default: the preset's)
@@ -30,7 +31,7 @@ preset="$1"; shift
 config="$root/configs/$preset.ini"
 [ -f "$config" ] || die "no preset '$preset' (known: $(ls "$root/configs" | sed 's/\.ini$//' | tr '\n' ' '))"
 
-out="" actors=4 num_actors="" time_budget=600 goal="" seed=1 ttl=0 port="" run_id=""
+out="" actors="" num_actors="" time_budget=600 goal="" seed=1 ttl=0 port="" run_id=""
 actor_args="" replay_args="" learner_args="" evaluator_args=""
 build_dir="$root/build" setup=1
 while [ $# -gt 0 ]; do
@@ -56,6 +57,11 @@ while [ $# -gt 0 ]; do
   [ $# -gt 0 ] || die "option needs a value"
   shift
 done
+# The preset's top-level "actors = N" (before any section), unless given; else 4.
+if [ -z "$actors" ]; then
+  actors=$(awk -F= '/^\[/{exit} $1~/^ *actors *$/{gsub(/ /,"",$2); print $2}' "$config")
+  actors=${actors:-4}
+fi
 [[ "$actors" =~ ^[0-9]+$ ]] || die "--actors must be a number"
 num_actors=${num_actors:-$actors}
 [[ "$ttl" == 0 || "$ttl" == 1 ]] || die "--ttl must be 0 or 1"

@@ -7,7 +7,7 @@ source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
 set +e
-launch lunar_lander --out "$dir/run" --actors 4 --seed 1 --goal 0 --time-budget 300 \
+launch lunar_lander --out "$dir/run" --seed 1 --goal 0 --time-budget 300 \
   > "$dir/launch.log" 2>&1
 status=$?
 set -e
