@@ -63,10 +63,10 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
     throw std::runtime_error("checkpoint " + path + ": cannot build architecture '" +
                              ckpt.architecture + "': " + e.what());
   }
-  if (static_cast<int64_t>(ckpt.params.size()) != net.NumParams()) {
+  if (static_cast<int64_t>(ckpt.params.size()) != net.FlatSize()) {
     throw std::runtime_error("checkpoint " + path + ": " + std::to_string(ckpt.params.size()) +
                              " parameters, but architecture '" + ckpt.architecture + "' has " +
-                             std::to_string(net.NumParams()));
+                             std::to_string(net.FlatSize()));
   }
   net.SetFlat(ckpt.params.data(), ckpt.params.size());
   const std::string misfit =

@@ -30,6 +30,7 @@ Dqn::Dqn(int obs_size, int num_actions, DqnConfig config)
   std::mt19937 rng(static_cast<std::mt19937::result_type>(config_.seed));
   online_ = nn::MakeMlp(obs_size, config_.hidden, num_actions, &rng);
   target_ = online_;
+  target_.set_training(false);  // the target network uses running statistics (BatchNorm)
   params_ = online_.Params();
   if (config_.optimizer == "adam") {
     optimizer_ =

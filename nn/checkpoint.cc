@@ -252,17 +252,17 @@ Checkpoint LoadCheckpoint(const std::string& path) {
     throw fail("is corrupted: " + std::to_string(r.remaining()) + " unexpected trailing bytes");
   }
 
-  // The parameters must fit the architecture.
+  // The parameters (and buffers) must fit the architecture.
   std::mt19937 rng(0);
   int64_t expected = 0;
   try {
-    expected = BuildFromArchitecture(ckpt.architecture, &rng).NumParams();
+    expected = BuildFromArchitecture(ckpt.architecture, &rng).FlatSize();
   } catch (const std::invalid_argument& e) {
     throw fail(std::string("has an invalid architecture: ") + e.what());
   }
   if (static_cast<uint64_t>(expected) != num_params) {
     throw fail("holds " + std::to_string(num_params) + " parameters but " + ckpt.architecture +
-               " has " + std::to_string(expected));
+               " has " + std::to_string(expected) + " (parameters and buffers)");
   }
   return ckpt;
 }

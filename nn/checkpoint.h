@@ -7,7 +7,7 @@
 //   u32 n, char[n]   architecture string (Sequential::Architecture())
 //   i64      update        i64 env_steps     f64 wall_seconds     u64 run_id
 //   u32 n, char[n]   note (free-form, e.g. the run's configuration)
-//   u64 n, f32[n]    parameters in Sequential::GetFlat() order
+//   u64 n, f32[n]    parameters then buffers, in Sequential::GetFlat() order
 //   u32      CRC-32 (IEEE) of every byte before it
 #pragma once
 
@@ -27,7 +27,8 @@ struct CheckpointMeta {
 };
 
 /// A network in a form that can be rebuilt: BuildFromArchitecture(architecture) then
-/// SetFlat(params).
+/// SetFlat(params). `params` is Sequential::GetFlat(): the parameters, then the buffers (running
+/// statistics), FlatSize() floats.
 struct Checkpoint {
   std::string architecture;
   CheckpointMeta meta;
@@ -43,7 +44,7 @@ void SaveCheckpoint(const std::string& path, const Checkpoint& ckpt);
 /// Reads and verifies a checkpoint. Throws std::runtime_error naming the path and the reason:
 /// cannot open, not a checkpoint file (wrong magic), unsupported version, truncated, corrupted
 /// (checksum mismatch or inconsistent lengths), or a parameter count that does not match the
-/// architecture.
+/// architecture's FlatSize().
 Checkpoint LoadCheckpoint(const std::string& path);
 
 }  // namespace rl::nn

@@ -28,8 +28,13 @@ constexpr int kMaxVecs = 2;
 constexpr int kNr = 6;
 #endif
 constexpr int kMaxMr = kMaxVecs * kLanes;
+static_assert(kMaxMr == kPanelRows, "gemm.h promises panels of kPanelRows rows");
 // Depth of one packed panel: kMaxMr x kKc floats (24 KB at most) stay in L1 while B streams by.
 constexpr int kKc = 256;
+// Floats of packed A kept at once when whole blocks of panels are packed (512 KB, half of L2).
+constexpr int64_t kBlockFloats = 128 * 1024;
+// Columns of C ahead of the current block that PanelGemm prefetches when it accumulates.
+constexpr int kPrefetchAhead = 2 * kNr;
 // Products with at most this many rows use dot products (DotKernel) instead of panels.
 constexpr int kMaxSmallM = 4;
 // Columns of B per DotKernel call.
@@ -53,7 +58,8 @@ inline float Activate(float r, bool relu, const float* mask) {
 
 // What one micro-kernel call computes and where it stores it.
 struct Block {
-  const float* bias;  // kMr floats (padded) or null.
+  const float* bias;      // kMr floats (padded) or null.
+  const float* col_bias;  // NR floats or null: added to column j of the block.
   bool accumulate;
   bool relu;
   const float* mask;  // Laid out like c, or null.
@@ -78,7 +84,9 @@ void MicroKernel(int k, const float* ap, int64_t a_step, const float* b, int64_t
   for (int i = 0; i < V; ++i) {
     const Vec init = out.bias != nullptr ? Load(out.bias + i * kLanes) : Vec{};
 #pragma GCC unroll 16
-    for (int j = 0; j < NR; ++j) acc[i][j] = init;
+    for (int j = 0; j < NR; ++j) {
+      acc[i][j] = out.col_bias != nullptr ? init + out.col_bias[j] : init;
+    }
   }
   // Rank-1 updates: one column of the A panel times one row of B per step.
   for (int p = 0; p < k; ++p) {
@@ -179,11 +187,15 @@ inline void TransposeStages(Vec* rows) {
 // (zero beyond `rows`).
 void PackPanel(const ConstView& a, int i0, int rows, int p0, int k, int mr, float* dst) {
   if (a.row_stride == 1) {
-    // Columns of the panel are contiguous in `a`.
-    for (int p = 0; p < k; ++p) {
+    // Columns of the panel are contiguous in `a`. Copy whole vectors (a call to memcpy per column
+    // costs more than the copy), then the ragged end.
+    const int full = rows / kLanes;
+    const float* src = a.data + i0 + p0 * a.col_stride;
+    for (int p = 0; p < k; ++p, src += a.col_stride) {
       float* d = dst + static_cast<int64_t>(p) * mr;
-      std::memcpy(d, a.data + i0 + (p0 + p) * a.col_stride, sizeof(float) * rows);
-      std::fill(d + rows, d + mr, 0.0f);
+      for (int v = 0; v < full; ++v) Store(d + v * kLanes, Load(src + v * kLanes));
+      for (int i = full * kLanes; i < rows; ++i) d[i] = src[i];
+      for (int i = rows; i < mr; ++i) d[i] = 0.0f;
     }
     return;
   }
@@ -218,16 +230,53 @@ void PackPanel(const ConstView& a, int i0, int rows, int p0, int k, int mr, floa
   }
 }
 
+// Copies panels [q0, q1) of rows of a column-major `a` (row_stride 1), columns [p0, p0 + k), into
+// `dst`: panel q at (q - q0) * kMaxMr * k, laid out as PackPanel() does. Walks each column of `a`
+// once across all the panels, so a large A streams from memory instead of being read in short
+// strided pieces.
+void PackPanelBlock(const ConstView& a, int q0, int q1, int p0, int k, float* dst) {
+  const int m = a.rows;
+  const float* src = a.data + p0 * a.col_stride;
+  for (int p = 0; p < k; ++p, src += a.col_stride) {
+    for (int q = q0; q < q1; ++q) {
+      const int i0 = q * kMaxMr;
+      const int rows = std::min(kMaxMr, m - i0);
+      const int mr = (rows + kLanes - 1) / kLanes * kLanes;
+      const int full = rows / kLanes;
+      float* d = dst + static_cast<int64_t>(q - q0) * kMaxMr * k + static_cast<int64_t>(p) * mr;
+      const float* s = src + i0;
+      for (int v = 0; v < full; ++v) Store(d + v * kLanes, Load(s + v * kLanes));
+      for (int i = full * kLanes; i < rows; ++i) d[i] = s[i];
+      for (int i = rows; i < mr; ++i) d[i] = 0.0f;
+    }
+  }
+}
+
 // The general case: panels of A times strided B, for any shapes with k > 0.
+// With `prepacked`, A is only a shape and its panels are read from there (see GemmPacked()).
 void PanelGemm(const ConstView& a, const ConstView& b, const MutView& c, bool accumulate,
-               const Epilogue& epilogue, Vector* workspace) {
+               const Epilogue& epilogue, Vector* workspace, const float* prepacked = nullptr) {
   const int m = c.rows;
   const int n = c.cols;
   const int k = a.cols;
-  const int64_t needed = static_cast<int64_t>(kMaxMr) * (std::min(k, kKc) + 1);
-  if (workspace->size() < needed) workspace->resize(needed);
-  float* panel = workspace->data();
-  float* bias_panel = panel + static_cast<int64_t>(kMaxMr) * std::min(k, kKc);
+  const int kc_max = std::min(k, kKc);
+  const int panels = (m + kMaxMr - 1) / kMaxMr;
+  // A large column-major A (a weight matrix that does not fit the L2 cache) used by several
+  // blocks of columns is packed a block of panels at a time (about half the L2 cache); otherwise
+  // one panel at a time, which then stays in L1, or not at all.
+  const bool pack_blocks = prepacked == nullptr && a.row_stride == 1 && n > kNr && panels > 1 &&
+                           static_cast<int64_t>(m) * k > 2 * kBlockFloats;
+  int block_panels = 1;
+  if (pack_blocks) {
+    const int max_panels =
+        std::max<int>(1, static_cast<int>(kBlockFloats / (static_cast<int64_t>(kMaxMr) * kc_max)));
+    const int blocks = (panels + max_panels - 1) / max_panels;
+    block_panels = (panels + blocks - 1) / blocks;
+  }
+  const int64_t packed_floats = static_cast<int64_t>(block_panels) * kMaxMr * kc_max;
+  if (workspace->size() < packed_floats + kMaxMr) workspace->resize(packed_floats + kMaxMr);
+  float* packed = workspace->data();
+  float* bias_panel = packed + packed_floats;
 
   for (int p0 = 0; p0 < k; p0 += kKc) {
     const int kc = std::min(kKc, k - p0);
@@ -235,44 +284,94 @@ void PanelGemm(const ConstView& a, const ConstView& b, const MutView& c, bool ac
     // last one applies the activation steps.
     const bool first = p0 == 0;
     const bool last = p0 + kc == k;
-    for (int i0 = 0; i0 < m; i0 += kMaxMr) {
-      const int rows = std::min(kMaxMr, m - i0);
-      const int vecs = (rows + kLanes - 1) / kLanes;
-      const int mr = vecs * kLanes;
-      // With a single block of columns each panel is used once, so packing costs more than it
-      // saves; full panels of a column-major A are then read in place.
-      const float* ap = panel;
-      int64_t a_step = mr;
-      if (n <= kNr && a.row_stride == 1 && rows == mr) {
-        ap = a.data + i0 + p0 * a.col_stride;
-        a_step = a.col_stride;
-      } else {
-        PackPanel(a, i0, rows, p0, kc, mr, panel);
+    for (int q0 = 0; q0 < panels; q0 += block_panels) {
+      const int q1 = std::min(panels, q0 + block_panels);
+      if (pack_blocks) PackPanelBlock(a, q0, q1, p0, kc, packed);
+      // While this block is multiplied, prefetch the part of A that the next one packs (a large
+      // A comes from memory; without this, packing waits for it).
+      int next_p0 = p0;
+      int next_q0 = q0 + block_panels;
+      if (next_q0 >= panels) {
+        next_p0 = p0 + kKc;
+        next_q0 = 0;
       }
-      Block out{nullptr,
-                accumulate || !first,
-                last && epilogue.relu,
-                nullptr,
-                c.data + i0 * c.row_stride,
-                c.row_stride,
-                c.col_stride,
-                rows};
-      if (first && epilogue.row_bias != nullptr) {
-        std::copy(epilogue.row_bias + i0, epilogue.row_bias + i0 + rows, bias_panel);
-        std::fill(bias_panel + rows, bias_panel + mr, 0.0f);
-        out.bias = bias_panel;
-      }
-      const float* mask_rows = nullptr;
-      if (last && epilogue.mask != nullptr) mask_rows = epilogue.mask + i0 * c.row_stride;
-      const std::array<KernelFn, kNr + 1>& kernels = kKernels[vecs - 1];
-      const float* b_slice = b.data + p0 * b.row_stride;
-      float* c_rows = out.c;
-      // Blocks of kNr columns, then one narrower block for the remainder.
-      for (int j0 = 0; j0 < n; j0 += kNr) {
-        const int nr = std::min(kNr, n - j0);
-        out.c = c_rows + j0 * c.col_stride;
-        out.mask = mask_rows != nullptr ? mask_rows + j0 * c.col_stride : nullptr;
-        kernels[nr](kc, ap, a_step, b_slice + j0 * b.col_stride, b.row_stride, b.col_stride, out);
+      const bool prefetch = pack_blocks && next_p0 < k;
+      const int next_kc = prefetch ? std::min(kKc, k - next_p0) : 0;
+      const int next_i0 = next_q0 * kMaxMr;
+      const int next_i1 = std::min(m, (next_q0 + block_panels) * kMaxMr);
+      const int calls = (q1 - q0) * ((n + kNr - 1) / kNr);
+      int call = 0;
+      for (int q = q0; q < q1; ++q) {
+        const int i0 = q * kMaxMr;
+        const int rows = std::min(kMaxMr, m - i0);
+        const int vecs = (rows + kLanes - 1) / kLanes;
+        const int mr = vecs * kLanes;
+        const float* ap = packed + static_cast<int64_t>(q - q0) * kMaxMr * kc;
+        int64_t a_step = mr;
+        if (prepacked != nullptr) {
+          ap = prepacked + (static_cast<int64_t>(q) * k + p0) * kMaxMr;
+          a_step = kMaxMr;
+        } else if (!pack_blocks) {
+          // With a single block of columns each panel is used once, so packing costs more than
+          // it saves; full panels of a column-major A are then read in place.
+          if (n <= kNr && a.row_stride == 1 && rows == mr) {
+            ap = a.data + i0 + p0 * a.col_stride;
+            a_step = a.col_stride;
+          } else {
+            PackPanel(a, i0, rows, p0, kc, mr, packed);
+          }
+        }
+        Block out{nullptr,
+                  nullptr,
+                  accumulate || !first,
+                  last && epilogue.relu,
+                  nullptr,
+                  c.data + i0 * c.row_stride,
+                  c.row_stride,
+                  c.col_stride,
+                  rows};
+        if (first && epilogue.row_bias != nullptr) {
+          std::copy(epilogue.row_bias + i0, epilogue.row_bias + i0 + rows, bias_panel);
+          std::fill(bias_panel + rows, bias_panel + mr, 0.0f);
+          out.bias = bias_panel;
+        }
+        const float* mask_rows = nullptr;
+        if (last && epilogue.mask != nullptr) mask_rows = epilogue.mask + i0 * c.row_stride;
+        const std::array<KernelFn, kNr + 1>& kernels = kKernels[vecs - 1];
+        const float* b_slice = b.data + p0 * b.row_stride;
+        float* c_rows = out.c;
+        // Blocks of kNr columns, then one narrower block for the remainder.
+        for (int j0 = 0; j0 < n; j0 += kNr) {
+          const int nr = std::min(kNr, n - j0);
+          out.c = c_rows + j0 * c.col_stride;
+          out.mask = mask_rows != nullptr ? mask_rows + j0 * c.col_stride : nullptr;
+          out.col_bias = first && epilogue.col_bias != nullptr ? epilogue.col_bias + j0 : nullptr;
+          if (prefetch) {
+            // Columns [c0, c1) of the next block, one call's share.
+            const int c0 = next_p0 + static_cast<int>(static_cast<int64_t>(next_kc) * call / calls);
+            const int c1 =
+                next_p0 + static_cast<int>(static_cast<int64_t>(next_kc) * (call + 1) / calls);
+            for (int col = c0; col < c1; ++col) {
+              const float* from = a.data + static_cast<int64_t>(col) * a.col_stride + next_i0;
+              const float* to = from + (next_i1 - next_i0);
+              for (const float* line = from; line < to; line += 16) {
+                __builtin_prefetch(line, 0, 2);
+              }
+            }
+            ++call;
+          }
+          if (out.accumulate && c.row_stride == 1 && j0 + kPrefetchAhead < n) {
+            // The block of C stored kPrefetchAhead columns later: a large C (a weight gradient)
+            // is read from memory.
+            float* ahead = c_rows + (j0 + kPrefetchAhead) * c.col_stride;
+            const int cols = std::min(kNr, n - j0 - kPrefetchAhead);
+            for (int j = 0; j < cols; ++j) {
+              __builtin_prefetch(ahead + j * c.col_stride, 1, 2);
+              __builtin_prefetch(ahead + j * c.col_stride + rows - 1, 1, 2);
+            }
+          }
+          kernels[nr](kc, ap, a_step, b_slice + j0 * b.col_stride, b.row_stride, b.col_stride, out);
+        }
       }
     }
   }
@@ -374,11 +473,18 @@ void DotKernel(int k, int k_pad, const float* at, const float* b, int64_t bcs,
       float sum = sums[(o * NC + j) / kLanes][(o * NC + j) % kLanes];
       for (int p = k_vec; p < k; ++p) sum += a_row[p] * b[j * bcs + p];
       if (epilogue.row_bias != nullptr) sum += epilogue.row_bias[o];
+      if (epilogue.col_bias != nullptr) sum += epilogue.col_bias[j];
       const int64_t at_c = o * crs + j * ccs;
       if (accumulate) sum += c[at_c];
       c[at_c] = Activate(sum, epilogue.relu, mask != nullptr ? mask + at_c : nullptr);
     }
   }
+}
+
+// The epilogue of the columns from j on (the mask is offset by the caller).
+inline Epilogue ShiftColumns(Epilogue e, int j) {
+  if (e.col_bias != nullptr) e.col_bias += j;
+  return e;
 }
 
 template <int M>
@@ -400,17 +506,28 @@ void SmallMGemm(const ConstView& a, const ConstView& b, const MutView& c, bool a
   };
   int j = 0;
   for (; j + kDotColumns <= n; j += kDotColumns) {
-    DotKernel<M, kDotColumns>(k, k_pad, at, b.data + j * b.col_stride, b.col_stride, epilogue,
-                              accumulate, c.data + j * c.col_stride, mask_at(j), c.row_stride,
-                              c.col_stride);
+    DotKernel<M, kDotColumns>(k, k_pad, at, b.data + j * b.col_stride, b.col_stride,
+                              ShiftColumns(epilogue, j), accumulate, c.data + j * c.col_stride,
+                              mask_at(j), c.row_stride, c.col_stride);
   }
   for (; j < n; ++j) {
-    DotKernel<M, 1>(k, k_pad, at, b.data + j * b.col_stride, b.col_stride, epilogue, accumulate,
-                    c.data + j * c.col_stride, mask_at(j), c.row_stride, c.col_stride);
+    DotKernel<M, 1>(k, k_pad, at, b.data + j * b.col_stride, b.col_stride,
+                    ShiftColumns(epilogue, j), accumulate, c.data + j * c.col_stride, mask_at(j),
+                    c.row_stride, c.col_stride);
   }
 }
 
 }  // namespace
+
+void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, bool accumulate,
+                const Epilogue& epilogue, Vector* workspace) {
+  RL_CHECK(k == b.rows && m == c.rows && b.cols == c.cols)
+      << "GemmPacked shapes: (" << m << "x" << k << ") * (" << b.rows << "x" << b.cols << ") -> ("
+      << c.rows << "x" << c.cols << ")";
+  if (m == 0 || c.cols == 0) return;
+  if (k == 0) return Gemm({a_packed, m, 0, 1, m}, b, c, accumulate, epilogue, workspace);
+  PanelGemm({nullptr, m, k, 0, 0}, b, c, accumulate, epilogue, workspace, a_packed);
+}
 
 void AddRowSums(const Matrix& g, float* out) {
   // Blocks of kRowVecs vectors of rows: add the columns one after another into registers.
@@ -478,7 +595,8 @@ void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& 
   auto elem = [&](int i, int j) { return i * c.row_stride + j * c.col_stride; };
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < m; ++i) {
-      const float bias = epilogue.row_bias != nullptr ? epilogue.row_bias[i] : 0.0f;
+      float bias = epilogue.row_bias != nullptr ? epilogue.row_bias[i] : 0.0f;
+      if (epilogue.col_bias != nullptr) bias += epilogue.col_bias[j];
       c.data[elem(i, j)] = accumulate ? c.data[elem(i, j)] + bias : bias;
     }
   }

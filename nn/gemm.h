@@ -52,17 +52,35 @@ bool PreferGemm(int m, int n, int k);
 /// Element-wise steps applied to each result of Gemm() before it is stored, in this order.
 struct Epilogue {
   const float* row_bias = nullptr;  ///< c.rows floats; row_bias[i] is added to row i of c.
+  const float* col_bias = nullptr;  ///< c.cols floats; col_bias[j] is added to column j of c.
   bool relu = false;                ///< Store max(result, 0) (a fused ReLU forward).
   /// Laid out like c (same strides): store 0 where mask <= 0 (a fused ReLU backward, the mask
   /// being the ReLU's output).
   const float* mask = nullptr;
 };
 
+/// Rows per packed panel of the left operand (see GemmPacked()).
+#if defined(__AVX512F__)
+constexpr int kPanelRows = 24;
+#elif defined(__AVX__)
+constexpr int kPanelRows = 16;
+#else
+constexpr int kPanelRows = 8;
+#endif
+
 /// c = a * b (accumulate == false) or c += a * b (accumulate == true), followed by `epilogue`.
 /// `c` must not overlap `a`, `b` or the mask. `workspace` is scratch space; it only grows, so
 /// repeated calls with the same shapes do not allocate. O(m n k).
 void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& epilogue,
           Vector* workspace);
+
+/// As Gemm() for an m x k left operand that the caller has already packed (e.g. unfolded into
+/// place by a convolution): rows [q * kPanelRows, (q + 1) * kPanelRows) are at
+/// a_packed + q * kPanelRows * k, as k steps of kPanelRows floats (row i of the panel at step p
+/// is a_packed[q * kPanelRows * k + p * kPanelRows + i]). Rows past m in the last panel are read
+/// but do not affect c. O(m n k).
+void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, bool accumulate,
+                const Epilogue& epilogue, Vector* workspace);
 
 /// out[i] += sum_j g(i, j) for a column-major g (the bias gradient of a batch). O(rows cols).
 void AddRowSums(const Matrix& g, float* out);

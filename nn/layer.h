@@ -20,7 +20,8 @@ class Layer {
   virtual ~Layer() = default;
 
   /// Computes the output for the batch `x` (one sample per column). Returns a reference to an
-  /// internal buffer that stays valid until the next call on this layer.
+  /// internal buffer (or, for layers that do not change the data, to `x` itself) that stays valid
+  /// until the next call on this layer.
   virtual const Matrix& Forward(const Matrix& x) = 0;
 
   /// Given d(loss)/d(output) of the last Forward(), ADDS d(loss)/d(parameters) into the parameter
@@ -36,16 +37,38 @@ class Layer {
   /// network prefixes them.
   virtual std::vector<Param> Params() { return {}; }
 
+  /// The non-trainable state tensors (e.g. running statistics), in a fixed order, named like
+  /// Params(). Optimizers do not update them; the layer does, in Forward() in training mode.
+  virtual std::vector<Buffer> Buffers() { return {}; }
+
+  /// Training (the default) or evaluation mode. Only layers whose forward pass differs between
+  /// the two (batch normalisation) care.
+  virtual void set_training(bool /*training*/) {}
+
   /// The layer in architecture-string form, e.g. "linear(4,120)" or "relu".
   virtual std::string Describe() const = 0;
 
-  /// A deep copy of the parameters (gradients zero, no cached activations).
+  /// A deep copy of the parameters and buffers, in the same mode (gradients zero, no cached
+  /// activations, no fusion).
   virtual std::unique_ptr<Layer> Clone() const = 0;
 
   /// Number of input features, or 0 if the layer accepts any (element-wise layers).
   virtual int input_size() const { return 0; }
   /// Number of output features, or 0 if it equals the number of input features.
   virtual int output_size() const { return 0; }
+  /// For layers that read images: the C x H x W shape of one input; empty otherwise.
+  virtual ImageShape input_shape() const { return {}; }
+  /// For layers that produce images: the shape of one output; empty otherwise.
+  virtual ImageShape output_shape() const { return {}; }
+
+  /// Asks the layer to apply a ReLU that follows it: on success (returns true) Forward() returns
+  /// max(output, 0) from now on. Used by Sequential, which then skips the ReLU's own pass.
+  virtual bool FuseOutputRelu() { return false; }
+  /// Asks the layer to apply the backward pass of a ReLU that precedes it: on success (returns
+  /// true) Backward() returns the gradient with respect to the ReLU's input, zero wherever this
+  /// layer's input (the ReLU's output) is 0. Used by Sequential, which then skips the ReLU's
+  /// Backward().
+  virtual bool FuseInputReluGrad() { return false; }
 };
 
 }  // namespace rl::nn

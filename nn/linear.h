@@ -47,6 +47,14 @@ class Linear : public Layer {
   /// gradient with respect to the ReLU's input, zero wherever this layer's input (the ReLU's
   /// output) is 0. Set by Sequential, which then skips the ReLU's Backward().
   void set_fused_input_relu_grad(bool on) { fused_input_relu_grad_ = on; }
+  bool FuseOutputRelu() override {
+    set_fused_output_relu(true);
+    return true;
+  }
+  bool FuseInputReluGrad() override {
+    set_fused_input_relu_grad(true);
+    return true;
+  }
 
  private:
   // Adds dW and db for `grad_out` and the input of the last Forward().

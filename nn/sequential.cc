@@ -1,8 +1,8 @@
 #include "nn/sequential.h"
 
 #include <algorithm>
-#include <charconv>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "common/check.h"
@@ -11,7 +11,7 @@
 
 namespace rl::nn {
 
-Sequential::Sequential(const Sequential& other) {
+Sequential::Sequential(const Sequential& other) : training_(other.training_) {
   for (const auto& layer : other.layers_) Add(layer->Clone());
 }
 
@@ -32,23 +32,38 @@ void Sequential::Add(std::unique_ptr<Layer> layer) {
                                 " inputs but the previous layer produces " +
                                 std::to_string(output_size_));
   }
+  const ImageShape in_image = layer->input_shape();
+  if (!in_image.empty() && !image_.empty() && in_image != image_) {
+    auto str = [](const ImageShape& s) {
+      return std::to_string(s.channels) + "x" + std::to_string(s.height) + "x" +
+             std::to_string(s.width);
+    };
+    throw std::invalid_argument("layer " + std::to_string(layers_.size()) + " " +
+                                layer->Describe() + " expects " + str(in_image) +
+                                " images but the previous layers produce " + str(image_));
+  }
   if (input_size_ == 0 && output_size_ == 0) input_size_ = in;
   if (layer->output_size() != 0) output_size_ = layer->output_size();
+  // Track image shapes through element-wise and shape-preserving layers only.
+  if (!layer->output_shape().empty()) {
+    image_ = layer->output_shape();
+  } else if (layer->output_size() != 0 && layer->output_size() != in) {
+    image_ = {};
+  }
 
-  // Fuse ReLUs into neighbouring Linear layers.
+  // Fuse ReLUs into the layers around them, where those support it.
   Layer* prev = layers_.empty() ? nullptr : layers_.back().get();
   auto* relu = dynamic_cast<ReLU*>(layer.get());
-  auto* linear = dynamic_cast<Linear*>(layer.get());
   fused_forward_.push_back(nullptr);
   fused_backward_.push_back(false);
-  if (auto* prev_linear = dynamic_cast<Linear*>(prev); relu != nullptr && prev_linear != nullptr) {
-    prev_linear->set_fused_output_relu(true);
+  if (relu != nullptr && prev != nullptr && dynamic_cast<ReLU*>(prev) == nullptr &&
+      prev->FuseOutputRelu()) {
     fused_forward_.back() = relu;
   }
-  if (linear != nullptr && dynamic_cast<ReLU*>(prev) != nullptr) {
-    linear->set_fused_input_relu_grad(true);
+  if (relu == nullptr && dynamic_cast<ReLU*>(prev) != nullptr && layer->FuseInputReluGrad()) {
     fused_backward_[layers_.size() - 1] = true;
   }
+  layer->set_training(training_);
 
   const std::string prefix = std::to_string(layers_.size()) + ".";
   for (Param& p : layer->Params()) {
@@ -58,9 +73,19 @@ void Sequential::Add(std::unique_ptr<Layer> layer) {
     num_params_ += p.value->size();
     params_.push_back({prefix + p.name, p.value, p.grad});
   }
+  for (Buffer& b : layer->Buffers()) {
+    RL_CHECK(b.value != nullptr) << layer->Describe() << ": buffer " << b.name << " is null";
+    num_buffers_ += b.value->size();
+    buffers_.push_back({prefix + b.name, b.value});
+  }
   if (!architecture_.empty()) architecture_ += ",";
   architecture_ += layer->Describe();
   layers_.push_back(std::move(layer));
+}
+
+void Sequential::set_training(bool training) {
+  training_ = training;
+  for (auto& layer : layers_) layer->set_training(training);
 }
 
 const Matrix& Sequential::Forward(const Matrix& x) {
@@ -95,23 +120,32 @@ void Sequential::ZeroGrad() {
 }
 
 void Sequential::GetFlat(std::vector<float>* out) const {
-  out->resize(static_cast<size_t>(num_params_));
+  out->resize(static_cast<size_t>(FlatSize()));
   float* dst = out->data();
   for (const Param& p : params_) {
     std::copy_n(p.value->data(), p.value->size(), dst);
     dst += p.value->size();
   }
+  for (const Buffer& b : buffers_) {
+    std::copy_n(b.value->data(), b.value->size(), dst);
+    dst += b.value->size();
+  }
 }
 
 void Sequential::SetFlat(const float* data, size_t n) {
-  if (n != static_cast<size_t>(num_params_)) {
-    throw std::invalid_argument("SetFlat: got " + std::to_string(n) + " floats but " +
-                                architecture_ + " has " + std::to_string(num_params_) +
-                                " parameters");
+  if (n != static_cast<size_t>(FlatSize())) {
+    throw std::invalid_argument(
+        "SetFlat: got " + std::to_string(n) + " floats but " + architecture_ + " has " +
+        std::to_string(num_params_) + " parameters" +
+        (num_buffers_ > 0 ? " and " + std::to_string(num_buffers_) + " buffer floats" : ""));
   }
   for (Param& p : params_) {
     std::copy_n(data, p.value->size(), p.value->data());
     data += p.value->size();
+  }
+  for (Buffer& b : buffers_) {
+    std::copy_n(data, b.value->size(), b.value->data());
+    data += b.value->size();
   }
 }
 
@@ -120,6 +154,7 @@ void Sequential::CopyParamsFrom(const Sequential& other) {
       << "CopyParamsFrom needs the same architecture: " << architecture_ << " vs "
       << other.architecture_;
   for (size_t i = 0; i < params_.size(); ++i) *params_[i].value = *other.params_[i].value;
+  for (size_t i = 0; i < buffers_.size(); ++i) *buffers_[i].value = *other.buffers_[i].value;
 }
 
 void Sequential::SoftUpdateFrom(const Sequential& other, float tau) {
@@ -130,6 +165,10 @@ void Sequential::SoftUpdateFrom(const Sequential& other, float tau) {
     Matrix& mine = *params_[i].value;
     mine = tau * *other.params_[i].value + (1.0f - tau) * mine;
   }
+  for (size_t i = 0; i < buffers_.size(); ++i) {
+    Matrix& mine = *buffers_[i].value;
+    mine = tau * *other.buffers_[i].value + (1.0f - tau) * mine;
+  }
 }
 
 const Matrix& Sequential::Predict(const float* obs, int obs_size) {
@@ -137,7 +176,12 @@ const Matrix& Sequential::Predict(const float* obs, int obs_size) {
       << "Predict got " << obs_size << " features, " << architecture_ << " takes " << input_size_;
   observation_.resize(obs_size, 1);
   std::copy_n(obs, obs_size, observation_.data());
-  return Forward(observation_);
+  if (!training_ || buffers_.empty()) return Forward(observation_);
+  // Only layers with buffers behave differently in evaluation mode.
+  for (auto& layer : layers_) layer->set_training(false);
+  const Matrix& q = Forward(observation_);
+  for (auto& layer : layers_) layer->set_training(true);
+  return q;
 }
 
 int Sequential::Argmax(const float* obs, int obs_size) {
@@ -146,116 +190,6 @@ int Sequential::Argmax(const float* obs, int obs_size) {
   Eigen::Index best = 0;
   q.col(0).maxCoeff(&best);
   return static_cast<int>(best);
-}
-
-namespace {
-
-// Throws the error of BuildFromArchitecture for `arch`.
-[[noreturn]] void ArchError(const std::string& arch, const std::string& what) {
-  throw std::invalid_argument("architecture '" + arch + "': " + what);
-}
-
-// One parsed layer: "name" or "name(arg,...)".
-struct LayerSpec {
-  std::string name;
-  std::vector<std::string> args;
-  bool has_parens = false;
-};
-
-std::string Trim(const std::string& s) {
-  const size_t first = s.find_first_not_of(" \t");
-  if (first == std::string::npos) return "";
-  const size_t last = s.find_last_not_of(" \t");
-  return s.substr(first, last - first + 1);
-}
-
-// Splits `arch` at the commas that are not inside parentheses.
-std::vector<LayerSpec> ParseArchitecture(const std::string& arch) {
-  std::vector<std::string> parts;
-  std::string current;
-  int depth = 0;
-  for (char ch : arch) {
-    if (ch == '(') ++depth;
-    if (ch == ')' && --depth < 0) ArchError(arch, "unbalanced ')'");
-    if (ch == ',' && depth == 0) {
-      parts.push_back(current);
-      current.clear();
-    } else {
-      current += ch;
-    }
-  }
-  if (depth != 0) ArchError(arch, "unbalanced '('");
-  parts.push_back(current);
-
-  std::vector<LayerSpec> specs;
-  for (size_t i = 0; i < parts.size(); ++i) {
-    const std::string part = Trim(parts[i]);
-    if (part.empty()) ArchError(arch, "layer " + std::to_string(i) + " is empty");
-    LayerSpec spec;
-    const size_t open = part.find('(');
-    spec.name = Trim(part.substr(0, open));
-    if (open != std::string::npos) {
-      spec.has_parens = true;
-      if (part.back() != ')') {
-        ArchError(arch, "layer " + std::to_string(i) + " '" + part + "' has text after ')'");
-      }
-      std::string inner = part.substr(open + 1, part.size() - open - 2);
-      if (!Trim(inner).empty()) {
-        size_t start = 0;
-        while (true) {
-          const size_t comma = inner.find(',', start);
-          spec.args.push_back(Trim(inner.substr(start, comma - start)));
-          if (comma == std::string::npos) break;
-          start = comma + 1;
-        }
-      }
-    }
-    specs.push_back(std::move(spec));
-  }
-  return specs;
-}
-
-int ParsePositiveInt(const std::string& arch, const std::string& layer, const std::string& s) {
-  int value = 0;
-  const char* end = s.data() + s.size();
-  const auto [ptr, ec] = std::from_chars(s.data(), end, value);
-  if (s.empty() || ec != std::errc() || ptr != end || value <= 0) {
-    ArchError(arch, "layer '" + layer + "': '" + s + "' is not a positive integer");
-  }
-  return value;
-}
-
-}  // namespace
-
-Sequential BuildFromArchitecture(const std::string& arch, std::mt19937* rng) {
-  if (Trim(arch).empty()) ArchError(arch, "no layers");
-  Sequential net;
-  const std::vector<LayerSpec> specs = ParseArchitecture(arch);
-  for (size_t i = 0; i < specs.size(); ++i) {
-    const LayerSpec& spec = specs[i];
-    const std::string where = "layer " + std::to_string(i) + " '" + spec.name + "'";
-    std::unique_ptr<Layer> layer;
-    if (spec.name == "linear") {
-      if (spec.args.size() != 2) ArchError(arch, where + " needs linear(in,out)");
-      layer = std::make_unique<Linear>(ParsePositiveInt(arch, spec.name, spec.args[0]),
-                                       ParsePositiveInt(arch, spec.name, spec.args[1]), rng);
-    } else if (spec.name == "relu" || spec.name == "tanh") {
-      if (spec.has_parens) ArchError(arch, where + " takes no arguments");
-      if (spec.name == "relu") {
-        layer = std::make_unique<ReLU>();
-      } else {
-        layer = std::make_unique<Tanh>();
-      }
-    } else {
-      ArchError(arch, "unknown " + where + " (known: linear(in,out), relu, tanh)");
-    }
-    try {
-      net.Add(std::move(layer));
-    } catch (const std::invalid_argument& e) {
-      ArchError(arch, e.what());
-    }
-  }
-  return net;
 }
 
 Sequential MakeMlp(int in, const std::vector<int>& hidden, int out, std::mt19937* rng) {

@@ -22,12 +22,33 @@ using Matrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic>;
 /// A float32 column vector (losses, per-sample weights).
 using Vector = Eigen::VectorXf;
 
+/// Images are stored one per column, channel-major: the pixel (channel c, row y, column x) of a
+/// C x H x W image is row (c * H + y) * W + x of its column, as in a flattened PyTorch NCHW
+/// tensor. A batch of B stacks of four 84 x 84 frames is a 28224 x B Matrix.
+struct ImageShape {
+  int channels = 0;  ///< 0 for "not an image".
+  int height = 0;
+  int width = 0;
+
+  int size() const { return channels * height * width; }
+  bool empty() const { return channels == 0; }
+  bool operator==(const ImageShape&) const = default;
+};
+
 /// A trainable tensor and its gradient, both owned by a layer. The pointers stay valid for as long
 /// as the layer lives; the shapes never change after construction.
 struct Param {
   std::string name;  ///< e.g. "0.weight", "2.bias" (layer index in the network, then the tensor).
   Matrix* value;     ///< The parameter.
   Matrix* grad;      ///< Same shape as `value`; layers accumulate into it in Backward().
+};
+
+/// A non-trainable tensor that is part of a layer's state, e.g. the running statistics of a batch
+/// normalisation. Optimizers never see it; Sequential::GetFlat()/SetFlat() and checkpoints carry
+/// it after the parameters.
+struct Buffer {
+  std::string name;  ///< e.g. "1.running_mean" (layer index in the network, then the tensor).
+  Matrix* value;
 };
 
 }  // namespace rl::nn

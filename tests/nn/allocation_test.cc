@@ -1,5 +1,6 @@
 // The learner's update and the actors' single-observation inference must not touch the heap once
 // shapes are stable.
+#include <cstdint>
 #include <random>
 #include <vector>
 
@@ -7,6 +8,8 @@
 
 #include "nn/losses.h"
 #include "nn/optimizers.h"
+#include "nn/pixels.h"
+#include "nn/presets.h"
 #include "nn/sequential.h"
 #include "tests/nn/allocation_counter.h"
 #include "tests/nn/gradient_check.h"
@@ -80,6 +83,61 @@ TEST(AllocationTest, DqnUpdateDoesNotAllocateOnceShapesAreStable) {
   online.Forward(obs);
   online.Backward(grad_q);
   EXPECT_EQ(AllocationCount() - after_warmup, 0);
+}
+
+TEST(AllocationTest, NatureCnnPredictDoesNotAllocateAfterTheFirstCall) {
+  ASSERT_TRUE(AllocationCountingAvailable()) << "this test needs glibc without a sanitizer";
+  std::mt19937 rng(0);
+  Sequential net = MakeNatureCnn(7, &rng);
+  std::vector<float> obs(static_cast<size_t>(net.InputSize()));
+  for (size_t i = 0; i < obs.size(); ++i) obs[i] = static_cast<float>(i % 256) / 255.0f;
+  const int size = net.InputSize();
+  net.Predict(obs.data(), size);
+  const int64_t before = AllocationCount();
+  int sum = 0;
+  sum += net.Argmax(obs.data(), size);
+  sum += static_cast<int>(net.Predict(obs.data(), size)(0, 0) > 0.0f);
+  EXPECT_EQ(AllocationCount() - before, 0) << sum;
+}
+
+// The learner's update of a pixel network: uint8 conversion, both forward passes, backward
+// through convolutions and batch normalisation, centred RMSProp.
+TEST(AllocationTest, GraspCnnUpdateDoesNotAllocateOnceShapesAreStable) {
+  ASSERT_TRUE(AllocationCountingAvailable()) << "this test needs glibc without a sanitizer";
+  std::mt19937 rng(0);
+  constexpr int kBatch = 8;
+  constexpr int kActions = 3;
+  Sequential online = MakeGraspCnn(kActions, &rng);
+  Sequential target = online;
+  target.set_training(false);
+  const std::vector<Param> params = online.Params();
+  RmsProp rmsprop(params, 2.5e-4f, 0.95f, 0.01f, /*centered=*/true);
+  std::vector<uint8_t> pixels(static_cast<size_t>(online.InputSize()) * kBatch);
+  for (size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<uint8_t>(i * 31 % 256);
+  Matrix obs;
+  Vector q_taken(kBatch);
+  Vector td_target(kBatch);
+  Vector grad;
+  Matrix grad_q(kActions, kBatch);
+  auto update = [&] {
+    PixelsToMatrix(pixels.data(), online.InputSize(), kBatch, &obs);
+    const Matrix& q_next = target.Forward(obs);
+    for (int j = 0; j < kBatch; ++j) td_target[j] = 1.0f + 0.99f * q_next.col(j).maxCoeff();
+    const Matrix& q = online.Forward(obs);
+    for (int j = 0; j < kBatch; ++j) q_taken[j] = q(j % kActions, j);
+    HuberLoss(q_taken, td_target, &grad);
+    grad_q.setZero();
+    for (int j = 0; j < kBatch; ++j) grad_q(j % kActions, j) = grad[j];
+    online.ZeroGrad();
+    online.BackwardParams(grad_q);
+    ClipGradNorm(params, 10.0f);
+    rmsprop.Step();
+    target.CopyParamsFrom(online);
+  };
+  update();
+  const int64_t before = AllocationCount();
+  for (int i = 0; i < 3; ++i) update();
+  EXPECT_EQ(AllocationCount() - before, 0);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include "nn/presets.h"
 #include "nn/sequential.h"
 
 namespace rl::nn {
@@ -199,6 +200,31 @@ TEST_F(CheckpointTest, RefusesAnUnknownArchitecture) {
   SaveCheckpoint(path_, ckpt);
   const std::string error = LoadError();
   EXPECT_NE(error.find("invalid architecture"), std::string::npos) << error;
+}
+
+TEST_F(CheckpointTest, ConvNetWithBatchNormRoundTripsIncludingRunningStatistics) {
+  std::mt19937 rng(23);
+  Sequential net = MakeGraspCnn(5, &rng);
+  Matrix x = Matrix::Random(net.InputSize(), 6).cwiseAbs();
+  for (int i = 0; i < 3; ++i) net.Forward(x);
+  Checkpoint ckpt;
+  ckpt.architecture = net.Architecture();
+  net.GetFlat(&ckpt.params);
+  SaveCheckpoint(path_, ckpt);
+
+  const Checkpoint loaded = LoadCheckpoint(path_);
+  ASSERT_EQ(loaded.params.size(), static_cast<size_t>(net.FlatSize()));
+  Sequential restored = BuildFromArchitecture(loaded.architecture, &rng);
+  restored.SetFlat(loaded.params.data(), loaded.params.size());
+  net.set_training(false);
+  restored.set_training(false);
+  EXPECT_EQ(Matrix(restored.Forward(x)), Matrix(net.Forward(x)));
+  EXPECT_EQ(*restored.Buffers()[3].value, *net.Buffers()[3].value);
+
+  // A checkpoint of the parameters without the buffers does not fit the architecture.
+  ckpt.params.resize(static_cast<size_t>(net.NumParams()));
+  SaveCheckpoint(path_, ckpt);
+  EXPECT_THROW(LoadCheckpoint(path_), std::runtime_error);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -12,8 +13,8 @@ namespace {
 
 using testing::RandomMatrix;
 
-// Compares Gemm with Eigen for c (m x n) = op(a) * op(b) (+ bias) over every combination of
-// transposed operands, transposed output, accumulation and bias.
+// Compares Gemm with Eigen for c (m x n) = op(a) * op(b) (+ biases) over every combination of
+// transposed operands, transposed output, accumulation, row bias and column bias.
 void CheckAgainstEigen(int m, int n, int k) {
   std::mt19937 rng(static_cast<unsigned>(m * 10007 + n * 101 + k));
   Vector workspace;
@@ -22,14 +23,16 @@ void CheckAgainstEigen(int m, int n, int k) {
   const Matrix b = RandomMatrix(k, n, &rng);
   const Matrix b_t = b.transpose();
   const Matrix bias = RandomMatrix(m, 1, &rng);
+  const Matrix col_bias = RandomMatrix(n, 1, &rng);
   const Matrix start = RandomMatrix(m, n, &rng);
   const Matrix product = a * b;
-  for (int mode = 0; mode < 32; ++mode) {
+  for (int mode = 0; mode < 64; ++mode) {
     const bool trans_a = (mode & 1) != 0;
     const bool trans_b = (mode & 2) != 0;
     const bool trans_c = (mode & 4) != 0;
     const bool accumulate = (mode & 8) != 0;
     const bool with_bias = (mode & 16) != 0;
+    const bool with_col_bias = (mode & 32) != 0;
     Matrix c = start;
     Matrix c_t = start.transpose();
     const ConstView va = trans_a ? View(a_t).Transposed() : View(a);
@@ -37,9 +40,11 @@ void CheckAgainstEigen(int m, int n, int k) {
     const MutView vc = trans_c ? View(&c_t).Transposed() : View(&c);
     Epilogue epilogue;
     epilogue.row_bias = with_bias ? bias.data() : nullptr;
+    epilogue.col_bias = with_col_bias ? col_bias.data() : nullptr;
     Gemm(va, vb, vc, accumulate, epilogue, &workspace);
     Matrix expected = product;
     if (with_bias) expected.colwise() += bias.col(0);
+    if (with_col_bias) expected.rowwise() += col_bias.col(0).transpose();
     if (accumulate) expected += start;
     const Matrix got = trans_c ? Matrix(c_t.transpose()) : c;
     const float tol = 1e-5f * static_cast<float>(k + 1);
@@ -111,6 +116,38 @@ TEST(GemmTest, EmptySharedDimensionGivesBiasOrKeepsTheAccumulator) {
   Gemm(View(a), View(b), View(&c), /*accumulate=*/false, epilogue, &workspace);
   EXPECT_EQ(c(2, 1), 3.0f);
   EXPECT_EQ(c(0, 0), 1.0f);
+}
+
+// A left operand packed by the caller in the documented layout gives the same product.
+TEST(GemmTest, PrepackedLeftOperandMatchesEigen) {
+  for (const auto& [m, n, k] :
+       {std::array<int, 3>{1, 5, 3}, std::array<int, 3>{24, 8, 9}, std::array<int, 3>{49, 64, 576},
+        std::array<int, 3>{400, 32, 256}, std::array<int, 3>{30, 13, 300}}) {
+    std::mt19937 rng(static_cast<unsigned>(m * 31 + n * 7 + k));
+    Vector workspace;
+    const Matrix a = RandomMatrix(m, k, &rng);
+    const Matrix b = RandomMatrix(k, n, &rng);
+    const Matrix col_bias = RandomMatrix(n, 1, &rng);
+    const int panels = (m + kPanelRows - 1) / kPanelRows;
+    // Rows past m hold garbage, which must not reach c.
+    std::vector<float> packed(static_cast<size_t>(panels) * kPanelRows * k, 1e30f);
+    for (int i = 0; i < m; ++i) {
+      for (int p = 0; p < k; ++p) {
+        const int q = i / kPanelRows;
+        packed[(static_cast<size_t>(q) * k + p) * kPanelRows + i % kPanelRows] = a(i, p);
+      }
+    }
+    Epilogue epilogue;
+    epilogue.col_bias = col_bias.data();
+    epilogue.relu = true;
+    Matrix c(m, n);
+    GemmPacked(packed.data(), m, k, View(b), View(&c), /*accumulate=*/false, epilogue, &workspace);
+    Matrix expected = a * b;
+    expected.rowwise() += col_bias.col(0).transpose();
+    expected = expected.cwiseMax(0.0f);
+    EXPECT_LE((c - expected).cwiseAbs().maxCoeff(), 1e-5f * static_cast<float>(k + 1))
+        << m << "x" << n << "x" << k;
+  }
 }
 
 TEST(AddRowSumsTest, AddsTheSumOfEachRowAcrossTheBatch) {

@@ -298,5 +298,196 @@ TEST(SequentialTest, ZeroGradClearsAllGradients) {
   for (const Param& p : net.Params()) EXPECT_TRUE(p.grad->isZero()) << p.name;
 }
 
+// A small network with every kind of layer: 2 x 7 x 7 images -> 3 Q values.
+constexpr char kConvArch[] =
+    "conv2d(2,4,3,2,1,7,7),batchnorm2d(4,4,4),relu,conv2d(4,3,2,1,0,4,4),relu,flatten,"
+    "layernorm(27),linear(27,8),tanh,dueling(8,5,3)";
+
+TEST(SequentialTest, ArchitecturesWithEveryLayerKindRoundTrip) {
+  std::mt19937 rng(30);
+  const Sequential net = BuildFromArchitecture(kConvArch, &rng);
+  EXPECT_EQ(net.Architecture(), kConvArch);
+  EXPECT_EQ(net.InputSize(), 2 * 7 * 7);
+  EXPECT_EQ(net.OutputSize(), 3);
+  EXPECT_EQ(BuildFromArchitecture(" conv2d( 1, 2, 3, 1, 1, 4, 4 ) , flatten , linear(32,2)", &rng)
+                .Architecture(),
+            "conv2d(1,2,3,1,1,4,4),flatten,linear(32,2)");
+}
+
+TEST(SequentialTest, MalformedConvolutionalArchitecturesThrowWithTheOffendingLayer) {
+  std::mt19937 rng(0);
+  const std::pair<std::string, std::string> cases[] = {
+      {"conv2d(4,32,8,4,0,84)", "needs conv2d(in_channels,out_channels,kernel,stride,padding,"},
+      {"conv2d(4,32,8,4,-1,84,84)", "'-1' is not a non-negative integer"},
+      {"conv2d(4,32,0,4,0,84,84)", "'0' is not a positive integer"},
+      {"conv2d(4,32,90,1,0,84,84)", "kernel is larger than the padded input"},
+      {"batchnorm2d(32,9)", "needs batchnorm2d(channels,height,width)"},
+      {"flatten(1)", "takes no arguments"},
+      {"layernorm()", "needs layernorm(features), got 0 arguments"},
+      {"dueling(10,0,3)", "'0' is not a positive integer"},
+      {"conv2d(1,2,3,1,0,5,5),batchnorm2d(3,3,3)", "expects 27 inputs"},
+      {"conv2d(4,32,8,4,0,84,84),relu,conv2d(16,64,4,2,0,40,20)",
+       "expects 16x40x20 images but the previous layers produce 32x20x20"},
+      {"maxpool(2)", "unknown layer 0 'maxpool' (known: linear(in,out), conv2d("},
+  };
+  for (const auto& [arch, message] : cases) {
+    try {
+      BuildFromArchitecture(arch, &rng);
+      ADD_FAILURE() << "no exception for '" << arch << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos)
+          << "'" << arch << "' gave: " << e.what();
+    }
+  }
+}
+
+TEST(SequentialTest, BuffersFollowTheParametersInGetFlat) {
+  std::mt19937 rng(31);
+  Sequential net = BuildFromArchitecture(kConvArch, &rng);
+  const std::vector<Buffer> buffers = net.Buffers();
+  ASSERT_EQ(buffers.size(), 2u);
+  EXPECT_EQ(buffers[0].name, "1.running_mean");
+  EXPECT_EQ(buffers[1].name, "1.running_var");
+  EXPECT_EQ(net.NumBuffers(), 8);
+  EXPECT_EQ(net.FlatSize(), net.NumParams() + 8);
+  // Params() holds trainable tensors only.
+  for (const Param& p : net.Params()) EXPECT_EQ(p.name.find("running"), std::string::npos);
+
+  // Move the running statistics away from their initial values, then check the flat layout.
+  net.Forward(RandomMatrix(net.InputSize(), 6, &rng));
+  const std::vector<float> flat = Flat(net);
+  ASSERT_EQ(flat.size(), static_cast<size_t>(net.FlatSize()));
+  const auto at = static_cast<size_t>(net.NumParams());
+  for (int c = 0; c < 4; ++c) {
+    EXPECT_EQ(flat[at + c], (*buffers[0].value)(c, 0));
+    EXPECT_EQ(flat[at + 4 + c], (*buffers[1].value)(c, 0));
+  }
+  EXPECT_NE(flat[at], 0.0f);
+
+  // SetFlat restores parameters and buffers; a wrong size names both counts.
+  Sequential other = BuildFromArchitecture(kConvArch, &rng);
+  other.SetFlat(flat.data(), flat.size());
+  EXPECT_EQ(Flat(other), flat);
+  EXPECT_EQ(*other.Buffers()[1].value, *buffers[1].value);
+  try {
+    other.SetFlat(flat.data(), static_cast<size_t>(net.NumParams()));
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("and 8 buffer floats"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SequentialTest, CopyAndSoftUpdateIncludeBuffers) {
+  std::mt19937 rng(32);
+  Sequential online = BuildFromArchitecture(kConvArch, &rng);
+  Sequential target = BuildFromArchitecture(kConvArch, &rng);
+  online.Forward(RandomMatrix(online.InputSize(), 6, &rng));
+  const Matrix online_mean = *online.Buffers()[0].value;
+  target.SoftUpdateFrom(online, 0.5f);
+  EXPECT_TRUE(target.Buffers()[0].value->isApprox(0.5f * online_mean, 1e-6f));
+  target.CopyParamsFrom(online);
+  EXPECT_EQ(Flat(target), Flat(online));
+}
+
+TEST(SequentialTest, EvalModeUsesRunningStatisticsAndPredictAlwaysDoes) {
+  std::mt19937 rng(33);
+  Sequential net = BuildFromArchitecture(kConvArch, &rng);
+  EXPECT_TRUE(net.training());
+  const Matrix batch = RandomMatrix(net.InputSize(), 8, &rng, 2.0f);
+  for (int i = 0; i < 5; ++i) net.Forward(batch);
+  const Matrix one = batch.col(3);
+
+  // Training mode: the statistics of the batch, which for one sample differ from the running
+  // ones, and every forward pass moves the running statistics.
+  const Matrix train_batch_q = net.Forward(batch);
+  const std::vector<float> before = Flat(net);
+  net.set_training(false);
+  EXPECT_FALSE(net.training());
+  const Matrix eval_q = net.Forward(one);
+  EXPECT_EQ(Flat(net), before);
+  EXPECT_GT((eval_q.col(0) - train_batch_q.col(3)).cwiseAbs().maxCoeff(), 1e-4f);
+
+  // Predict() gives the eval-mode result even in training mode, and leaves the buffers alone.
+  net.set_training(true);
+  const Matrix& predicted = net.Predict(one.data(), static_cast<int>(one.size()));
+  EXPECT_TRUE(predicted.isApprox(eval_q, 1e-5f));
+  EXPECT_EQ(Flat(net), before);
+  EXPECT_TRUE(net.training());
+  net.Forward(batch);
+  EXPECT_NE(Flat(net), before);
+
+  // Copies keep the mode.
+  net.set_training(false);
+  const Sequential copy = net;
+  EXPECT_FALSE(copy.training());
+}
+
+// Back-propagates a gathered-action Huber loss through the network with every layer kind.
+TEST(SequentialTest, ConvNetGradientsThroughHuberMatchFiniteDifferences) {
+  std::mt19937 rng(34);
+  Sequential net = BuildFromArchitecture(kConvArch, &rng);
+  const int batch = 5;
+  Matrix x = RandomMatrix(net.InputSize(), batch, &rng, 2.0f);
+  const int actions[batch] = {0, 2, 1, 1, 2};
+  const Vector target = RandomMatrix(batch, 1, &rng, 2.0f);
+  Vector pred(batch);
+  auto loss_with_grad = [&](Vector* grad) {
+    const Matrix& q = net.Forward(x);
+    for (int j = 0; j < batch; ++j) pred[j] = q(actions[j], j);
+    return HuberLoss(pred, target, grad);
+  };
+  auto loss = [&] { return static_cast<double>(loss_with_grad(nullptr)); };
+
+  Vector grad;
+  loss_with_grad(&grad);
+  Matrix grad_q = Matrix::Zero(3, batch);
+  for (int j = 0; j < batch; ++j) grad_q(actions[j], j) = grad[j];
+  net.ZeroGrad();
+  const Matrix dx = net.Backward(grad_q);
+
+  ExpectGradientsClose(dx, NumericalGradient(loss, &x), "input");
+  for (const Param& p : net.Params()) {
+    const Matrix analytic = *p.grad;
+    ExpectGradientsClose(analytic, NumericalGradient(loss, p.value), p.name);
+  }
+}
+
+// ReLUs fused into convolutions, batch normalisation and the dueling head give the same results
+// as running unfused clones layer by layer.
+TEST(SequentialTest, FusedReluInConvNetsGivesTheSameResultsAsSeparateLayers) {
+  std::mt19937 rng(35);
+  for (const std::string& arch :
+       {std::string("conv2d(2,4,3,1,1,6,6),relu,conv2d(4,3,3,2,0,6,6),relu,flatten,linear(12,2)"),
+        std::string("conv2d(2,4,3,2,1,6,6),batchnorm2d(4,3,3),relu,conv2d(4,5,2,1,0,3,3),relu,"
+                    "flatten,relu,dueling(20,6,3)")}) {
+    for (int batch : {2, 9}) {
+      SCOPED_TRACE(arch + " batch " + std::to_string(batch));
+      Sequential net = BuildFromArchitecture(arch, &rng);
+      std::vector<std::unique_ptr<Layer>> layers;
+      for (int i = 0; i < net.num_layers(); ++i) layers.push_back(net.layer(i).Clone());
+      const Matrix x = RandomMatrix(net.InputSize(), batch, &rng);
+      const Matrix grad_out = RandomMatrix(net.OutputSize(), batch, &rng);
+
+      const Matrix* h = &x;
+      for (auto& layer : layers) h = &layer->Forward(*h);
+      const Matrix* g = &grad_out;
+      for (size_t i = layers.size(); i-- > 0;) g = &layers[i]->Backward(*g);
+
+      EXPECT_TRUE(net.Forward(x).isApprox(*h, 1e-5f));
+      net.ZeroGrad();
+      EXPECT_TRUE(net.Backward(grad_out).isApprox(*g, 1e-5f));
+      std::vector<Param> expected;
+      for (auto& layer : layers) {
+        for (const Param& p : layer->Params()) expected.push_back(p);
+      }
+      const std::vector<Param> got = net.Params();
+      ASSERT_EQ(got.size(), expected.size());
+      for (size_t i = 0; i < got.size(); ++i) {
+        EXPECT_TRUE(got[i].grad->isApprox(*expected[i].grad, 1e-4f)) << got[i].name;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rl::nn

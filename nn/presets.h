@@ -1,0 +1,34 @@
+// Ready-made convolutional Q networks for pixel observations (see nn/README.md).
+#pragma once
+
+#include <random>
+#include <string>
+
+#include "nn/sequential.h"
+
+namespace rl::nn {
+
+/// The network of Mnih et al. 2015 ("Human-level control through deep reinforcement learning")
+/// on stacks of four 84 x 84 frames (input 4 x 84 x 84 = 28224 features):
+///   conv2d(4,32,8,4,0,84,84),relu,conv2d(32,64,4,2,0,20,20),relu,
+///   conv2d(64,64,3,1,0,9,9),relu,flatten,linear(3136,512),relu,linear(512,num_actions)
+/// With `dueling` the last two layers become dueling(3136,512,num_actions) (Wang et al. 2016).
+/// Throws std::invalid_argument unless num_actions > 0.
+std::string NatureCnnArchitecture(int num_actions, bool dueling = false);
+/// BuildFromArchitecture(NatureCnnArchitecture(num_actions, dueling), rng). 1,687,719 parameters
+/// for 7 actions.
+Sequential MakeNatureCnn(int num_actions, std::mt19937* rng, bool dueling = false);
+
+/// A smaller network for stacks of `in_channels` 40 x 40 grayscale frames (spatial sizes
+/// 40 -> 9 -> 3 -> 1), with batch normalisation after the first two convolutions:
+///   conv2d(C,32,8,4,0,40,40),batchnorm2d(32,9,9),relu,conv2d(32,64,4,2,0,9,9),
+///   batchnorm2d(64,3,3),relu,conv2d(64,64,3,1,0,3,3),relu,flatten,linear(64,512),relu,
+///   linear(512,num_actions)
+/// With `dueling` the last two layers become dueling(64,512,num_actions). Throws
+/// std::invalid_argument unless num_actions and in_channels are positive.
+std::string GraspCnnArchitecture(int num_actions, int in_channels = 4, bool dueling = false);
+/// BuildFromArchitecture(GraspCnnArchitecture(num_actions, in_channels, dueling), rng).
+Sequential MakeGraspCnn(int num_actions, std::mt19937* rng, int in_channels = 4,
+                        bool dueling = false);
+
+}  // namespace rl::nn
