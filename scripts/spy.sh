@@ -16,7 +16,7 @@ while [ $# -gt 0 ]; do
     --lcm-url) url="$2"; shift ;;
     --bulk) bulk=1 ;;
     --build-dir) build_dir="$2"; shift ;;
-    -h|--help) sed -n '2,10p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "spy.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
   shift
