@@ -10,6 +10,7 @@
 #include "envs/cartpole.h"
 #include "envs/raster.h"
 #include "envs/registry.h"
+#include "tests/envs/image_testing.h"
 
 namespace rl::envs {
 namespace {
@@ -19,42 +20,9 @@ constexpr Rgb kBlack{0, 0, 0};
 constexpr Rgb kPole{202, 152, 101};
 constexpr Rgb kAxle{129, 132, 203};
 
-// A rendered RGB image with pixel access.
-struct Image {
-  std::vector<uint8_t> rgb;
-  int width = 0;
-  int height = 0;
-
-  Rgb at(int x, int y) const {
-    const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 3;
-    return Rgb{rgb[i], rgb[i + 1], rgb[i + 2]};
-  }
-};
-
-// Mean column and row of the pixels of one colour, and their count; optionally skipping a row.
-struct Blob {
-  int count = 0;
-  double mean_x = 0;
-  double mean_y = 0;
-};
-Blob FindColor(const Image& image, Rgb color, int skip_row = -1) {
-  Blob blob;
-  for (int y = 0; y < image.height; ++y) {
-    if (y == skip_row) continue;
-    for (int x = 0; x < image.width; ++x) {
-      if (image.at(x, y) == color) {
-        ++blob.count;
-        blob.mean_x += x;
-        blob.mean_y += y;
-      }
-    }
-  }
-  if (blob.count > 0) {
-    blob.mean_x /= blob.count;
-    blob.mean_y /= blob.count;
-  }
-  return blob;
-}
+using testing::Blob;
+using testing::FindColor;
+using testing::Image;
 
 Image RenderState(const std::array<double, 4>& state) {
   CartPole env;

@@ -8,6 +8,7 @@
 #include "envs/box2d/lunar_lander.h"
 #include "envs/raster.h"
 #include "envs/registry.h"
+#include "tests/envs/image_testing.h"
 
 namespace rl::envs {
 namespace {
@@ -18,41 +19,9 @@ constexpr Rgb kLanderFill{128, 102, 230};
 constexpr Rgb kLanderOutline{77, 77, 128};
 constexpr Rgb kFlag{204, 204, 0};
 
-// A rendered RGB image with pixel access.
-struct Image {
-  std::vector<uint8_t> rgb;
-  int width = 0;
-  int height = 0;
-
-  Rgb at(int x, int y) const {
-    const std::size_t i = (static_cast<std::size_t>(y) * width + x) * 3;
-    return Rgb{rgb[i], rgb[i + 1], rgb[i + 2]};
-  }
-};
-
-// Count and mean position of the pixels of one colour.
-struct Blob {
-  int count = 0;
-  double mean_x = 0;
-  double mean_y = 0;
-};
-Blob FindColor(const Image& image, Rgb color) {
-  Blob blob;
-  for (int y = 0; y < image.height; ++y) {
-    for (int x = 0; x < image.width; ++x) {
-      if (image.at(x, y) == color) {
-        ++blob.count;
-        blob.mean_x += x;
-        blob.mean_y += y;
-      }
-    }
-  }
-  if (blob.count > 0) {
-    blob.mean_x /= blob.count;
-    blob.mean_y /= blob.count;
-  }
-  return blob;
-}
+using testing::Blob;
+using testing::FindColor;
+using testing::Image;
 
 Image RenderAt(LunarLander& env, const LanderKinematics& k) {
   env.SetLanderKinematics(k);
