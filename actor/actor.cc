@@ -1,5 +1,6 @@
 #include "actor/actor.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <numeric>
 #include <stdexcept>
@@ -44,13 +45,28 @@ Actor::Actor(ActorConfig config, Bus* bus)
       throw std::invalid_argument(config_.env_id +
                                   " has continuous actions; the DQN actor needs discrete ones");
     }
-    obs_size_ = env->spec().observation_size;
-    num_actions_ = env->spec().num_actions;
+    const envs::EnvSpec& spec = env->spec();
+    obs_size_ = spec.observation_size;
+    num_actions_ = spec.num_actions;
+    pixels_ = spec.frame_stack > 0;
     env->Reset(TrainingSeed(config_.seed, config_.actor_id, j));
     auto o = env->observation();
+    // A pixel env's transitions are frame ids: the float accumulator only needs a token size.
+    const int nstep_size = pixels_ ? 1 : obs_size_;
+    const int stack = std::max(1, spec.frame_stack);
     slots_.push_back(EnvSlot{std::move(env), std::vector<float>(o.begin(), o.end()),
-                             NStepAccumulator(config_.n_step, config_.gamma, obs_size_), 0.0, 0});
+                             NStepAccumulator(config_.n_step, config_.gamma, nstep_size), 0.0, 0,
+                             std::vector<int64_t>(static_cast<size_t>(stack)),
+                             std::vector<int64_t>(static_cast<size_t>(stack)),
+                             FrameNStepAccumulator(config_.n_step, config_.gamma, stack)});
+    if (pixels_) {
+      pixel_batch_.height = spec.frame_height;
+      pixel_batch_.width = spec.frame_width;
+      pixel_batch_.stack = spec.frame_stack;
+      StartStack(&slots_.back());
+    }
   }
+  pixel_batch_.actor_id = config_.actor_id;
   random_action_ = std::uniform_int_distribution<int>(0, num_actions_ - 1);
   epsilon_ = config_.exploration.Epsilon(config_.actor_id, config_.num_actors, 0);
   annealed_ = config_.exploration.mode == "linear";
@@ -114,15 +130,71 @@ void Actor::PublishBatch() {
   batch_.priority.clear();
 }
 
+int64_t Actor::AddFrame(const envs::Env& env) {
+  const std::span<const uint8_t> f = env.frame();
+  pixel_batch_.frames.insert(pixel_batch_.frames.end(), f.begin(), f.end());
+  pixel_batch_.frame_id.push_back(next_frame_id_);
+  return next_frame_id_++;
+}
+
+void Actor::StartStack(EnvSlot* s) {
+  // The env repeats its first frame to fill the stack; the ids say the same.
+  const int64_t id = AddFrame(*s->env);
+  std::fill(s->stack_ids.begin(), s->stack_ids.end(), id);
+}
+
+void Actor::AppendPixels(const FrameTransition& t, int64_t episode_id) {
+  pixel_batch_.obs_frames.insert(pixel_batch_.obs_frames.end(), t.obs.begin(), t.obs.end());
+  pixel_batch_.next_obs_frames.insert(pixel_batch_.next_obs_frames.end(), t.next_obs.begin(),
+                                      t.next_obs.end());
+  pixel_batch_.action.push_back(t.action);
+  pixel_batch_.reward.push_back(t.reward);
+  pixel_batch_.discount.push_back(t.discount);
+  pixel_batch_.episode_id.push_back(episode_id);
+  pixel_batch_.priority.push_back(0.0f);
+  if (static_cast<int>(pixel_batch_.action.size()) >= config_.batch_size) PublishPixelBatch();
+}
+
+void Actor::PublishPixelBatch() {
+  rlmsg::pixel_batch_t& b = pixel_batch_;
+  b.num_frames = static_cast<int32_t>(b.frame_id.size());
+  b.num_bytes = static_cast<int32_t>(b.frames.size());
+  b.count = static_cast<int32_t>(b.action.size());
+  b.num_refs = static_cast<int32_t>(b.obs_frames.size());
+  if (b.count == 0 && b.num_frames == 0) return;
+  bus_->Publish(channels::kPixelTransitions, &b);
+  published_ += b.count;
+  b.frame_id.clear();
+  b.frames.clear();
+  b.obs_frames.clear();
+  b.next_obs_frames.clear();
+  b.action.clear();
+  b.reward.clear();
+  b.discount.clear();
+  b.episode_id.clear();
+  b.priority.clear();
+}
+
 int Actor::StepEnvs() {
   for (EnvSlot& s : slots_) {
     const int action = SelectAction(s.obs);
     const envs::StepResult r = s.env->Step(action);
     const std::span<const float> next = s.env->observation();
     s.episode_return += r.reward;
+    const double reward = config_.clip_rewards ? std::clamp(r.reward, -1.0, 1.0) : r.reward;
     const int64_t episode_id = s.episode_id;
-    s.nstep.Add(s.obs, action, r.reward, next, r.terminated, r.truncated,
-                [this, episode_id](const Transition& t) { Append(t, episode_id); });
+    if (pixels_) {
+      // The new stack: the old one shifted by one, then the new frame.
+      std::copy(s.stack_ids.begin() + 1, s.stack_ids.end(), s.next_stack_ids.begin());
+      s.next_stack_ids.back() = AddFrame(*s.env);
+      s.frame_nstep.Add(
+          s.stack_ids, action, reward, s.next_stack_ids, r.terminated, r.truncated,
+          [this, episode_id](const FrameTransition& t) { AppendPixels(t, episode_id); });
+      s.stack_ids.swap(s.next_stack_ids);
+    } else {
+      s.nstep.Add(s.obs, action, reward, next, r.terminated, r.truncated,
+                  [this, episode_id](const Transition& t) { Append(t, episode_id); });
+    }
     if (r.terminated || r.truncated) {
       recent_returns_.push_back(s.episode_return);
       if (recent_returns_.size() > 100) recent_returns_.pop_front();
@@ -132,6 +204,7 @@ int Actor::StepEnvs() {
       s.env->Reset();
       const std::span<const float> o = s.env->observation();
       s.obs.assign(o.begin(), o.end());
+      if (pixels_) StartStack(&s);
     } else {
       s.obs.assign(next.begin(), next.end());
     }
@@ -199,7 +272,11 @@ void Actor::Run() {
       next_log = now + 5.0;
     }
   }
-  PublishBatch();
+  if (pixels_) {
+    PublishPixelBatch();
+  } else {
+    PublishBatch();
+  }
   PublishStats();
 }
 

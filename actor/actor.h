@@ -1,5 +1,8 @@
 // Actor: runs environments with an epsilon-greedy policy and publishes their transitions.
 //
+// Pixel envs (EnvSpec::frame_stack > 0) publish pixel_batch_t on RL_PIXEL_TRANSITIONS instead:
+// every frame once, with an actor-local id, and transitions that name their stacks by frame id.
+//
 // It steps envs_per_actor environments in turn, acts with the newest complete weights version
 // from the learner (uniformly at random until the first one arrives), turns steps into n-step
 // transitions and publishes them in batches on RL_TRANSITIONS. While the replay's rate limiter
@@ -21,6 +24,7 @@
 #include "common/lcm_bus.h"
 #include "envs/env.h"
 #include "nn/sequential.h"
+#include "rlmsg/pixel_batch_t.hpp"
 #include "rlmsg/transition_batch_t.hpp"
 
 namespace rl::actor {
@@ -37,6 +41,7 @@ struct ActorConfig {
   ExplorationConfig exploration;       // how epsilon is chosen
   double stats_hz = 4.0;               // stats messages per second
   int64_t max_steps = 0;               // stop after this many env steps (0: run until stopped)
+  bool clip_rewards = false;           // clamp each step's reward to [-1, 1] in transitions
 
   // Throws std::invalid_argument naming the bad field.
   void Validate() const;
@@ -75,12 +80,23 @@ class Actor {
     NStepAccumulator nstep;
     double episode_return = 0;
     int64_t episode_id = 0;
+    // Pixel envs: ids of the frames of the current stack (oldest first), and their n-step
+    // accumulator.
+    std::vector<int64_t> stack_ids;
+    std::vector<int64_t> next_stack_ids;
+    FrameNStepAccumulator frame_nstep;
   };
 
   int SelectAction(const std::vector<float>& obs);
   void OnWeights(const rlmsg::weights_chunk_t& chunk);
   void Append(const Transition& t, int64_t episode_id);
   void PublishBatch();
+  // Pixel envs: queues the env's newest frame and returns its id.
+  int64_t AddFrame(const envs::Env& env);
+  // Pixel envs: starts the stack of a freshly reset env.
+  void StartStack(EnvSlot* s);
+  void AppendPixels(const FrameTransition& t, int64_t episode_id);
+  void PublishPixelBatch();
 
   ActorConfig config_;
   Bus* bus_;
@@ -104,6 +120,9 @@ class Actor {
   int64_t published_ = 0;
   std::deque<double> recent_returns_;  // last 100 episode returns
   rlmsg::transition_batch_t batch_{};
+  bool pixels_ = false;  // the env gives frames (pixel_batch_t)
+  int64_t next_frame_id_ = 0;
+  rlmsg::pixel_batch_t pixel_batch_{};
 
   double stats_last_time_ = 0;
   int64_t stats_last_steps_ = 0;

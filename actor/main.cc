@@ -41,6 +41,9 @@ int Main(int argc, char** argv) {
        "linear: steps from start to end")  //
       ("stats-hz", rl::po::value(&c.stats_hz)->default_value(c.stats_hz),
        "stats messages per second")  //
+      ("clip-rewards", rl::po::value(&c.clip_rewards)->default_value(c.clip_rewards),
+       "clamp rewards to [-1, 1] in transitions, as Mnih et al. 2015 (1/0; returns in the stats "
+       "stay unclipped)")  //
       ("max-steps", rl::po::value(&c.max_steps)->default_value(c.max_steps),
        "stop after this many env steps (0: until stopped)");
   rl::po::variables_map vm;

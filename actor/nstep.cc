@@ -6,7 +6,8 @@
 
 namespace rl::actor {
 
-NStepAccumulator::NStepAccumulator(int n, double gamma, int obs_size)
+template <class T>
+BasicNStepAccumulator<T>::BasicNStepAccumulator(int n, double gamma, int obs_size)
     : n_(n), gamma_(gamma), obs_size_(obs_size) {
   if (n < 1) throw std::invalid_argument("n-step must be >= 1");
   if (!(gamma >= 0.0 && gamma <= 1.0)) throw std::invalid_argument("gamma must be in [0, 1]");
@@ -16,9 +17,10 @@ NStepAccumulator::NStepAccumulator(int n, double gamma, int obs_size)
   for (Pending& p : steps_) p.obs.resize(static_cast<size_t>(obs_size));
 }
 
-void NStepAccumulator::Add(std::span<const float> obs, int action, double reward,
-                           std::span<const float> next_obs, bool terminated, bool truncated,
-                           const Sink& sink) {
+template <class T>
+void BasicNStepAccumulator<T>::Add(std::span<const T> obs, int action, double reward,
+                                   std::span<const T> next_obs, bool terminated, bool truncated,
+                                   const Sink& sink) {
   if (static_cast<int>(obs.size()) != obs_size_ || static_cast<int>(next_obs.size()) != obs_size_) {
     throw std::invalid_argument("observation size differs from the accumulator's");
   }
@@ -36,7 +38,8 @@ void NStepAccumulator::Add(std::span<const float> obs, int action, double reward
   }
 }
 
-void NStepAccumulator::EmitOldest(bool bootstrap, const Sink& sink) {
+template <class T>
+void BasicNStepAccumulator<T>::EmitOldest(bool bootstrap, const Sink& sink) {
   double ret = 0.0;
   double scale = 1.0;
   for (int k = 0; k < count_; ++k) {
@@ -44,7 +47,7 @@ void NStepAccumulator::EmitOldest(bool bootstrap, const Sink& sink) {
     scale *= gamma_;
   }
   // scale is now gamma^k with k the number of pending steps.
-  Transition t;
+  BasicTransition<T> t;
   t.obs = At(0).obs;
   t.action = At(0).action;
   t.reward = static_cast<float>(ret);
@@ -54,5 +57,8 @@ void NStepAccumulator::EmitOldest(bool bootstrap, const Sink& sink) {
   head_ = (head_ + 1) % n_;
   --count_;
 }
+
+template class BasicNStepAccumulator<float>;
+template class BasicNStepAccumulator<int64_t>;
 
 }  // namespace rl::actor

@@ -5,31 +5,37 @@
 // emitted with d_t = 0; at a time-limit truncation (not a terminal) every pending step is emitted
 // with k the steps left before the cut and d_t = gamma^k, bootstrapping from the last
 // observation. With n = 1 this is the one-step transition of DQN.
+//
+// Observations are float vectors (BasicNStepAccumulator<float>, flat envs) or, for pixel envs,
+// the frame ids of a stack (BasicNStepAccumulator<int64_t>): the frames themselves travel once.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <span>
 #include <vector>
 
 namespace rl::actor {
 
-struct Transition {
-  std::span<const float> obs;
+template <class T>
+struct BasicTransition {
+  std::span<const T> obs;
   int action = 0;
   float reward = 0;    // n-step discounted return
   float discount = 0;  // gamma^k, or 0 after a termination
-  std::span<const float> next_obs;
+  std::span<const T> next_obs;
 };
 
-class NStepAccumulator {
+template <class T>
+class BasicNStepAccumulator {
  public:
-  using Sink = std::function<void(const Transition&)>;
+  using Sink = std::function<void(const BasicTransition<T>&)>;
 
-  NStepAccumulator(int n, double gamma, int obs_size);
+  BasicNStepAccumulator(int n, double gamma, int obs_size);
 
   // Records the step taken from `obs` with `action`, which gave `reward` and `next_obs`, and
   // emits every transition that is now complete.
-  void Add(std::span<const float> obs, int action, double reward, std::span<const float> next_obs,
+  void Add(std::span<const T> obs, int action, double reward, std::span<const T> next_obs,
            bool terminated, bool truncated, const Sink& sink);
 
   // Steps waiting for their n-step return.
@@ -38,7 +44,7 @@ class NStepAccumulator {
  private:
   // A ring of n preallocated steps, so that stepping allocates nothing.
   struct Pending {
-    std::vector<float> obs;
+    std::vector<T> obs;
     int action = 0;
     double reward = 0;
   };
@@ -53,7 +59,15 @@ class NStepAccumulator {
   std::vector<Pending> steps_;
   int head_ = 0;   // oldest pending step
   int count_ = 0;  // pending steps
-  std::vector<float> next_obs_;
+  std::vector<T> next_obs_;
 };
+
+extern template class BasicNStepAccumulator<float>;
+extern template class BasicNStepAccumulator<int64_t>;
+
+using Transition = BasicTransition<float>;
+using NStepAccumulator = BasicNStepAccumulator<float>;
+using FrameTransition = BasicTransition<int64_t>;
+using FrameNStepAccumulator = BasicNStepAccumulator<int64_t>;
 
 }  // namespace rl::actor

@@ -110,6 +110,57 @@ const char* Prescan(const rlmsg::sample_batch_t*, const uint8_t* data, size_t si
   return Finish(r);
 }
 
+const char* Prescan(const rlmsg::pixel_batch_t*, const uint8_t* data, size_t size) {
+  Reader r(data, size);
+  r.Skip(8);
+  r.Header();
+  r.Skip(16);  // actor_id, height, width, stack
+  const int64_t num_frames = r.ReadInt(4);
+  r.Array(num_frames, 8);  // frame_id
+  const int64_t num_bytes = r.ReadInt(4);
+  r.Array(num_bytes, 1);  // frames
+  const int64_t count = r.ReadInt(4);
+  const int64_t num_refs = r.ReadInt(4);
+  r.Array(num_refs, 8);  // obs_frames
+  r.Array(num_refs, 8);  // next_obs_frames
+  r.Array(count, 4);     // action
+  r.Array(count, 4);     // reward
+  r.Array(count, 4);     // discount
+  r.Array(count, 8);     // episode_id
+  r.Array(count, 4);     // priority
+  return Finish(r);
+}
+
+const char* Prescan(const rlmsg::pixel_sample_batch_t*, const uint8_t* data, size_t size) {
+  Reader r(data, size);
+  r.Skip(8);
+  r.Header();
+  r.String();  // requester
+  r.Skip(8);   // request_id
+  r.Skip(12);  // height, width, stack
+  const int64_t count = r.ReadInt(4);
+  const int64_t num_bytes = r.ReadInt(4);
+  r.Array(num_bytes, 1);  // obs
+  r.Array(num_bytes, 1);  // next_obs
+  r.Array(count, 4);      // action
+  r.Array(count, 4);      // reward
+  r.Array(count, 4);      // discount
+  r.Array(count, 8);      // index
+  r.Array(count, 4);      // weight
+  r.Skip(16);             // replay_size, total_inserts
+  return Finish(r);
+}
+
+const char* Prescan(const rlmsg::priority_update_t*, const uint8_t* data, size_t size) {
+  Reader r(data, size);
+  r.Skip(8);
+  r.Header();
+  const int64_t count = r.ReadInt(4);
+  r.Array(count, 8);  // index
+  r.Array(count, 4);  // priority
+  return Finish(r);
+}
+
 const char* Prescan(const rlmsg::weights_chunk_t*, const uint8_t* data, size_t size) {
   Reader r(data, size);
   r.Skip(8);
@@ -137,6 +188,68 @@ const char* Validate(const rlmsg::transition_batch_t& m) {
     const float d = m.discount[static_cast<size_t>(i)];
     if (d < 0.0f || d > 1.0f) return "discount outside [0, 1]";
     if (m.priority[static_cast<size_t>(i)] < 0.0f) return "negative priority";
+  }
+  return nullptr;
+}
+
+namespace {
+
+// Frame geometry of pixel messages: positive and small enough that products cannot overflow.
+bool GeometryOk(int32_t height, int32_t width, int32_t stack) {
+  return height > 0 && width > 0 && stack > 0 && height <= 4096 && width <= 4096 && stack <= 64;
+}
+
+// Actions, discounts and priorities of `count` transitions.
+const char* CheckTransitions(const std::vector<int32_t>& action, const std::vector<float>& discount,
+                             const std::vector<float>& priority) {
+  for (int32_t a : action) {
+    if (a < 0) return "negative action";
+  }
+  for (float d : discount) {
+    if (d < 0.0f || d > 1.0f) return "discount outside [0, 1]";
+  }
+  for (float p : priority) {
+    if (p < 0.0f) return "negative priority";
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+const char* Validate(const rlmsg::pixel_batch_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (m.actor_id < 0) return "negative actor_id";
+  if (!GeometryOk(m.height, m.width, m.stack)) return "bad frame geometry";
+  if (m.num_frames < 0 || m.count < 0 || m.num_frames + m.count == 0) return "empty batch";
+  if (int64_t{m.num_frames} * m.height * m.width != m.num_bytes) return "num_bytes mismatch";
+  if (int64_t{m.count} * m.stack != m.num_refs) return "num_refs mismatch";
+  for (size_t i = 1; i < m.frame_id.size(); ++i) {
+    if (m.frame_id[i] <= m.frame_id[i - 1]) return "frame ids not increasing";
+  }
+  if (!m.frame_id.empty() && m.frame_id.front() < 0) return "negative frame id";
+  if (!AllFinite(m.reward) || !AllFinite(m.discount) || !AllFinite(m.priority)) {
+    return "non-finite value";
+  }
+  return CheckTransitions(m.action, m.discount, m.priority);
+}
+
+const char* Validate(const rlmsg::pixel_sample_batch_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (!GeometryOk(m.height, m.width, m.stack)) return "bad frame geometry";
+  if (m.count <= 0) return "empty batch";
+  if (int64_t{m.count} * m.stack * m.height * m.width != m.num_bytes) return "num_bytes mismatch";
+  if (!AllFinite(m.reward) || !AllFinite(m.discount) || !AllFinite(m.weight)) {
+    return "non-finite value";
+  }
+  return CheckTransitions(m.action, m.discount, {});
+}
+
+const char* Validate(const rlmsg::priority_update_t& m) {
+  if (!HeaderOk(m.header)) return "bad header";
+  if (m.count <= 0) return "empty update";
+  for (size_t i = 0; i < m.priority.size(); ++i) {
+    if (!std::isfinite(m.priority[i]) || m.priority[i] < 0.0f) return "bad priority";
+    if (m.index[i] < 0) return "negative index";
   }
   return nullptr;
 }

@@ -13,6 +13,9 @@
 #include "rlmsg/checkpoint_t.hpp"
 #include "rlmsg/eval_result_t.hpp"
 #include "rlmsg/flow_control_t.hpp"
+#include "rlmsg/pixel_batch_t.hpp"
+#include "rlmsg/pixel_sample_batch_t.hpp"
+#include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
 #include "rlmsg/stats_actor_t.hpp"
@@ -30,6 +33,9 @@ inline constexpr int64_t kMaxArrayElements = 64 * 1024 * 1024;
 const char* Prescan(const rlmsg::transition_batch_t*, const uint8_t* data, size_t size);
 const char* Prescan(const rlmsg::sample_batch_t*, const uint8_t* data, size_t size);
 const char* Prescan(const rlmsg::weights_chunk_t*, const uint8_t* data, size_t size);
+const char* Prescan(const rlmsg::pixel_batch_t*, const uint8_t* data, size_t size);
+const char* Prescan(const rlmsg::pixel_sample_batch_t*, const uint8_t* data, size_t size);
+const char* Prescan(const rlmsg::priority_update_t*, const uint8_t* data, size_t size);
 // Messages whose only variable part is strings: lcm-gen's decoder checks string lengths, but a
 // zero or negative length makes it throw; the bus catches that, so no prescan is needed.
 template <class Msg>
@@ -41,6 +47,9 @@ const char* Validate(const rlmsg::transition_batch_t& m);
 const char* Validate(const rlmsg::sample_request_t& m);
 const char* Validate(const rlmsg::sample_batch_t& m);
 const char* Validate(const rlmsg::weights_chunk_t& m);
+const char* Validate(const rlmsg::pixel_batch_t& m);
+const char* Validate(const rlmsg::pixel_sample_batch_t& m);
+const char* Validate(const rlmsg::priority_update_t& m);
 const char* Validate(const rlmsg::checkpoint_t& m);
 const char* Validate(const rlmsg::flow_control_t& m);
 const char* Validate(const rlmsg::eval_result_t& m);

@@ -12,6 +12,8 @@ StepResult Env::StepContinuous(std::span<const float> /*action*/) {
   throw std::logic_error("discrete env");
 }
 
+std::span<const uint8_t> Env::frame() const { throw std::logic_error("not a pixel env"); }
+
 void Env::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
   RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
   if (width <= 0 || height <= 0) {

@@ -30,6 +30,14 @@ struct EnvSpec {
   int action_dim = 0;       // Size of a continuous action vector; 0 for discrete envs.
   float action_low = 0;     // Bounds of every component of a continuous action (a box); the env
   float action_high = 0;    // clips values outside them. Both 0 for discrete envs.
+  // Pixel envs (frame_stack > 0): observation() is the stack of the last frame_stack grayscale
+  // frames of frame_height x frame_width pixels, oldest first, each pixel divided by 255, so
+  // observation_size == frame_stack * frame_height * frame_width; frame() is the newest frame as
+  // bytes. After a reset the stack holds the first frame frame_stack times (never frames of the
+  // previous episode). All three are 0 for envs with flat observations.
+  int frame_height = 0;
+  int frame_width = 0;
+  int frame_stack = 0;
 };
 
 /// One environment instance. Not thread-safe: an instance is used by one thread at a time. Each
@@ -59,6 +67,11 @@ class Env {
 
   /// Current observation (observation_size float32 values). Valid until the next Reset or Step.
   virtual std::span<const float> observation() const = 0;
+
+  /// Pixel envs only: the newest grayscale frame, frame_height x frame_width bytes, row-major
+  /// (the last frame of the stack in observation(), before the division by 255). Valid until the
+  /// next Reset or Step. The default (for flat envs) throws std::logic_error("not a pixel env").
+  virtual std::span<const uint8_t> frame() const;
 
   /// Renders the current state at the env's native size as RGB bytes, row-major, top row first,
   /// height x width x 3. Resizes *rgb and writes the size to *width and *height.

@@ -7,6 +7,8 @@
 
 #include "envs/box2d/lunar_lander.h"
 #include "envs/cartpole.h"
+#include "envs/catch.h"
+#include "envs/pixel_spec.h"
 #include "envs/time_limit.h"
 
 namespace rl::envs {
@@ -32,11 +34,19 @@ constexpr std::array kRegistrations = {
                    return std::make_unique<TimeLimit>(
                        std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true}), 1000);
                  }},
+    // Every Catch episode ends after 9 steps, so the limit never cuts one short: it only marks
+    // the terminating step truncated as well (terminated still means no bootstrapping).
+    Registration{"Catch-v0",
+                 []() -> std::unique_ptr<Env> {
+                   return std::make_unique<TimeLimit>(std::make_unique<Catch>(), 9);
+                 }},
 };
 
 }  // namespace
 
 std::unique_ptr<Env> MakeEnv(const std::string& id) {
+  const EnvIdParts parts = ParseEnvId(id);
+  if (parts.pixels) return MakePixelEnv(MakeEnv(parts.base), parts.image);
   for (const Registration& r : kRegistrations) {
     if (r.id == id) return r.make();
   }

@@ -11,8 +11,9 @@ namespace rl::envs {
 
 /// Creates a fresh, not yet reset env for a registered id. "CartPole-v1" gives
 /// TimeLimit(CartPole, 500); "LunarLander-v3" and "LunarLanderContinuous-v3" give
-/// TimeLimit(LunarLander, 1000). Throws std::invalid_argument naming the known ids for an unknown
-/// id.
+/// TimeLimit(LunarLander, 1000); "Catch-v0" gives TimeLimit(Catch, 9). An id followed by
+/// "+pixels(...)" gives that env behind the image pipeline (see pixel_spec.h). Throws
+/// std::invalid_argument naming the known ids for an unknown id, or naming a bad pixels setting.
 std::unique_ptr<Env> MakeEnv(const std::string& id);
 
 /// The registered ids, sorted.

@@ -2,12 +2,16 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "nn/losses.h"
+#include "nn/pixels.h"
+#include "nn/presets.h"
 
 namespace rl::learner {
 
 void DqnConfig::Validate() const {
+  if (network.empty()) throw std::invalid_argument("network must not be empty");
   if (hidden.empty()) throw std::invalid_argument("hidden: at least one hidden layer");
   for (int h : hidden) {
     if (h < 1) throw std::invalid_argument("hidden: widths must be >= 1");
@@ -24,11 +28,52 @@ void DqnConfig::Validate() const {
   if (!(max_grad_norm >= 0)) throw std::invalid_argument("max-grad-norm must be >= 0");
 }
 
+std::string QNetworkArchitecture(const DqnConfig& config, int obs_size, int num_actions) {
+  const auto fail = [&](const std::string& why) {
+    return std::invalid_argument("network '" + config.network + "': " + why);
+  };
+  if (obs_size < 1 || num_actions < 1) throw fail("needs observations and actions");
+  if (config.network == "mlp") {
+    std::string arch;
+    int in = obs_size;
+    const size_t n = config.hidden.size();
+    // With dueling, the last hidden width is the streams' own hidden layer.
+    for (size_t i = 0; i + (config.dueling ? 1 : 0) < n; ++i) {
+      arch += "linear(" + std::to_string(in) + "," + std::to_string(config.hidden[i]) + "),relu,";
+      in = config.hidden[i];
+    }
+    if (config.dueling) {
+      return arch + "dueling(" + std::to_string(in) + "," + std::to_string(config.hidden.back()) +
+             "," + std::to_string(num_actions) + ")";
+    }
+    return arch + "linear(" + std::to_string(in) + "," + std::to_string(num_actions) + ")";
+  }
+  if (config.network == "nature") {
+    if (obs_size != 4 * 84 * 84) throw fail("takes 4 x 84 x 84 observations");
+    return nn::NatureCnnArchitecture(num_actions, config.dueling);
+  }
+  if (config.network == "grasp") {
+    if (obs_size % (40 * 40) != 0) throw fail("takes stacks of 40 x 40 frames");
+    return nn::GraspCnnArchitecture(num_actions, obs_size / (40 * 40), config.dueling);
+  }
+  if (config.network.find('(') == std::string::npos) {
+    throw fail("expected mlp, nature, grasp or an architecture string");
+  }
+  if (config.dueling) throw fail("dueling applies to mlp, nature and grasp; write dueling(...)");
+  return config.network;
+}
+
 Dqn::Dqn(int obs_size, int num_actions, DqnConfig config)
     : config_(std::move(config)), obs_size_(obs_size), num_actions_(num_actions) {
   config_.Validate();
   std::mt19937 rng(static_cast<std::mt19937::result_type>(config_.seed));
-  online_ = nn::MakeMlp(obs_size, config_.hidden, num_actions, &rng);
+  online_ = nn::BuildFromArchitecture(QNetworkArchitecture(config_, obs_size, num_actions), &rng);
+  if (online_.InputSize() != obs_size || online_.OutputSize() != num_actions) {
+    throw std::invalid_argument("network '" + config_.network + "' takes " +
+                                std::to_string(online_.InputSize()) + " inputs and gives " +
+                                std::to_string(online_.OutputSize()) + " outputs; the env has " +
+                                std::to_string(obs_size) + " and " + std::to_string(num_actions));
+  }
   target_ = online_;
   target_.set_training(false);  // the target network uses running statistics (BatchNorm)
   params_ = online_.Params();
@@ -46,8 +91,15 @@ UpdateResult Dqn::Update(const BatchView& b) {
   if (b.obs_size != obs_size_) throw std::invalid_argument("batch observation size mismatch");
   if (b.count < 1) throw std::invalid_argument("empty batch");
   const int n = b.count;
-  obs_ = Eigen::Map<const nn::Matrix>(b.obs, obs_size_, n);
-  next_obs_ = Eigen::Map<const nn::Matrix>(b.next_obs, obs_size_, n);
+  if (b.obs_pixels != nullptr && b.next_obs_pixels != nullptr) {
+    nn::PixelsToMatrix(b.obs_pixels, obs_size_, n, &obs_);
+    nn::PixelsToMatrix(b.next_obs_pixels, obs_size_, n, &next_obs_);
+  } else if (b.obs != nullptr && b.next_obs != nullptr) {
+    obs_ = Eigen::Map<const nn::Matrix>(b.obs, obs_size_, n);
+    next_obs_ = Eigen::Map<const nn::Matrix>(b.next_obs, obs_size_, n);
+  } else {
+    throw std::invalid_argument("batch without observations");
+  }
 
   // Targets y = r + discount * Q_target(s', a*), a* = argmax of the online (Double DQN) or
   // target network. The online network's forward on s' comes first, because the forward on s

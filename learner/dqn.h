@@ -18,13 +18,18 @@
 namespace rl::learner {
 
 struct DqnConfig {
+  // The Q network: "mlp" (widths in `hidden`), "nature" (Mnih et al. 2015, 4 x 84 x 84 input),
+  // "grasp" (stacks of 40 x 40 frames), or an architecture string as nn::BuildFromArchitecture
+  // reads it ("conv2d(2,16,3,1,0,10,5),relu,flatten,...").
+  std::string network = "mlp";
   std::vector<int> hidden = {120, 84};  // hidden layer widths of the MLP (ReLU between layers)
-  std::string optimizer = "adam";       // "adam" or "rmsprop"
-  float learning_rate = 1e-3f;          // step size
-  float adam_eps = 1e-8f;               // Adam's epsilon
-  float rmsprop_alpha = 0.95f;          // RMSProp smoothing (DeepMind: 0.95)
-  float rmsprop_eps = 0.01f;            // RMSProp epsilon (DeepMind: 0.01)
-  bool rmsprop_centered = true;         // centered RMSProp, as DeepMind's
+  bool dueling = false;  // value and advantage streams (Wang et al. 2016); mlp, nature, grasp
+  std::string optimizer = "adam";  // "adam" or "rmsprop"
+  float learning_rate = 1e-3f;     // step size
+  float adam_eps = 1e-8f;          // Adam's epsilon
+  float rmsprop_alpha = 0.95f;     // RMSProp smoothing (DeepMind: 0.95)
+  float rmsprop_eps = 0.01f;       // RMSProp epsilon (DeepMind: 0.01)
+  bool rmsprop_centered = true;    // centered RMSProp, as DeepMind's
   std::string loss = "huber";      // "huber" (delta 1, as Mnih et al.'s error clipping) or "mse"
   bool double_dqn = true;          // pick next actions with the online network
   int target_update_period = 500;  // updates between target refreshes
@@ -36,13 +41,20 @@ struct DqnConfig {
   void Validate() const;
 };
 
+// The architecture string DqnConfig describes, for observations of obs_size values. Throws
+// std::invalid_argument when the network cannot take such observations.
+std::string QNetworkArchitecture(const DqnConfig& config, int obs_size, int num_actions);
+
 // A batch of transitions laid out as in the messages: transition i's observation is
-// obs[i*obs_size .. (i+1)*obs_size).
+// obs[i*obs_size .. (i+1)*obs_size). Pixel batches give bytes instead (obs_pixels and
+// next_obs_pixels, divided by 255 on the way into the network) and leave obs and next_obs null.
 struct BatchView {
   int obs_size = 0;
   int count = 0;
   const float* obs = nullptr;
   const float* next_obs = nullptr;
+  const uint8_t* obs_pixels = nullptr;
+  const uint8_t* next_obs_pixels = nullptr;
   const int32_t* action = nullptr;
   const float* reward = nullptr;
   const float* discount = nullptr;

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+#include <type_traits>
 
 #include "common/channels.h"
 #include "common/clock.h"
@@ -42,22 +43,50 @@ Learner::Learner(LearnerConfig config, Bus* bus)
   std::filesystem::create_directories(std::filesystem::path(config_.out_dir) / "checkpoints");
   bus_->Subscribe<rlmsg::sample_batch_t>(
       channels::kSamples, [this](const rlmsg::sample_batch_t& m) { OnSamples(m); }, Port::kBulk);
+  bus_->Subscribe<rlmsg::pixel_sample_batch_t>(
+      channels::kPixelSamples, [this](const rlmsg::pixel_sample_batch_t& m) { OnPixelSamples(m); },
+      Port::kBulk);
+}
+
+bool Learner::Accept(const std::string& requester, int64_t request_id, int64_t total_inserts) {
+  if (requester != sender_) return false;  // another learner's reply
+  auto it = in_flight_.find(request_id);
+  if (it == in_flight_.end()) {
+    ++stale_replies_;  // answered twice after a retry
+    return false;
+  }
+  in_flight_.erase(it);
+  env_steps_ = std::max(env_steps_, total_inserts);
+  return true;
 }
 
 void Learner::OnSamples(const rlmsg::sample_batch_t& m) {
-  if (m.requester != sender_) return;  // another learner's reply
-  auto it = in_flight_.find(m.request_id);
-  if (it == in_flight_.end()) {
-    ++stale_replies_;  // answered twice after a retry
-    return;
-  }
-  in_flight_.erase(it);
+  if (!Accept(m.requester, m.request_id, m.total_inserts)) return;
   if (m.obs_size != obs_size_) {
     throw std::invalid_argument("sample batch with observation size " + std::to_string(m.obs_size) +
                                 ", expected " + std::to_string(obs_size_));
   }
-  env_steps_ = std::max(env_steps_, m.total_inserts);
-  ready_.push_back(m);
+  ready_.emplace_back(m);
+}
+
+void Learner::OnPixelSamples(const rlmsg::pixel_sample_batch_t& m) {
+  if (!Accept(m.requester, m.request_id, m.total_inserts)) return;
+  const int64_t obs_size = int64_t{m.stack} * m.height * m.width;
+  if (obs_size != obs_size_) {
+    throw std::invalid_argument("pixel sample batch of " + std::to_string(m.stack) + " x " +
+                                std::to_string(m.height) + " x " + std::to_string(m.width) +
+                                " bytes per observation, expected " + std::to_string(obs_size_));
+  }
+  ready_.emplace_back(m);
+}
+
+void Learner::PublishPriorities(const std::vector<int64_t>& index) {
+  const std::vector<float>& td = dqn_.last_td_errors();
+  priorities_.count = static_cast<int32_t>(index.size());
+  priorities_.index = index;
+  priorities_.priority.assign(td.begin(), td.end());
+  bus_->Publish(channels::kPriorities, &priorities_);
+  priorities_sent_ += priorities_.count;
 }
 
 void Learner::SendRequest(int64_t id) {
@@ -83,17 +112,29 @@ void Learner::TopUpRequests(double now) {
   }
 }
 
-void Learner::TrainOn(const rlmsg::sample_batch_t& m) {
+void Learner::TrainOn(const Batch& batch) {
   BatchView b;
-  b.obs_size = m.obs_size;
-  b.count = m.count;
-  b.obs = m.obs.data();
-  b.next_obs = m.next_obs.data();
-  b.action = m.action.data();
-  b.reward = m.reward.data();
-  b.discount = m.discount.data();
-  b.weight = m.weight.data();
+  b.obs_size = obs_size_;
+  const std::vector<int64_t>* index = nullptr;
+  std::visit(
+      [&](const auto& m) {
+        b.count = m.count;
+        if constexpr (std::is_same_v<std::decay_t<decltype(m)>, rlmsg::sample_batch_t>) {
+          b.obs = m.obs.data();
+          b.next_obs = m.next_obs.data();
+        } else {
+          b.obs_pixels = m.obs.data();
+          b.next_obs_pixels = m.next_obs.data();
+        }
+        b.action = m.action.data();
+        b.reward = m.reward.data();
+        b.discount = m.discount.data();
+        b.weight = m.weight.data();
+        index = &m.index;
+      },
+      batch);
   const UpdateResult r = dqn_.Update(b);
+  if (config_.prioritized) PublishPriorities(*index);
   loss_sum_ += r.loss;
   q_sum_ += r.mean_q;
   ++stat_updates_;
@@ -143,6 +184,7 @@ void Learner::PublishStats(double now) {
   s.weights_version = weights_.published_version();
   s.env_steps = env_steps_;
   s.request_timeouts = request_timeouts_;
+  s.priorities_sent = priorities_sent_;
   bus_->FillCounters(&s);
   bus_->Publish(channels::kStatsLearner, &s);
   stats_last_time_ = now;

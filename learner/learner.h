@@ -10,10 +10,13 @@
 #include <deque>
 #include <map>
 #include <string>
+#include <variant>
 
 #include "common/lcm_bus.h"
 #include "learner/dqn.h"
 #include "learner/weights_publisher.h"
+#include "rlmsg/pixel_sample_batch_t.hpp"
+#include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
 
 namespace rl::learner {
@@ -27,6 +30,7 @@ struct LearnerConfig {
   int weights_every = 100;             // updates between weight broadcasts
   int checkpoint_every = 1000;         // updates between checkpoints
   int keep_checkpoints = 0;            // newest checkpoint files kept on disk (0: all)
+  bool prioritized = false;            // publish |TD errors| as priorities after every update
   std::string out_dir = ".";           // checkpoints go to <out_dir>/checkpoints/
   int64_t max_updates = 0;             // stop after this many updates (0: until stopped)
   double stats_hz = 4.0;               // stats messages per second
@@ -54,10 +58,18 @@ class Learner {
     double sent = 0;
   };
 
+  // A reply received and not yet trained on: flat or pixel observations.
+  using Batch = std::variant<rlmsg::sample_batch_t, rlmsg::pixel_sample_batch_t>;
+
+  // Takes a reply if it answers one of our requests in flight; false for another learner's or a
+  // duplicate.
+  bool Accept(const std::string& requester, int64_t request_id, int64_t total_inserts);
   void OnSamples(const rlmsg::sample_batch_t& m);
+  void OnPixelSamples(const rlmsg::pixel_sample_batch_t& m);
+  void PublishPriorities(const std::vector<int64_t>& index);
   void TopUpRequests(double now);
   void SendRequest(int64_t id);
-  void TrainOn(const rlmsg::sample_batch_t& m);
+  void TrainOn(const Batch& batch);
   void PublishStats(double now);
 
   LearnerConfig config_;
@@ -70,7 +82,9 @@ class Learner {
 
   std::map<int64_t, Request> in_flight_;  // by request id
   int64_t next_request_id_ = 0;
-  std::deque<rlmsg::sample_batch_t> ready_;
+  std::deque<Batch> ready_;
+  rlmsg::priority_update_t priorities_{};
+  int64_t priorities_sent_ = 0;
   int64_t env_steps_ = 0;
   int64_t request_timeouts_ = 0;
   int64_t stale_replies_ = 0;

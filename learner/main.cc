@@ -38,15 +38,28 @@ int Main(int argc, char** argv) {
       ("env", rl::po::value(&c.env_id)->default_value(c.env_id), "environment id")  //
       ("out", rl::po::value(&c.out_dir)->default_value(c.out_dir),
        "run folder; checkpoints go to <out>/checkpoints")  //
+      ("network", rl::po::value(&d.network)->default_value(d.network),
+       "Q network: mlp, nature (Mnih et al. 2015, 4x84x84 frames), grasp (stacks of 40x40 "
+       "frames) or an architecture string")  //
       ("hidden", rl::po::value(&hidden)->default_value(hidden),
        "hidden layer widths of the MLP")  //
+      ("dueling", rl::po::value(&d.dueling)->default_value(d.dueling),
+       "dueling value and advantage streams (1/0; mlp, nature, grasp)")  //
+      ("prioritized", rl::po::value(&c.prioritized)->default_value(c.prioritized),
+       "send |TD errors| to the replay as priorities after every update (1/0)")  //
       ("batch-size", rl::po::value(&c.batch_size)->default_value(c.batch_size),
        "transitions per update")                                                                 //
       ("optimizer", rl::po::value(&d.optimizer)->default_value(d.optimizer), "adam or rmsprop")  //
       ("learning-rate", rl::po::value(&d.learning_rate)->default_value(d.learning_rate),
        "step size")                                                                        //
       ("adam-eps", rl::po::value(&d.adam_eps)->default_value(d.adam_eps), "Adam epsilon")  //
-      ("loss", rl::po::value(&d.loss)->default_value(d.loss), "huber or mse")              //
+      ("rmsprop-alpha", rl::po::value(&d.rmsprop_alpha)->default_value(d.rmsprop_alpha),
+       "RMSProp smoothing constant (DeepMind: 0.95)")  //
+      ("rmsprop-eps", rl::po::value(&d.rmsprop_eps)->default_value(d.rmsprop_eps),
+       "RMSProp epsilon (DeepMind: 0.01)")  //
+      ("rmsprop-centered", rl::po::value(&d.rmsprop_centered)->default_value(d.rmsprop_centered),
+       "centered RMSProp, as DeepMind's (1/0)")                                //
+      ("loss", rl::po::value(&d.loss)->default_value(d.loss), "huber or mse")  //
       ("double-dqn", rl::po::value(&d.double_dqn)->default_value(d.double_dqn),
        "Double DQN targets (1/0)")  //
       ("target-update-period",

@@ -14,7 +14,8 @@ namespace {
 constexpr char kUsage[] =
     "Usage: replay [options]\n"
     "The replay daemon: stores transitions from RL_TRANSITIONS in a ring buffer and answers\n"
-    "RL_SAMPLE_REQUEST with uniformly drawn batches on RL_SAMPLES, holding the ratio of\n"
+    "RL_SAMPLE_REQUEST with batches on RL_SAMPLES (uniform or prioritized; pixel transitions\n"
+    "from RL_PIXEL_TRANSITIONS are answered on RL_PIXEL_SAMPLES), holding the ratio of\n"
     "samples to inserts near --samples-per-insert (actors are paused through RL_FLOW).";
 
 int Main(int argc, char** argv) {
@@ -44,6 +45,20 @@ int Main(int argc, char** argv) {
        "samples-per-insert transitions ahead, the learner error-buffer samples ahead")  //
       ("seed", po::value(&options.seed)->default_value(options.seed),
        "seed of the sampler")  //
+      ("prioritized", po::value(&options.prioritized)->default_value(options.prioritized),
+       "sample in proportion to priority (Schaul et al. 2016) instead of uniformly")  //
+      ("alpha", po::value(&options.alpha)->default_value(options.alpha),
+       "priority exponent: P(i) ~ (priority_i + priority-epsilon)^alpha")  //
+      ("beta", po::value(&options.beta)->default_value(options.beta),
+       "initial importance-sampling exponent, annealed linearly to 1")  //
+      ("beta-anneal-samples",
+       po::value(&options.beta_anneal_samples)->default_value(options.beta_anneal_samples),
+       "sampled transitions over which beta reaches 1 (0: beta stays constant)")  //
+      ("priority-epsilon",
+       po::value(&options.priority_epsilon)->default_value(options.priority_epsilon),
+       "added to every priority, so that no transition has probability 0")  //
+      ("frame-capacity", po::value(&options.frame_capacity)->default_value(options.frame_capacity),
+       "pixel frames kept (0: a little above capacity)")  //
       ("max-pending-requests",
        po::value(&options.max_pending_requests)->default_value(options.max_pending_requests),
        "sample requests held while the rate limiter waits; the oldest is dropped beyond")  //
@@ -64,8 +79,8 @@ int Main(int argc, char** argv) {
 
   service.Run(rl::StopRequested);
   std::printf("replay: stopped after %lld inserts and %lld samples\n",
-              static_cast<long long>(service.table().total_inserts()),
-              static_cast<long long>(service.table().total_samples()));
+              static_cast<long long>(service.total_inserts()),
+              static_cast<long long>(service.total_samples()));
   std::fflush(stdout);
   return 0;
 }

@@ -1,5 +1,6 @@
 #include "replay/replay_service.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -8,6 +9,8 @@
 
 #include "common/channels.h"
 #include "common/check.h"
+#include "replay/prioritized_sampler.h"
+#include "replay/uniform_sampler.h"
 
 namespace rl::replay {
 namespace {
@@ -58,6 +61,26 @@ void ReplayServiceOptions::Validate() const {
     throw std::invalid_argument("replay service: progress_seconds must be >= 0 (0: none), got " +
                                 Str(progress_seconds));
   }
+  if (prioritized) {
+    if (!std::isfinite(alpha) || alpha < 0) {
+      throw std::invalid_argument("replay service: alpha must be >= 0, got " + Str(alpha));
+    }
+    if (!std::isfinite(beta) || beta < 0 || beta > 1) {
+      throw std::invalid_argument("replay service: beta must be in [0, 1], got " + Str(beta));
+    }
+    if (!std::isfinite(priority_epsilon) || priority_epsilon <= 0) {
+      throw std::invalid_argument("replay service: priority_epsilon must be > 0, got " +
+                                  Str(priority_epsilon));
+    }
+  }
+  if (beta_anneal_samples < 0) {
+    throw std::invalid_argument("replay service: beta_anneal_samples must be >= 0, got " +
+                                std::to_string(beta_anneal_samples));
+  }
+  if (frame_capacity < 0) {
+    throw std::invalid_argument("replay service: frame_capacity must be >= 0, got " +
+                                std::to_string(frame_capacity));
+  }
   if (handle_timeout_ms < 0) {
     throw std::invalid_argument("replay service: handle_timeout_ms must be >= 0, got " +
                                 std::to_string(handle_timeout_ms));
@@ -76,14 +99,33 @@ double ReplayService::IntervalRate::Take(int64_t count, double now) {
 ReplayService::ReplayService(Bus* bus, ReplayServiceOptions options)
     : bus_(*bus),
       options_(Validated(std::move(options))),
-      table_(options_.table),
+      table_(options_.table, MakeSampler()),
       limiter_(options_.limiter),
       rng_(options_.seed) {
   insert_allowed_ = limiter_.CanInsert(options_.insert_unit);
   bus_.Subscribe<rlmsg::transition_batch_t>(
       channels::kTransitions, [this](const rlmsg::transition_batch_t& m) { OnTransitions(m); });
+  bus_.Subscribe<rlmsg::pixel_batch_t>(
+      channels::kPixelTransitions,
+      [this](const rlmsg::pixel_batch_t& m) { OnPixelTransitions(m); });
   bus_.Subscribe<rlmsg::sample_request_t>(
       channels::kSampleRequest, [this](const rlmsg::sample_request_t& m) { OnSampleRequest(m); });
+  bus_.Subscribe<rlmsg::priority_update_t>(
+      channels::kPriorities, [this](const rlmsg::priority_update_t& m) { OnPriorities(m); });
+}
+
+std::unique_ptr<Sampler> ReplayService::MakeSampler() const {
+  if (!options_.prioritized) return std::make_unique<UniformSampler>(options_.table.capacity);
+  return std::make_unique<PrioritizedSampler>(options_.table.capacity, options_.alpha,
+                                              options_.priority_epsilon);
+}
+
+double ReplayService::beta() const {
+  if (!options_.prioritized) return 1.0;
+  if (options_.beta_anneal_samples <= 0) return options_.beta;
+  const double progress = std::min(1.0, static_cast<double>(total_samples()) /
+                                            static_cast<double>(options_.beta_anneal_samples));
+  return options_.beta + (1.0 - options_.beta) * progress;
 }
 
 ReplayService::~ReplayService() = default;
@@ -95,6 +137,11 @@ void ReplayService::LogRefusal(const char* what, const char* why) {
 }
 
 void ReplayService::OnTransitions(const rlmsg::transition_batch_t& m) {
+  if (pixels_ != nullptr) {
+    ++counters_.batches_refused;
+    LogRefusal("transition batch", "this run stores pixel transitions");
+    return;
+  }
   // The bus has checked sizes and values; the table checks what only it knows (obs_size).
   const TransitionBatchView view{m.obs_size, m.count,    m.obs,        m.next_obs, m.action,
                                  m.reward,   m.discount, m.episode_id, m.priority};
@@ -105,6 +152,39 @@ void ReplayService::OnTransitions(const rlmsg::transition_batch_t& m) {
   }
   limiter_.Insert(m.count);
   PublishFlow(/*force=*/false);
+}
+
+void ReplayService::OnPixelTransitions(const rlmsg::pixel_batch_t& m) {
+  if (table_.total_inserts() > 0) {
+    ++counters_.batches_refused;
+    LogRefusal("pixel batch", "this run stores flat transitions");
+    return;
+  }
+  if (pixels_ == nullptr) {
+    PixelTableOptions options;
+    options.capacity = options_.table.capacity;
+    options.frame_capacity = options_.frame_capacity;
+    pixels_ = std::make_unique<PixelTable>(options, MakeSampler());
+  }
+  // The bus has checked sizes and values; the table checks geometry and frame references.
+  const PixelBatchView view{m.actor_id, m.height, m.width,    m.stack,      m.num_frames,
+                            m.frame_id, m.frames, m.count,    m.obs_frames, m.next_obs_frames,
+                            m.action,   m.reward, m.discount, m.episode_id, m.priority};
+  const int64_t before = pixels_->total_inserts();
+  if (const char* why = pixels_->Insert(view)) {
+    ++counters_.batches_refused;
+    LogRefusal("pixel batch", why);
+    return;
+  }
+  limiter_.Insert(pixels_->total_inserts() - before);
+  PublishFlow(/*force=*/false);
+}
+
+void ReplayService::OnPriorities(const rlmsg::priority_update_t& m) {
+  const int64_t applied = pixels_ ? pixels_->UpdatePriorities(m.index, m.priority)
+                                  : table_.UpdatePriorities(m.index, m.priority);
+  counters_.priorities_applied += applied;
+  counters_.priorities_stale += m.count - applied;
 }
 
 void ReplayService::OnSampleRequest(const rlmsg::sample_request_t& m) {
@@ -131,6 +211,14 @@ const char* ReplayService::Unanswerable(const PendingRequest& request) {
   if (max_batch > 0 && request.batch_size > max_batch) {
     return "batch_size above 2 * error_buffer - samples_per_insert (the limiter could never "
            "allow it)";
+  }
+  if (pixels_ != nullptr && pixels_->height() > 0) {
+    const int64_t obs_bytes = int64_t{pixels_->stack()} * pixels_->height() * pixels_->width();
+    // Two byte arrays of batch_size stacks, and 36 bytes per transition for the rest.
+    if (int64_t{request.batch_size} * (2 * obs_bytes + 36) + 1024 > options_.max_reply_bytes) {
+      return "reply above max_reply_bytes";
+    }
+    return nullptr;
   }
   // The reply's size is known once the observation size is.
   if (table_.obs_size() > 0) {
@@ -168,6 +256,10 @@ int ReplayService::Serve() {
 }
 
 void ReplayService::Answer(const PendingRequest& request) {
+  if (pixels_ != nullptr) {
+    AnswerPixels(request);
+    return;
+  }
   // Size the reused reply (no allocation once warm) and let the table fill it.
   const int count = request.batch_size;
   const int obs_size = table_.obs_size();
@@ -188,12 +280,49 @@ void ReplayService::Answer(const PendingRequest& request) {
   const SampleSpans out{reply_.obs,      reply_.next_obs, reply_.action, reply_.reward,
                         reply_.discount, reply_.index,    reply_.weight, {}};
   // CanSample() held, so at least min_size_to_sample >= 1 transitions are stored.
+  table_.set_importance_exponent(beta());
   const bool sampled = table_.Sample(count, &rng_, out);
   RL_CHECK(sampled) << "the limiter allowed a sample from an empty table";
   limiter_.Sample(count);
   reply_.replay_size = table_.size();
   reply_.total_inserts = table_.total_inserts();
   bus_.Publish(channels::kSamples, &reply_, Port::kBulk);
+  ++counters_.requests_answered;
+}
+
+void ReplayService::AnswerPixels(const PendingRequest& request) {
+  const int count = request.batch_size;
+  const auto n = static_cast<size_t>(count);
+  const int64_t obs_bytes = int64_t{pixels_->stack()} * pixels_->height() * pixels_->width();
+  const auto bytes = static_cast<size_t>(obs_bytes * count);
+  rlmsg::pixel_sample_batch_t& r = pixel_reply_;
+  r.requester = request.requester;
+  r.request_id = request.request_id;
+  r.height = pixels_->height();
+  r.width = pixels_->width();
+  r.stack = pixels_->stack();
+  r.count = count;
+  r.num_bytes = static_cast<int32_t>(bytes);
+  r.obs.resize(bytes);
+  r.next_obs.resize(bytes);
+  r.action.resize(n);
+  r.reward.resize(n);
+  r.discount.resize(n);
+  r.index.resize(n);
+  r.weight.resize(n);
+  const PixelSampleSpans out{r.obs, r.next_obs, r.action, r.reward, r.discount, r.index, r.weight};
+  pixels_->set_importance_exponent(beta());
+  if (!pixels_->Sample(count, &rng_, out)) {
+    // Every stored transition names an overwritten frame (a frame ring far too small for the
+    // traffic): nothing can be drawn until new transitions arrive.
+    ++counters_.requests_refused;
+    LogRefusal("sample request", "every stored transition names an overwritten frame");
+    return;
+  }
+  limiter_.Sample(count);
+  r.replay_size = pixels_->size();
+  r.total_inserts = pixels_->total_inserts();
+  bus_.Publish(channels::kPixelSamples, &r, Port::kBulk);
   ++counters_.requests_answered;
 }
 
@@ -209,12 +338,20 @@ void ReplayService::PublishFlow(bool force) {
 }
 
 void ReplayService::PublishStats(double now) {
-  stats_.size = table_.size();
+  stats_.size = size();
   stats_.capacity = table_.capacity();
-  stats_.total_inserts = table_.total_inserts();
-  stats_.total_samples = table_.total_samples();
-  stats_.inserts_per_second = stats_insert_rate_.Take(table_.total_inserts(), now);
-  stats_.samples_per_second = stats_sample_rate_.Take(table_.total_samples(), now);
+  stats_.total_inserts = total_inserts();
+  stats_.total_samples = total_samples();
+  stats_.inserts_per_second = stats_insert_rate_.Take(total_inserts(), now);
+  stats_.samples_per_second = stats_sample_rate_.Take(total_samples(), now);
+  stats_.prioritized = options_.prioritized ? 1 : 0;
+  stats_.beta = beta();
+  stats_.memory_bytes = table_.memory_bytes() + (pixels_ ? pixels_->memory_bytes() : 0);
+  stats_.frames = pixels_ ? std::min(pixels_->total_frames(), pixels_->frame_capacity()) : 0;
+  stats_.priorities_applied = counters_.priorities_applied;
+  stats_.priorities_stale = counters_.priorities_stale;
+  stats_.missing_frames = pixels_ ? pixels_->transitions_missing_frames() : 0;
+  stats_.stale_draws = pixels_ ? pixels_->stale_draws() : 0;
   stats_.samples_per_insert = limiter_.samples_per_insert();
   stats_.insert_allowed = insert_allowed_ ? 1 : 0;
   stats_.pending_requests = pending_requests();
@@ -225,19 +362,32 @@ void ReplayService::PublishStats(double now) {
 }
 
 void ReplayService::PrintProgress(double now) {
-  const double inserts_per_second = progress_insert_rate_.Take(table_.total_inserts(), now);
-  const double samples_per_second = progress_sample_rate_.Take(table_.total_samples(), now);
+  const double inserts_per_second = progress_insert_rate_.Take(total_inserts(), now);
+  const double samples_per_second = progress_sample_rate_.Take(total_samples(), now);
   const BusCounters& bus = bus_.counters();
   std::printf(
       "replay: size %lld/%lld inserts %lld (%.1f/s) samples %lld (%.1f/s) spi %.2f "
-      "insert_allowed %d pending %d dropped %lld lost %lld\n",
-      static_cast<long long>(table_.size()), static_cast<long long>(table_.capacity()),
-      static_cast<long long>(table_.total_inserts()), inserts_per_second,
-      static_cast<long long>(table_.total_samples()), samples_per_second,
-      limiter_.samples_per_insert(), insert_allowed_ ? 1 : 0, pending_requests(),
+      "insert_allowed %d pending %d dropped %lld lost %lld memory %.1f MB",
+      static_cast<long long>(size()), static_cast<long long>(table_.capacity()),
+      static_cast<long long>(total_inserts()), inserts_per_second,
+      static_cast<long long>(total_samples()), samples_per_second, limiter_.samples_per_insert(),
+      insert_allowed_ ? 1 : 0, pending_requests(),
       static_cast<long long>(bus.malformed + bus.foreign + bus.invalid + counters_.batches_refused +
                              counters_.requests_refused + counters_.requests_dropped),
-      static_cast<long long>(bus.lost));
+      static_cast<long long>(bus.lost),
+      static_cast<double>(table_.memory_bytes() + (pixels_ ? pixels_->memory_bytes() : 0)) / 1e6);
+  if (options_.prioritized) {
+    std::printf(" beta %.3f priorities %lld stale %lld", beta(),
+                static_cast<long long>(counters_.priorities_applied),
+                static_cast<long long>(counters_.priorities_stale));
+  }
+  if (pixels_ != nullptr) {
+    std::printf(" frames %lld missing_frames %lld stale_draws %lld",
+                static_cast<long long>(pixels_->total_frames()),
+                static_cast<long long>(pixels_->transitions_missing_frames()),
+                static_cast<long long>(pixels_->stale_draws()));
+  }
+  std::printf("\n");
   std::fflush(stdout);
 }
 
@@ -256,8 +406,8 @@ void ReplayService::Tick(double now) {
     if (next_progress_ >= 0) {
       PrintProgress(now);
     } else {
-      progress_insert_rate_.Take(table_.total_inserts(), now);
-      progress_sample_rate_.Take(table_.total_samples(), now);
+      progress_insert_rate_.Take(total_inserts(), now);
+      progress_sample_rate_.Take(total_samples(), now);
     }
     next_progress_ = now + options_.progress_seconds;
   }
@@ -269,10 +419,11 @@ void ReplayService::Run(const std::function<bool()>& should_stop) {
     Serve();
     Tick();
   }
-  // Leave a last word for the monitor.
+  // Leave a last word for the monitor, and the final counts in the log.
   const double now = MonoSeconds();
   PublishFlow(/*force=*/true);
   PublishStats(now);
+  if (options_.progress_seconds > 0) PrintProgress(now);
 }
 
 }  // namespace rl::replay

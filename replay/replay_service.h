@@ -4,10 +4,13 @@
 // In (main port):
 //   RL_TRANSITIONS     transition_batch_t  every valid batch is stored, whatever the limiter says
 //                                          (the limiter only tells actors to pause)
+//   RL_PIXEL_TRANSITIONS pixel_batch_t     the same for pixel transitions (frames stored once)
 //   RL_SAMPLE_REQUEST  sample_request_t    queued; several may be in flight
+//   RL_PRIORITIES      priority_update_t   new priorities (prioritized replay)
 // Out:
 //   RL_SAMPLES         sample_batch_t      (bulk port) one reply per request, in request order,
 //                                          as soon as the limiter allows a sample of its size
+//   RL_PIXEL_SAMPLES   pixel_sample_batch_t  (bulk port) the same when the replay holds pixels
 //   RL_FLOW            flow_control_t      at flow_hz, and at once whenever insert_allowed changes
 //   RL_STATS_REPLAY    stats_replay_t      at stats_hz
 //
@@ -15,8 +18,13 @@
 // itself refuses (a batch the table will not store, a request that can never be answered) is
 // counted here and reported in stats_replay_t.dropped_invalid together with the bus's count.
 //
+// A run stores either flat or pixel transitions: the kind of the first batch decides, and
+// batches of the other kind are refused. Sampling is uniform, or proportional to priority
+// (Schaul et al. 2016) with importance weights whose exponent beta is annealed to 1.
+//
 // Replies are one message each: a request whose reply would exceed max_reply_bytes is refused.
-// For CartPole a batch of 128 is about 7 KB.
+// For CartPole a batch of 128 is about 7 KB; a batch of 32 Nature-DQN stacks (4 x 84 x 84) about
+// 1.8 MB.
 //
 // Not thread-safe: one thread constructs the service and calls every method; the bus must be
 // used by that thread only and must outlive the service.
@@ -25,14 +33,19 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <memory>
 #include <random>
 #include <string>
 
 #include "common/clock.h"
 #include "common/lcm_bus.h"
+#include "replay/pixel_table.h"
 #include "replay/rate_limiter.h"
 #include "replay/replay_table.h"
 #include "rlmsg/flow_control_t.hpp"
+#include "rlmsg/pixel_batch_t.hpp"
+#include "rlmsg/pixel_sample_batch_t.hpp"
+#include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
 #include "rlmsg/stats_replay_t.hpp"
@@ -47,6 +60,16 @@ struct ReplayServiceOptions {
   RateLimiterOptions limiter;
   // Seed of the sampler's random generator.
   uint64_t seed = 1;
+  // Prioritized sampling: P(i) proportional to (priority_i + priority_epsilon)^alpha, importance
+  // weights (N P(i))^-beta normalised by their maximum, beta growing linearly from `beta` to 1
+  // over the first beta_anneal_samples sampled transitions (0: constant).
+  bool prioritized = false;
+  double alpha = 0.6;
+  double beta = 0.4;
+  int64_t beta_anneal_samples = 0;
+  double priority_epsilon = 1e-6;
+  // Frames kept for pixel transitions (0: the pixel table's default, a little above capacity).
+  int64_t frame_capacity = 0;
   // Transitions an actor asks to insert at a time: insert_allowed is CanInsert(insert_unit).
   int insert_unit = 1;
   // Sample requests waiting for the limiter; when full, the oldest is dropped.
@@ -69,10 +92,12 @@ struct ReplayServiceOptions {
 
 /// What the service refused or dropped itself (the bus counts the rest).
 struct ServiceCounters {
-  int64_t batches_refused = 0;    // transition batches the table would not store
-  int64_t requests_refused = 0;   // requests whose batch could never be served
-  int64_t requests_dropped = 0;   // pending requests pushed out of a full queue
-  int64_t requests_answered = 0;  // replies published
+  int64_t batches_refused = 0;     // transition batches the table would not store
+  int64_t requests_refused = 0;    // requests whose batch could never be served
+  int64_t requests_dropped = 0;    // pending requests pushed out of a full queue
+  int64_t requests_answered = 0;   // replies published
+  int64_t priorities_applied = 0;  // priority updates applied
+  int64_t priorities_stale = 0;    // priority updates for transitions overwritten since
 };
 
 class ReplayService {
@@ -97,7 +122,20 @@ class ReplayService {
   /// round). Publishes a flow_control_t and a stats_replay_t before returning.
   void Run(const std::function<bool()>& should_stop);
 
+  /// The flat table (empty when the run stores pixels).
   const ReplayTable& table() const { return table_; }
+  /// The pixel table, or nullptr before the first pixel batch.
+  const PixelTable* pixel_table() const { return pixels_.get(); }
+  /// Of whichever table holds the run's transitions.
+  int64_t size() const { return pixels_ ? pixels_->size() : table_.size(); }
+  int64_t total_inserts() const {
+    return pixels_ ? pixels_->total_inserts() : table_.total_inserts();
+  }
+  int64_t total_samples() const {
+    return pixels_ ? pixels_->total_samples() : table_.total_samples();
+  }
+  /// Importance-sampling exponent for the next batch (1 when sampling is uniform).
+  double beta() const;
   const RateLimiter& limiter() const { return limiter_; }
   const ServiceCounters& counters() const { return counters_; }
   int pending_requests() const { return static_cast<int>(pending_.size()); }
@@ -122,7 +160,11 @@ class ReplayService {
   };
 
   void OnTransitions(const rlmsg::transition_batch_t& m);
+  void OnPixelTransitions(const rlmsg::pixel_batch_t& m);
   void OnSampleRequest(const rlmsg::sample_request_t& m);
+  void OnPriorities(const rlmsg::priority_update_t& m);
+  std::unique_ptr<Sampler> MakeSampler() const;
+  void AnswerPixels(const PendingRequest& request);
   // Draws and publishes the reply to one request.
   void Answer(const PendingRequest& request);
   // Why a request can never be answered, or nullptr.
@@ -136,6 +178,7 @@ class ReplayService {
   Bus& bus_;
   ReplayServiceOptions options_;
   ReplayTable table_;
+  std::unique_ptr<PixelTable> pixels_;  // created by the first pixel batch
   RateLimiter limiter_;
   std::mt19937_64 rng_;
   std::deque<PendingRequest> pending_;
@@ -154,6 +197,7 @@ class ReplayService {
 
   // Reused messages, so that a warm service does not allocate per reply.
   rlmsg::sample_batch_t reply_{};
+  rlmsg::pixel_sample_batch_t pixel_reply_{};
   rlmsg::flow_control_t flow_{};
   rlmsg::stats_replay_t stats_{};
 };

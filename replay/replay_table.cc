@@ -1,6 +1,7 @@
 #include "replay/replay_table.h"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -131,6 +132,7 @@ bool ReplayTable::Sample(int batch_size, std::mt19937_64* rng, const SampleSpans
   if (items_.size() < n) items_.resize(n);
   const std::span<SampledItem> items(items_.data(), n);
   sampler_->Sample(rng, items);
+  const double min_probability = sampler_->MinProbability();
   for (size_t i = 0; i < n; ++i) {
     const auto s = static_cast<size_t>(items[i].slot);
     RL_DCHECK(items[i].slot >= 0 && items[i].slot < size_) << "sampler chose an empty slot";
@@ -140,12 +142,47 @@ bool ReplayTable::Sample(int batch_size, std::mt19937_64* rng, const SampleSpans
     out.reward[i] = reward_[s];
     out.discount[i] = discount_[s];
     out.index[i] = insert_number_[s];
-    // Uniform sampling needs no correction; a prioritized sampler will supply real weights.
-    out.weight[i] = 1.0f;
+    out.weight[i] = ImportanceWeight(items[i].probability, min_probability, beta_);
     if (!out.episode_id.empty()) out.episode_id[i] = episode_id_[s];
   }
   total_samples_ += batch_size;
   return true;
+}
+
+void ReplayTable::set_importance_exponent(double beta) {
+  if (!(beta >= 0.0 && beta <= 1.0)) {
+    throw std::invalid_argument("replay table: importance exponent must be in [0, 1], got " +
+                                std::to_string(beta));
+  }
+  beta_ = beta;
+}
+
+int64_t ReplayTable::UpdatePriorities(std::span<const int64_t> index,
+                                      std::span<const float> priority) {
+  RL_CHECK(index.size() == priority.size()) << "index and priority must have the same size, got "
+                                            << index.size() << " and " << priority.size();
+  int64_t applied = 0;
+  for (size_t i = 0; i < index.size(); ++i) {
+    // The slot must still hold that very transition: this rules out overwritten ones (the slot
+    // holds a later insert) and ones never inserted.
+    const int64_t number = index[i];
+    if (number < 0 || number >= total_inserts_) continue;
+    const int64_t slot = number % options_.capacity;
+    if (insert_number_[static_cast<size_t>(slot)] != number) continue;
+    if (!std::isfinite(priority[i]) || priority[i] < 0.0f) continue;
+    sampler_->Update(slot, priority[i]);
+    ++applied;
+  }
+  return applied;
+}
+
+int64_t ReplayTable::memory_bytes() const {
+  const size_t bytes = (obs_.capacity() + next_obs_.capacity()) * sizeof(float) +
+                       action_.capacity() * sizeof(int32_t) +
+                       (reward_.capacity() + discount_.capacity()) * sizeof(float) +
+                       (episode_id_.capacity() + insert_number_.capacity()) * sizeof(int64_t) +
+                       items_.capacity() * sizeof(SampledItem);
+  return static_cast<int64_t>(bytes) + sampler_->memory_bytes();
 }
 
 }  // namespace rl::replay

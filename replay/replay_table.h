@@ -4,10 +4,12 @@
 // Transitions are stored contiguously, one array per field (obs and next_obs hold
 // capacity * obs_size floats each), in slots 0 .. capacity-1 filled in insertion order. Once the
 // table is full, every insert overwrites the oldest transition. Which stored transitions a batch
-// is drawn from is decided by a Sampler (uniform by default).
+// is drawn from is decided by a Sampler (uniform by default, or PrioritizedSampler), which also
+// gives each draw's probability for the importance weights.
 //
-// Memory: capacity * (8 * obs_size + 37) bytes with the uniform sampler, allocated when obs_size
-// becomes known (from the options, or from the first batch).
+// Memory: capacity * (8 * obs_size + 28) bytes, allocated when obs_size becomes known (from the
+// options, or from the first batch), plus the sampler's (16 bytes per slot for the uniform
+// sampler, 32 to 64 for the prioritized one, allocated by its constructor).
 //
 // The table knows nothing about LCM: the caller hands it views of its own arrays. Not
 // thread-safe: one thread inserts and samples.
@@ -36,8 +38,9 @@ struct ReplayTableOptions {
 
 /// A batch of transitions to insert, as views of the caller's arrays. obs and next_obs hold
 /// count * obs_size floats (transition i at [i*obs_size, (i+1)*obs_size)); action, reward and
-/// discount hold count values; episode_id and priority hold count values or are empty (stored
-/// as -1 and 0).
+/// discount hold count values; episode_id and priority hold count values or are empty (an
+/// empty episode_id is stored as -1; a priority that is empty or not > 0 means "not known", to
+/// which a prioritized sampler gives the largest priority seen so far).
 struct TransitionBatchView {
   int obs_size = 0;
   int count = 0;
@@ -55,7 +58,7 @@ struct TransitionBatchView {
 /// wanted). `index` receives each transition's insert number (0 for the first transition ever
 /// inserted, 1 for the next, ...; its slot is index % capacity), so that a later priority update
 /// can tell a transition that has been overwritten since. `weight` receives the importance
-/// weight (1 for uniform sampling).
+/// weight (see ReplayTable::set_importance_exponent; 1 for uniform sampling).
 struct SampleSpans {
   std::span<float> obs;
   std::span<float> next_obs;
@@ -102,9 +105,26 @@ class ReplayTable {
 
   /// Draws batch_size transitions with replacement, as the sampler decides, into `out`, whose
   /// spans must have exactly the sizes batch_size and obs_size() call for (a mismatch is a
-  /// caller bug and aborts). Returns false, writing nothing, when the table is empty.
-  /// O(batch_size * obs_size); no allocation once a batch of this size has been drawn.
+  /// caller bug and aborts). Each weight is (N * P(i))^-beta / max_j (N * P(j))^-beta, the
+  /// maximum taken over all N stored transitions, so weights are at most 1; with the uniform
+  /// sampler they are exactly 1. Returns false, writing nothing, when the table is empty.
+  /// O(batch_size * (obs_size + log capacity)); no allocation once a batch of this size has been
+  /// drawn.
   bool Sample(int batch_size, std::mt19937_64* rng, const SampleSpans& out);
+
+  /// The exponent beta of the importance weights, in [0, 1] (throws std::invalid_argument
+  /// otherwise): 0 turns the correction off (weights 1), 1 (the default) fully compensates the
+  /// non-uniform probabilities. Schaul et al. anneal it from about 0.4 to 1 over training.
+  void set_importance_exponent(double beta);
+  double importance_exponent() const { return beta_; }
+
+  /// Gives transition index[i] (an insert number, as Sample() reports it) the priority
+  /// priority[i] (|TD error|), for every i. Entries are skipped when their transition is not
+  /// stored: overwritten since (index < total_inserts() - capacity()) or never inserted (index
+  /// < 0 or >= total_inserts()); and when the priority is negative or not finite. Returns the
+  /// number of entries applied. index and priority must have the same size (a mismatch is a
+  /// caller bug and aborts). O(n log capacity).
+  int64_t UpdatePriorities(std::span<const int64_t> index, std::span<const float> priority);
 
   /// Transitions stored (at most capacity()).
   int64_t size() const { return size_; }
@@ -115,6 +135,10 @@ class ReplayTable {
   int64_t total_inserts() const { return total_inserts_; }
   /// Transitions ever drawn by Sample().
   int64_t total_samples() const { return total_samples_; }
+  /// Bytes held by the table and its sampler (the capacities of their arrays).
+  int64_t memory_bytes() const;
+  /// The sampler, for inspection (probabilities, size).
+  const Sampler& sampler() const { return *sampler_; }
 
  private:
   void Allocate(int obs_size);
@@ -125,6 +149,7 @@ class ReplayTable {
   int64_t size_ = 0;
   int64_t total_inserts_ = 0;
   int64_t total_samples_ = 0;
+  double beta_ = 1.0;
 
   // Per-slot storage (obs_ and next_obs_: obs_size_ floats per slot).
   std::vector<float> obs_;

@@ -1,13 +1,15 @@
 // Sampler: chooses which stored transitions a batch is drawn from.
 //
-// A ReplayTable stores transitions in slots 0 .. capacity-1 and tells its sampler which slots
-// hold data; the sampler alone decides how they are drawn (uniformly now, by priority later).
-// Implementations see slot numbers only, never the transitions themselves.
+// A table (ReplayTable, PixelTable) stores transitions in slots 0 .. capacity-1 and tells its
+// sampler which slots hold data; the sampler alone decides how they are drawn (uniformly, or in
+// proportion to priority). Implementations see slot numbers only, never the transitions
+// themselves.
 //
 // Member methods will not be called concurrently, so implementations do not need to be
 // thread-safe.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <span>
@@ -29,16 +31,46 @@ class Sampler {
   virtual ~Sampler() = default;
 
   /// Slot `slot` (0 <= slot < capacity) now holds a new transition. A slot that already held
-  /// one is replaced (the old transition is gone). `priority` >= 0 is the transition's initial
-  /// priority; samplers that do not prioritize ignore it.
+  /// one is replaced (the old transition is gone). `priority` is the transition's initial
+  /// priority (|TD error|) when it is finite and > 0; anything else means "not known yet".
+  /// Samplers that do not prioritize ignore it.
   virtual void Insert(int64_t slot, double priority) = 0;
 
-  /// Fills every element of `out` with an independent draw, with replacement, among the slots
-  /// inserted so far. Must not be called while size() == 0.
+  /// The transition in `slot` has a new priority (|TD error|, >= 0). Slots that hold no
+  /// transition are ignored. Samplers that do not prioritize ignore the call.
+  virtual void Update(int64_t /*slot*/, double /*priority*/) {}
+
+  /// The transition in `slot` is gone: the slot is never drawn again until the next Insert() to
+  /// it. Slots that hold no transition are ignored.
+  virtual void Remove(int64_t slot) = 0;
+
+  /// Fills every element of `out` with a draw, with replacement, among the slots that hold a
+  /// transition, each with the probability it was drawn with. Must not be called while
+  /// size() == 0.
   virtual void Sample(std::mt19937_64* rng, std::span<SampledItem> out) = 0;
+
+  /// Probability with which a single draw would choose `slot` now (0 when it holds no
+  /// transition).
+  virtual double Probability(int64_t slot) const = 0;
+
+  /// Smallest Probability() of any slot that holds a transition (0 when size() == 0). Tables use
+  /// it to normalise importance weights by their largest possible value.
+  virtual double MinProbability() const = 0;
 
   /// Number of distinct slots that hold a transition.
   virtual int64_t size() const = 0;
+
+  /// Bytes of memory held (the capacities of its arrays).
+  virtual int64_t memory_bytes() const = 0;
 };
+
+/// Importance-sampling weight of a draw made with probability `probability` (Schaul et al.
+/// 2016, section 3.4): (N * P(i))^-beta / max_j (N * P(j))^-beta over all N stored transitions,
+/// which is (min_probability / probability)^beta, in [0, 1]. beta in [0, 1]; beta = 0 and
+/// uniform sampling give exactly 1.
+inline float ImportanceWeight(double probability, double min_probability, double beta) {
+  if (beta == 0.0 || probability <= min_probability) return 1.0f;
+  return static_cast<float>(std::pow(min_probability / probability, beta));
+}
 
 }  // namespace rl::replay

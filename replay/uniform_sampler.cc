@@ -8,19 +8,35 @@ namespace rl::replay {
 
 UniformSampler::UniformSampler(int64_t capacity) {
   if (capacity < 1) throw std::invalid_argument("UniformSampler: capacity must be at least 1");
-  present_.assign(static_cast<size_t>(capacity), 0);
+  position_.assign(static_cast<size_t>(capacity), -1);
   slots_.reserve(static_cast<size_t>(capacity));
 }
 
+void UniformSampler::CheckSlot(int64_t slot) const {
+  RL_CHECK(slot >= 0 && slot < static_cast<int64_t>(position_.size()))
+      << "slot " << slot << " outside [0, " << position_.size() << ")";
+}
+
 void UniformSampler::Insert(int64_t slot, double /*priority*/) {
-  RL_CHECK(slot >= 0 && slot < static_cast<int64_t>(present_.size()))
-      << "slot " << slot << " outside [0, " << present_.size() << ")";
+  CheckSlot(slot);
   // A replaced slot keeps its place in slots_: its new transition is just as likely.
-  uint8_t& present = present_[static_cast<size_t>(slot)];
-  if (present == 0) {
-    present = 1;
+  int64_t& position = position_[static_cast<size_t>(slot)];
+  if (position < 0) {
+    position = static_cast<int64_t>(slots_.size());
     slots_.push_back(slot);
   }
+}
+
+void UniformSampler::Remove(int64_t slot) {
+  CheckSlot(slot);
+  int64_t& position = position_[static_cast<size_t>(slot)];
+  if (position < 0) return;
+  // Move the last slot into the gap, so that slots_ stays dense.
+  const int64_t last = slots_.back();
+  slots_[static_cast<size_t>(position)] = last;
+  position_[static_cast<size_t>(last)] = position;
+  slots_.pop_back();
+  position = -1;
 }
 
 void UniformSampler::Sample(std::mt19937_64* rng, std::span<SampledItem> out) {
@@ -31,6 +47,20 @@ void UniformSampler::Sample(std::mt19937_64* rng, std::span<SampledItem> out) {
     item.slot = slots_[pick(*rng)];
     item.probability = probability;
   }
+}
+
+double UniformSampler::Probability(int64_t slot) const {
+  CheckSlot(slot);
+  if (position_[static_cast<size_t>(slot)] < 0) return 0.0;
+  return 1.0 / static_cast<double>(slots_.size());
+}
+
+double UniformSampler::MinProbability() const {
+  return slots_.empty() ? 0.0 : 1.0 / static_cast<double>(slots_.size());
+}
+
+int64_t UniformSampler::memory_bytes() const {
+  return static_cast<int64_t>((position_.capacity() + slots_.capacity()) * sizeof(int64_t));
 }
 
 }  // namespace rl::replay

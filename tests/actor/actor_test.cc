@@ -1,11 +1,14 @@
 #include "actor/actor.h"
 
+#include <cmath>
+#include <map>
 #include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "common/channels.h"
+#include "envs/registry.h"
 #include "learner/weights_publisher.h"
 #include "nn/sequential.h"
 #include "rlmsg/flow_control_t.hpp"
@@ -140,6 +143,80 @@ TEST_F(ActorTest, ActsInLunarLanderWithItsEightObservationsAndFourActions) {
     EXPECT_GE(a, 0);
     EXPECT_LT(a, 4);
   }
+}
+
+// Pixel envs: frames travel once, transitions name them. Rebuilding every stack from the frames
+// and replaying the transitions' actions in a second env with the same seed must give exactly
+// the observations the env produced, stack by stack, across episode boundaries.
+TEST(ActorPixelsTest, SendsEveryFrameOnceAndStacksThatRebuildTheEnvsObservations) {
+  Bus bus(Memq());
+  std::vector<rlmsg::pixel_batch_t> batches;
+  bus.Subscribe<rlmsg::pixel_batch_t>(
+      channels::kPixelTransitions,
+      [&batches](const rlmsg::pixel_batch_t& m) { batches.push_back(m); });
+  ActorConfig config;
+  config.env_id = "Catch-v0+pixels(width=5,height=10,stack=3,max-pool=0)";
+  config.batch_size = 8;
+  config.seed = 4;
+  Actor actor(config, &bus);
+  for (int i = 0; i < 60; ++i) actor.StepEnvs();
+  bus.Handle(0);
+  ASSERT_FALSE(batches.empty());
+
+  std::map<int64_t, std::vector<uint8_t>> frames;
+  std::vector<int64_t> obs_ids, next_ids;
+  std::vector<int32_t> actions;
+  std::vector<float> discounts;
+  for (const auto& b : batches) {
+    EXPECT_EQ(b.height, 10);
+    EXPECT_EQ(b.width, 5);
+    EXPECT_EQ(b.stack, 3);
+    for (int f = 0; f < b.num_frames; ++f) {
+      const auto at = b.frames.begin() + f * 50;
+      EXPECT_TRUE(
+          frames.emplace(b.frame_id[static_cast<size_t>(f)], std::vector<uint8_t>(at, at + 50))
+              .second)
+          << "frame " << b.frame_id[static_cast<size_t>(f)] << " sent twice";
+    }
+    obs_ids.insert(obs_ids.end(), b.obs_frames.begin(), b.obs_frames.end());
+    next_ids.insert(next_ids.end(), b.next_obs_frames.begin(), b.next_obs_frames.end());
+    actions.insert(actions.end(), b.action.begin(), b.action.end());
+    discounts.insert(discounts.end(), b.discount.begin(), b.discount.end());
+  }
+  // 60 steps in episodes of 9: 56 transitions published in 7 batches. They carry the frames
+  // queued until the 56th step: one per step and one per reset (the first, and after steps 9,
+  // 18, ..., 54), each once.
+  ASSERT_EQ(actions.size(), 56U);
+  EXPECT_EQ(frames.size(), 56U + 7U);
+
+  // Stacks as the bytes of an observation, from the frames the ids name.
+  const auto stack_bytes = [&frames](const int64_t* ids) {
+    std::vector<uint8_t> bytes;
+    for (int k = 0; k < 3; ++k) {
+      const auto it = frames.find(ids[k]);
+      EXPECT_NE(it, frames.end()) << "unknown frame id " << ids[k];
+      if (it != frames.end()) bytes.insert(bytes.end(), it->second.begin(), it->second.end());
+    }
+    return bytes;
+  };
+  const auto env_bytes = [](const envs::Env& env) {
+    std::vector<uint8_t> bytes;
+    for (float v : env.observation()) bytes.push_back(static_cast<uint8_t>(std::lround(v * 255)));
+    return bytes;
+  };
+  auto replica = envs::MakeEnv(config.env_id);
+  replica->Reset(TrainingSeed(config.seed, 0, 0));
+  int episode_starts = 0;
+  for (size_t i = 0; i < actions.size(); ++i) {
+    const int64_t* ids = &obs_ids[3 * i];
+    if (ids[0] == ids[2]) ++episode_starts;  // the first frame, repeated
+    EXPECT_EQ(stack_bytes(ids), env_bytes(*replica)) << "transition " << i;
+    const envs::StepResult r = replica->Step(actions[i]);
+    EXPECT_EQ(stack_bytes(&next_ids[3 * i]), env_bytes(*replica)) << "transition " << i;
+    EXPECT_EQ(discounts[i] == 0.0f, r.terminated) << "transition " << i;
+    if (r.terminated || r.truncated) replica->Reset();
+  }
+  EXPECT_EQ(episode_starts, 7);
 }
 
 TEST(ActorConfigTest, RefusesAnActorIdOutsideTheRun) {

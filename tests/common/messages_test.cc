@@ -77,6 +77,102 @@ TEST(PrescanTest, AgreesWithTheEncodingOfAWeightsChunk) {
   EXPECT_EQ(Validate(m), nullptr);
 }
 
+// Two 2 x 3 frames (ids 7 and 8) and one transition of stack 2 naming them.
+rlmsg::pixel_batch_t PixelBatch() {
+  rlmsg::pixel_batch_t m{};
+  m.header.sender = "actor-0";
+  m.height = 2;
+  m.width = 3;
+  m.stack = 2;
+  m.num_frames = 2;
+  m.frame_id = {7, 8};
+  m.num_bytes = 12;
+  m.frames.assign(12, 200);
+  m.count = 1;
+  m.num_refs = 2;
+  m.obs_frames = {7, 7};
+  m.next_obs_frames = {7, 8};
+  m.action = {2};
+  m.reward = {1.0f};
+  m.discount = {0.99f};
+  m.episode_id = {0};
+  m.priority = {0.0f};
+  return m;
+}
+
+TEST(PrescanTest, AgreesWithTheEncodingOfAPixelBatch) {
+  const rlmsg::pixel_batch_t m = PixelBatch();
+  ExpectPrescanMatchesTheEncoding(m);
+  EXPECT_EQ(Validate(m), nullptr);
+}
+
+TEST(PrescanTest, RefusesAPixelBatchWithAForgedFrameLength) {
+  rlmsg::pixel_batch_t m = PixelBatch();
+  auto bytes = Encode(m);
+  // num_bytes sits after the fingerprint, the header (8 + 4 + len("test") + 1 + 16), four int32
+  // fields, num_frames and two int64 frame ids.
+  const size_t at = 8 + 8 + 4 + 5 + 16 + 16 + 4 + 16;
+  ASSERT_EQ(bytes[at + 3], 12);  // the encoded num_bytes, big-endian
+  bytes[at] = 0x7f;              // about 2^31 bytes claimed
+  EXPECT_NE(Prescan(&m, bytes.data(), bytes.size()), nullptr);
+}
+
+TEST(ValidateTest, RefusesInconsistentPixelBatches) {
+  rlmsg::pixel_batch_t m = PixelBatch();
+  m.num_bytes = 11;
+  m.frames.resize(11);
+  EXPECT_STREQ(Validate(m), "num_bytes mismatch");
+  m = PixelBatch();
+  m.frame_id = {8, 7};
+  EXPECT_STREQ(Validate(m), "frame ids not increasing");
+  m = PixelBatch();
+  m.num_refs = 3;
+  m.obs_frames.push_back(7);
+  m.next_obs_frames.push_back(7);
+  EXPECT_STREQ(Validate(m), "num_refs mismatch");
+  m = PixelBatch();
+  m.stack = 0;
+  EXPECT_STREQ(Validate(m), "bad frame geometry");
+  m = PixelBatch();
+  m.discount = {1.5f};
+  EXPECT_STREQ(Validate(m), "discount outside [0, 1]");
+}
+
+TEST(PrescanTest, AgreesWithTheEncodingOfAPixelSampleBatchAndAPriorityUpdate) {
+  rlmsg::pixel_sample_batch_t m{};
+  m.header.sender = "replay";
+  m.requester = "learner";
+  m.height = 2;
+  m.width = 2;
+  m.stack = 3;
+  m.count = 2;
+  m.num_bytes = 24;
+  m.obs.assign(24, 1);
+  m.next_obs.assign(24, 2);
+  m.action = {0, 1};
+  m.reward = {0.0f, 1.0f};
+  m.discount = {0.9f, 0.0f};
+  m.index = {4, 5};
+  m.weight = {1.0f, 0.5f};
+  ExpectPrescanMatchesTheEncoding(m);
+  EXPECT_EQ(Validate(m), nullptr);
+  m.num_bytes = 23;
+  EXPECT_STREQ(Validate(m), "num_bytes mismatch");
+
+  rlmsg::priority_update_t p{};
+  p.header.sender = "learner";
+  p.count = 2;
+  p.index = {3, 9};
+  p.priority = {0.5f, 2.0f};
+  ExpectPrescanMatchesTheEncoding(p);
+  EXPECT_EQ(Validate(p), nullptr);
+  p.priority[1] = std::nanf("");
+  EXPECT_STREQ(Validate(p), "bad priority");
+  p.priority[1] = 1.0f;
+  p.index[0] = -1;
+  EXPECT_STREQ(Validate(p), "negative index");
+}
+
 TEST(ValidateTest, RefusesAChunkOutsideItsBufferAndAnInconsistentBatch) {
   rlmsg::weights_chunk_t w{};
   w.header.sender = "learner";

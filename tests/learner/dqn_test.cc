@@ -1,6 +1,8 @@
 #include "learner/dqn.h"
 
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -121,6 +123,85 @@ TEST(DqnTest, RefusesABatchThatDoesNotFitTheNetwork) {
   EXPECT_THROW(dqn.Update(v), std::invalid_argument);
   b.action[0] = 5;
   EXPECT_THROW(dqn.Update(b.view()), std::invalid_argument);
+}
+
+TEST(DqnTest, LearnsTheChainWithADuelingMlp) {
+  DqnConfig c;
+  c.hidden = {32, 32};
+  c.dueling = true;
+  c.target_update_period = 100;
+  EXPECT_EQ(QNetworkArchitecture(c, 2, 2), "linear(2,32),relu,dueling(32,32,2)");
+  ExpectChainSolved(c);
+}
+
+TEST(DqnTest, LearnsTheChainFromAnArchitectureString) {
+  DqnConfig c;
+  c.network = "linear(2,16),tanh,linear(16,2)";
+  c.target_update_period = 100;
+  ExpectChainSolved(c);
+}
+
+TEST(DqnTest, NamesTheQNetworksItKnowsAndRefusesMismatches) {
+  DqnConfig c;
+  c.hidden = {8};
+  EXPECT_EQ(QNetworkArchitecture(c, 3, 2), "linear(3,8),relu,linear(8,2)");
+  c.network = "nature";
+  EXPECT_NE(QNetworkArchitecture(c, 4 * 84 * 84, 6).find("conv2d(4,32,8,4,0,84,84)"),
+            std::string::npos);
+  EXPECT_THROW(QNetworkArchitecture(c, 3 * 84 * 84, 6), std::invalid_argument);
+  c.network = "grasp";
+  EXPECT_NE(QNetworkArchitecture(c, 2 * 40 * 40, 7).find("conv2d(2,32,8,4,0,40,40)"),
+            std::string::npos);
+  EXPECT_THROW(QNetworkArchitecture(c, 100, 7), std::invalid_argument);
+  c.network = "resnet";
+  EXPECT_THROW(QNetworkArchitecture(c, 3, 2), std::invalid_argument);
+  // An architecture string that does not fit the env is refused when the Dqn is built.
+  c.network = "linear(5,2)";
+  EXPECT_THROW(Dqn(3, 2, c), std::invalid_argument);
+}
+
+// Bytes in, divided by 255 on the way: the same update as the equivalent float batch.
+TEST(DqnTest, APixelBatchTrainsLikeTheSameBatchOfFloats) {
+  DqnConfig c;
+  c.network = "conv2d(2,4,3,1,1,3,3),relu,flatten,linear(36,3)";
+  c.seed = 5;
+  Dqn from_bytes(18, 3, c);
+  Dqn from_floats(18, 3, c);
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> byte(0, 255);
+  const int n = 8;
+  std::vector<uint8_t> obs(18 * n), next_obs(18 * n);
+  for (auto& v : obs) v = static_cast<uint8_t>(byte(rng));
+  for (auto& v : next_obs) v = static_cast<uint8_t>(byte(rng));
+  std::vector<float> obs_f(obs.size()), next_f(next_obs.size());
+  for (size_t i = 0; i < obs.size(); ++i) obs_f[i] = static_cast<float>(obs[i]) / 255.0f;
+  for (size_t i = 0; i < next_obs.size(); ++i) {
+    next_f[i] = static_cast<float>(next_obs[i]) / 255.0f;
+  }
+  const std::vector<int32_t> action = {0, 1, 2, 0, 1, 2, 0, 1};
+  const std::vector<float> reward(n, 0.5f), discount(n, 0.9f);
+  BatchView b;
+  b.obs_size = 18;
+  b.count = n;
+  b.action = action.data();
+  b.reward = reward.data();
+  b.discount = discount.data();
+  BatchView bytes = b;
+  bytes.obs_pixels = obs.data();
+  bytes.next_obs_pixels = next_obs.data();
+  BatchView floats = b;
+  floats.obs = obs_f.data();
+  floats.next_obs = next_f.data();
+  for (int i = 0; i < 3; ++i) {
+    const UpdateResult rb = from_bytes.Update(bytes);
+    const UpdateResult rf = from_floats.Update(floats);
+    EXPECT_EQ(rb.loss, rf.loss);
+  }
+  std::vector<float> pb, pf;
+  from_bytes.online().GetFlat(&pb);
+  from_floats.online().GetFlat(&pf);
+  EXPECT_EQ(pb, pf);
+  EXPECT_THROW(from_bytes.Update(b), std::invalid_argument);  // no observations at all
 }
 
 TEST(DqnConfigTest, RefusesBadSettings) {

@@ -11,6 +11,7 @@
 #include "common/channels.h"
 #include "nn/checkpoint.h"
 #include "rlmsg/checkpoint_t.hpp"
+#include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
 #include "rlmsg/weights_chunk_t.hpp"
 
@@ -62,6 +63,10 @@ class LearnerTest : public ::testing::Test {
   }
 
   void Reply(const rlmsg::sample_request_t& r) {
+    if (pixels_) {
+      ReplyPixels(r);
+      return;
+    }
     rlmsg::sample_batch_t b{};
     b.requester = r.header.sender;
     b.request_id = r.request_id;
@@ -85,6 +90,35 @@ class LearnerTest : public ::testing::Test {
     bus_->Publish(channels::kSamples, &b, Port::kBulk);
   }
 
+  // A batch of Catch-shaped pixel transitions (stack 2 of 10 x 5 frames); transition i is
+  // reported as index 1000 * request_id + i.
+  void ReplyPixels(const rlmsg::sample_request_t& r) {
+    rlmsg::pixel_sample_batch_t b{};
+    b.requester = r.header.sender;
+    b.request_id = r.request_id;
+    b.height = 10;
+    b.width = 5;
+    b.stack = 2;
+    b.count = r.batch_size;
+    b.num_bytes = 100 * b.count;
+    std::uniform_int_distribution<int> byte(0, 255);
+    for (int i = 0; i < b.num_bytes; ++i) {
+      b.obs.push_back(static_cast<uint8_t>(byte(rng_)));
+      b.next_obs.push_back(static_cast<uint8_t>(byte(rng_)));
+    }
+    for (int i = 0; i < b.count; ++i) {
+      b.action.push_back(i % 3);
+      b.reward.push_back(i % 2 == 0 ? 1.0f : -1.0f);
+      b.discount.push_back(0.0f);
+      b.index.push_back(1000 * r.request_id + i);
+      b.weight.push_back(0.5f);
+    }
+    b.replay_size = 1000;
+    b.total_inserts = 4321;
+    bus_->Publish(channels::kPixelSamples, &b, Port::kBulk);
+  }
+
+  bool pixels_ = false;
   fs::path dir_;
   std::unique_ptr<Bus> bus_;
   std::mt19937 rng_{1};
@@ -126,6 +160,42 @@ TEST_F(LearnerTest, TrainsBroadcastsWeightsAndWritesLoadableCheckpoints) {
   std::vector<float> flat;
   learner.dqn().online().GetFlat(&flat);
   EXPECT_EQ(nn::LoadCheckpoint(announced_.back()).params, flat);
+}
+
+TEST_F(LearnerTest, TrainsOnPixelBatchesAndSendsTheirTdErrorsAsPriorities) {
+  pixels_ = true;
+  std::vector<rlmsg::priority_update_t> updates;
+  bus_->Subscribe<rlmsg::priority_update_t>(
+      channels::kPriorities,
+      [&updates](const rlmsg::priority_update_t& m) { updates.push_back(m); });
+  LearnerConfig c;
+  c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)";
+  c.dqn.network = "conv2d(2,4,3,1,1,10,5),relu,flatten,linear(200,3)";
+  c.batch_size = 16;
+  c.max_updates = 20;
+  c.checkpoint_every = 100;
+  c.request_timeout = 0.05;
+  c.prioritized = true;
+  c.out_dir = dir_.string();
+  Learner learner(c, bus_.get());
+  learner.Run();
+  bus_->Handle(0);
+  EXPECT_EQ(learner.updates(), 20);
+  // One update per trained batch, naming the batch's transitions with their |TD errors|.
+  ASSERT_EQ(updates.size(), 20U);
+  for (const auto& u : updates) {
+    ASSERT_EQ(u.count, 16);
+    const int64_t request = u.index[0] / 1000;
+    for (int i = 0; i < u.count; ++i) {
+      EXPECT_EQ(u.index[static_cast<size_t>(i)], 1000 * request + i);
+      EXPECT_GE(u.priority[static_cast<size_t>(i)], 0.0f);
+    }
+  }
+  // Terminal transitions: the TD error is |reward - Q(s, a)|, so the last update's priorities
+  // differ between the +1 and -1 rewards.
+  EXPECT_NE(updates.back().priority[0], updates.back().priority[1]);
+  const nn::Checkpoint ckpt = nn::LoadCheckpoint(announced_.back());
+  EXPECT_EQ(ckpt.meta.env_steps, 4321);
 }
 
 TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFiles) {

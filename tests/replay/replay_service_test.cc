@@ -1,5 +1,6 @@
 #include "replay/replay_service.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -358,6 +359,118 @@ TEST_F(ReplayServiceTest, TickPublishesFlowAndStatsAtTheirRates) {
   EXPECT_EQ(s.pending_requests, 0);
   EXPECT_EQ(flows_.back().insert_allowed, 1);
   EXPECT_EQ(flows_.back().target_samples_per_insert, 8.0);
+}
+
+// Pixel transitions of one actor: frames 0 .. count (2 x 2 bytes, every byte of frame f equal
+// to f), transition t with stack 2 naming frames {t - 1, t} (frame 0 repeated for t = 0) and
+// next stack {t, t + 1}, action t % 3.
+rlmsg::pixel_batch_t MakePixelBatch(int count) {
+  rlmsg::pixel_batch_t m{};
+  m.height = 2;
+  m.width = 2;
+  m.stack = 2;
+  m.num_frames = count + 1;
+  for (int f = 0; f <= count; ++f) {
+    m.frame_id.push_back(f);
+    m.frames.insert(m.frames.end(), 4, static_cast<uint8_t>(f));
+  }
+  m.num_bytes = static_cast<int32_t>(m.frames.size());
+  m.count = count;
+  m.num_refs = 2 * count;
+  for (int t = 0; t < count; ++t) {
+    m.obs_frames.insert(m.obs_frames.end(), {std::max(t - 1, 0), t});
+    m.next_obs_frames.insert(m.next_obs_frames.end(), {t, t + 1});
+    m.action.push_back(t % 3);
+    m.reward.push_back(static_cast<float>(t));
+    m.discount.push_back(0.99f);
+    m.episode_id.push_back(0);
+    m.priority.push_back(0.0f);
+  }
+  return m;
+}
+
+TEST_F(ReplayServiceTest, StoresPixelTransitionsAndAnswersWithRebuiltStacks) {
+  std::vector<rlmsg::pixel_sample_batch_t> replies;
+  bus_.Subscribe<rlmsg::pixel_sample_batch_t>(
+      channels::kPixelSamples,
+      [&replies](const rlmsg::pixel_sample_batch_t& m) { replies.push_back(m); }, Port::kBulk);
+  Start(Options(8, 10, 200));
+  PublishAs(channels::kPixelTransitions, MakePixelBatch(20), "actor-0");
+  SendRequest(1, 16);
+  Pump();
+  EXPECT_EQ(service_->size(), 20);
+  ASSERT_EQ(replies.size(), 1U);
+  const rlmsg::pixel_sample_batch_t& r = replies[0];
+  EXPECT_EQ(r.request_id, 1);
+  EXPECT_EQ(r.count, 16);
+  EXPECT_EQ(r.stack, 2);
+  EXPECT_EQ(r.num_bytes, 16 * 8);
+  for (int i = 0; i < r.count; ++i) {
+    // The reward tells which transition was drawn; its stacks hold the frames it named.
+    const int t = static_cast<int>(r.reward[static_cast<size_t>(i)]);
+    EXPECT_EQ(r.action[static_cast<size_t>(i)], t % 3);
+    for (int b = 0; b < 4; ++b) {
+      EXPECT_EQ(r.obs[static_cast<size_t>(8 * i + b)], std::max(t - 1, 0));
+      EXPECT_EQ(r.obs[static_cast<size_t>(8 * i + 4 + b)], t);
+      EXPECT_EQ(r.next_obs[static_cast<size_t>(8 * i + b)], t);
+      EXPECT_EQ(r.next_obs[static_cast<size_t>(8 * i + 4 + b)], t + 1);
+    }
+    EXPECT_EQ(r.weight[static_cast<size_t>(i)], 1.0f);  // uniform sampling
+  }
+  // A flat batch in a pixel run is refused and counted.
+  SendTransitions(0, 5);
+  Pump();
+  EXPECT_EQ(service_->counters().batches_refused, 1);
+  EXPECT_EQ(service_->size(), 20);
+}
+
+TEST_F(ReplayServiceTest, PrioritizedSamplingFollowsThePrioritiesTheLearnerSends) {
+  ReplayServiceOptions o = Options(0, 10, 100000);
+  o.prioritized = true;
+  o.alpha = 1.0;
+  o.beta = 0.5;
+  Start(o);
+  SendTransitions(0, 10);
+  Pump();
+  // Transition 3 gets almost all the mass; the others nearly none.
+  rlmsg::priority_update_t u{};
+  u.count = 10;
+  for (int i = 0; i < 10; ++i) {
+    u.index.push_back(i);
+    u.priority.push_back(i == 3 ? 100.0f : 0.01f);
+  }
+  PublishAs(channels::kPriorities, u, "learner-0");
+  // An update for a transition that does not exist is skipped and counted.
+  rlmsg::priority_update_t stale{};
+  stale.count = 1;
+  stale.index = {12345};
+  stale.priority = {5.0f};
+  PublishAs(channels::kPriorities, stale, "learner-0");
+  SendRequest(1, 200);
+  Pump();
+  EXPECT_EQ(service_->counters().priorities_applied, 10);
+  EXPECT_EQ(service_->counters().priorities_stale, 1);
+  ASSERT_EQ(replies_.size(), 1U);
+  int threes = 0;
+  for (int i = 0; i < 200; ++i) {
+    const bool three = replies_[0].reward[static_cast<size_t>(i)] == 3.0f / 4.0f;
+    threes += three;
+    // Weights (N P(i))^-beta / max: 1 for the rarest transitions, far below for transition 3.
+    if (three) {
+      EXPECT_LT(replies_[0].weight[static_cast<size_t>(i)], 0.05f);
+    } else {
+      EXPECT_NEAR(replies_[0].weight[static_cast<size_t>(i)], 1.0f, 1e-4f);
+    }
+  }
+  // P(3) = 100 / (100 + 9 * 0.01) = 0.9991: nearly every draw.
+  EXPECT_GE(threes, 190);
+  service_->Tick(1.0);
+  bus_.Handle(0);
+  ASSERT_FALSE(stats_.empty());
+  EXPECT_EQ(stats_.back().prioritized, 1);
+  EXPECT_DOUBLE_EQ(stats_.back().beta, 0.5);
+  EXPECT_EQ(stats_.back().priorities_applied, 10);
+  EXPECT_GT(stats_.back().memory_bytes, 0);
 }
 
 TEST_F(ReplayServiceTest, RunServesUntilAskedToStop) {

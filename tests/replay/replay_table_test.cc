@@ -1,6 +1,9 @@
 #include "replay/replay_table.h"
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
+#include <memory>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -8,6 +11,8 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
+#include "replay/prioritized_sampler.h"
 
 namespace rl::replay {
 namespace {
@@ -68,6 +73,18 @@ void ExpectConsistent(const SampleBatch& s, int i) {
   EXPECT_EQ(s.discount[k], n % 2 == 1 ? 0.5f : 1.0f);
   EXPECT_EQ(s.episode_id[k], n / 10);
   EXPECT_EQ(s.weight[k], 1.0f);
+}
+
+// As ExpectConsistent(), whatever the weight.
+void ExpectConsistentButWeight(const SampleBatch& s, int i) {
+  const auto k = static_cast<size_t>(i);
+  const auto obs_size = static_cast<size_t>(s.obs_size);
+  const float v = s.obs[k * obs_size];
+  ASSERT_EQ(static_cast<float>(s.index[k]), v);
+  for (size_t j = 0; j < obs_size; ++j) {
+    EXPECT_EQ(s.next_obs[k * obs_size + j], v + 0.25f * static_cast<float>(j) + 100.0f);
+  }
+  EXPECT_EQ(s.reward[k], 2.0f * v);
 }
 
 TEST(ReplayTableTest, DefaultOptionsAreValid) { EXPECT_NO_THROW(ReplayTableOptions{}.Validate()); }
@@ -243,6 +260,116 @@ TEST(ReplayTableTest, SameSeedSameSamples) {
   ASSERT_TRUE(a.Sample(64, &rng_a, sa.spans()));
   ASSERT_TRUE(b.Sample(64, &rng_b, sb.spans()));
   EXPECT_EQ(sa.index, sb.index);
+}
+
+TEST(ReplayTableTest, UniformWeightsAreOneForAnyExponent) {
+  ReplayTable table(Options(10));
+  ASSERT_EQ(table.Insert(MakeBatch(0, 7, 1).view()), nullptr);
+  std::mt19937_64 rng(12);
+  SampleBatch s;
+  s.Resize(50, 1);
+  for (double beta : {0.0, 0.4, 1.0}) {
+    table.set_importance_exponent(beta);
+    ASSERT_TRUE(table.Sample(50, &rng, s.spans()));
+    for (float w : s.weight) ASSERT_EQ(w, 1.0f);
+  }
+  EXPECT_EQ(table.sampler().MinProbability(), 1.0 / 7.0);
+}
+
+TEST(ReplayTableTest, RefusesAnImportanceExponentOutsideZeroOne) {
+  ReplayTable table(Options(10));
+  EXPECT_EQ(table.importance_exponent(), 1.0);
+  EXPECT_THROW(table.set_importance_exponent(-0.1), std::invalid_argument);
+  EXPECT_THROW(table.set_importance_exponent(1.5), std::invalid_argument);
+  EXPECT_THROW(table.set_importance_exponent(std::numeric_limits<double>::quiet_NaN()),
+               std::invalid_argument);
+  table.set_importance_exponent(0.4);
+  EXPECT_EQ(table.importance_exponent(), 0.4);
+}
+
+TEST(ReplayTableTest, ImportanceWeightsOfThreeTransitionsMatchAHandComputation) {
+  // w_i = (N P_i)^-beta / max_j (N P_j)^-beta with N = 3. The largest is that of P = 1/8:
+  //   beta = 1:   (3/8)^-1 = 8/3,  (6/8)^-1 = 4/3,  (15/8)^-1 = 8/15  ->  1, 1/2, 1/5
+  //   beta = 0.5: sqrt of those ratios                                 ->  1, 0.70711, 0.44721
+  //   beta = 0:   1, 1, 1
+  struct Case {
+    double beta;
+    float w[3];
+  };
+  const Case cases[] = {{1.0, {1.0f, 0.5f, 0.2f}},
+                        {0.5, {1.0f, 0.70710678f, 0.44721360f}},
+                        {0.0, {1.0f, 1.0f, 1.0f}}};
+  // Three transitions of priorities 1, 2 and 5 (alpha 1, epsilon negligible): P = 1/8, 2/8, 5/8.
+  ReplayTable table(Options(8), std::make_unique<PrioritizedSampler>(8, 1.0, 1e-9));
+  OwnedBatch b = MakeBatch(0, 3, 2);
+  b.priority = {1.0f, 2.0f, 5.0f};
+  ASSERT_EQ(table.Insert(b.view()), nullptr);
+  std::mt19937_64 rng(13);
+  SampleBatch s;
+  s.Resize(8000, 2);
+  for (const Case& c : cases) {
+    table.set_importance_exponent(c.beta);
+    ASSERT_TRUE(table.Sample(8000, &rng, s.spans()));
+    std::vector<int> hits(3, 0);
+    for (size_t i = 0; i < 8000; ++i) {
+      ExpectConsistentButWeight(s, static_cast<int>(i));
+      const int64_t v = s.index[i];
+      ASSERT_TRUE(v >= 0 && v < 3) << v;
+      EXPECT_NEAR(s.weight[i], c.w[v], 1e-6) << "beta " << c.beta << " index " << v;
+      ++hits[static_cast<size_t>(v)];
+    }
+    // Stratified draws of 8000: each count within a few of 1000, 2000, 5000.
+    EXPECT_NEAR(hits[0], 1000, 5);
+    EXPECT_NEAR(hits[1], 2000, 5);
+    EXPECT_NEAR(hits[2], 5000, 5);
+  }
+}
+
+TEST(ReplayTableTest, UpdatePrioritiesSkipsOverwrittenAndUnknownTransitions) {
+  // Capacity 4 after 6 inserts: transitions 2 .. 5 are stored (slots 2, 3, 0, 1).
+  ReplayTable table(Options(4), std::make_unique<PrioritizedSampler>(4, 1.0, 1e-9));
+  ASSERT_EQ(table.Insert(MakeBatch(0, 6, 1).view()), nullptr);
+  const std::vector<int64_t> index = {0, 1, 2, 5, 6, -1, 3, 4};
+  const std::vector<float> priority = {9, 9, 100, 50, 9, 9, std::numeric_limits<float>::quiet_NaN(),
+                                       -1};
+  EXPECT_EQ(table.UpdatePriorities(index, priority), 2);
+  // Transitions 2 (slot 2) and 5 (slot 1) took 100 and 50; 3 and 4 kept the initial 1.
+  const Sampler& sampler = table.sampler();
+  EXPECT_NEAR(sampler.Probability(2), 100.0 / 152.0, 1e-6);
+  EXPECT_NEAR(sampler.Probability(1), 50.0 / 152.0, 1e-6);
+  EXPECT_NEAR(sampler.Probability(3), 1.0 / 152.0, 1e-6);
+  EXPECT_NEAR(sampler.Probability(0), 1.0 / 152.0, 1e-6);
+  // Nothing stored yet: everything is skipped.
+  ReplayTable empty(Options(4));
+  EXPECT_EQ(empty.UpdatePriorities(index, priority), 0);
+}
+
+TEST(ReplayTableTest, UpdatePrioritiesOfSampledTransitionsSteersTheSampler) {
+  ReplayTable table(Options(16), std::make_unique<PrioritizedSampler>(16, 1.0, 1e-6));
+  ASSERT_EQ(table.Insert(MakeBatch(0, 16, 1).view()), nullptr);
+  std::mt19937_64 rng(14);
+  SampleBatch s;
+  s.Resize(16, 1);
+  ASSERT_TRUE(table.Sample(16, &rng, s.spans()));
+  // The learner finds every TD error 0 except that of transition 7.
+  std::vector<float> priority(16, 0.0f);
+  for (size_t i = 0; i < 16; ++i) {
+    if (s.index[i] == 7) priority[i] = 1.0f;
+  }
+  EXPECT_EQ(table.UpdatePriorities(s.index, priority), 16);
+  // Every sampled transition (with stratified draws over 16 equal priorities, all of them)
+  // now has priority ~0 except 7.
+  ASSERT_TRUE(table.Sample(16, &rng, s.spans()));
+  for (int64_t v : s.index) EXPECT_EQ(v, 7);
+}
+
+TEST(ReplayTableTest, ReportsItsMemory) {
+  // Per slot: 2 * 4 floats of observations, 28 bytes of other fields, 16 of uniform sampler.
+  ReplayTable table(Options(1000, 4));
+  EXPECT_EQ(table.memory_bytes(), 1000 * (32 + 28 + 16));
+  // With a prioritized sampler: its tree of 2 * 1024 nodes of two doubles instead.
+  ReplayTable prioritized(Options(1000, 4), std::make_unique<PrioritizedSampler>(1000, 0.6));
+  EXPECT_EQ(prioritized.memory_bytes(), 1000 * (32 + 28) + 32 * 1024);
 }
 
 TEST(ReplayTableDeathTest, AbortsWhenTheOutputHasTheWrongSize) {

@@ -1,5 +1,6 @@
 #include "replay/uniform_sampler.h"
 
+#include <cstdint>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -38,6 +39,42 @@ TEST(UniformSamplerTest, DrawsOnlyInsertedSlotsWithProbabilityOneOverSize) {
     EXPECT_GT(hits[static_cast<size_t>(slot)], 850);
     EXPECT_LT(hits[static_cast<size_t>(slot)], 1150);
   }
+}
+
+TEST(UniformSamplerTest, RemovedSlotsAreNeverDrawnUntilInsertedAgain) {
+  UniformSampler sampler(6);
+  for (int64_t slot = 0; slot < 5; ++slot) sampler.Insert(slot, 0.0);
+  sampler.Remove(2);
+  sampler.Remove(2);  // twice: no effect
+  sampler.Remove(5);  // never inserted: no effect
+  sampler.Remove(4);  // the last one
+  EXPECT_EQ(sampler.size(), 3);
+  EXPECT_EQ(sampler.Probability(2), 0.0);
+  EXPECT_EQ(sampler.Probability(4), 0.0);
+  EXPECT_DOUBLE_EQ(sampler.Probability(0), 1.0 / 3.0);
+  EXPECT_DOUBLE_EQ(sampler.MinProbability(), 1.0 / 3.0);
+  std::mt19937_64 rng(4);
+  std::vector<SampledItem> items(600);
+  sampler.Sample(&rng, items);
+  for (const SampledItem& item : items) {
+    ASSERT_TRUE(item.slot == 0 || item.slot == 1 || item.slot == 3) << item.slot;
+  }
+  sampler.Insert(2, 0.0);
+  EXPECT_EQ(sampler.size(), 4);
+  EXPECT_DOUBLE_EQ(sampler.Probability(2), 0.25);
+}
+
+TEST(UniformSamplerTest, IgnoresPrioritiesAndReportsOneOverSize) {
+  UniformSampler sampler(10);
+  EXPECT_EQ(sampler.MinProbability(), 0.0);
+  sampler.Insert(0, 100.0);
+  sampler.Insert(1, 0.001);
+  sampler.Update(0, 1e6);
+  EXPECT_EQ(sampler.Probability(0), 0.5);
+  EXPECT_EQ(sampler.Probability(1), 0.5);
+  EXPECT_EQ(sampler.MinProbability(), 0.5);
+  // 8 bytes of position and 8 of slot list per slot.
+  EXPECT_EQ(sampler.memory_bytes(), 16 * 10);
 }
 
 TEST(UniformSamplerTest, SameSeedSameDraws) {

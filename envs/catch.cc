@@ -1,0 +1,114 @@
+#include "envs/catch.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+
+#include "common/check.h"
+#include "envs/raster.h"
+#include "envs/rng.h"
+
+namespace rl::envs {
+namespace {
+
+constexpr Rgb kBackground{0, 0, 0};
+constexpr Rgb kObject{255, 255, 255};
+
+// Paints grid cell (row, column) of a width x height canvas; the cell boundaries are
+// floor(i * size / cells), computed in 64 bits so that large sizes cannot overflow.
+void PaintCell(Canvas& canvas, int row, int column) {
+  const auto edge = [](int i, int size, int cells) {
+    return static_cast<int>(static_cast<int64_t>(i) * size / cells);
+  };
+  const int w = canvas.width();
+  const int h = canvas.height();
+  canvas.FillPixelRect(edge(column, w, Catch::kColumns), edge(row, h, Catch::kRows),
+                       edge(column + 1, w, Catch::kColumns), edge(row + 1, h, Catch::kRows),
+                       kObject);
+}
+
+}  // namespace
+
+Catch::Catch()
+    : spec_{.id = "Catch-v0",
+            .observation_size = kRows * kColumns,
+            .num_actions = 3,
+            .max_episode_steps = kRows - 1,
+            .reward_threshold = 0.9} {}
+
+void Catch::Reset(uint64_t seed) {
+  SeedRng(seed, rng_);
+  rng_seeded_ = true;
+  SampleInitialState();
+}
+
+void Catch::Reset() {
+  if (!rng_seeded_) {
+    SeedRngRandomly(rng_);
+    rng_seeded_ = true;
+  }
+  SampleInitialState();
+}
+
+void Catch::SampleInitialState() {
+  ball_column_ = static_cast<int>(UniformInt(rng_, 0, kColumns));
+  ball_row_ = 0;
+  paddle_column_ = kPaddleStartColumn;
+  has_state_ = true;
+  UpdateObservation();
+}
+
+StepResult Catch::Step(int action) {
+  if (action < 0 || action >= spec_.num_actions) {
+    throw std::invalid_argument("Catch: action must be 0, 1 or 2, got " + std::to_string(action));
+  }
+  if (!has_state_) throw std::logic_error("Catch: call Reset() before Step()");
+  if (episode_over()) {
+    throw std::logic_error(
+        "Catch: the episode is over (the ball is in the bottom row); call Reset()");
+  }
+
+  // Move the paddle (action 0, 1, 2 -> -1, 0, +1 columns), then drop the ball one row.
+  paddle_column_ = std::clamp(paddle_column_ + action - 1, 0, kColumns - 1);
+  ++ball_row_;
+  UpdateObservation();
+
+  // The episode ends when the ball reaches the paddle's row.
+  StepResult result;
+  if (ball_row_ == kRows - 1) {
+    result.terminated = true;
+    result.reward = paddle_column_ == ball_column_ ? 1.0 : -1.0;
+  }
+  return result;
+}
+
+void Catch::UpdateObservation() {
+  std::fill(observation_.begin(), observation_.end(), 0.0f);
+  observation_[static_cast<std::size_t>(ball_row_ * kColumns + ball_column_)] = 1.0f;
+  observation_[static_cast<std::size_t>((kRows - 1) * kColumns + paddle_column_)] = 1.0f;
+}
+
+void Catch::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
+  RL_CHECK(width != nullptr && height != nullptr) << "Render needs width and height outputs";
+  RenderSized(kScreenWidth, kScreenHeight, rgb);
+  *width = kScreenWidth;
+  *height = kScreenHeight;
+}
+
+void Catch::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
+  RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
+  if (width <= 0 || height <= 0) {
+    throw std::invalid_argument("Catch: render size must be positive, got " +
+                                std::to_string(width) + "x" + std::to_string(height));
+  }
+  if (!has_state_) throw std::logic_error("Catch: call Reset() before Render()");
+
+  // Black board with the ball's and the paddle's cells in white.
+  Canvas canvas(width, height, rgb);
+  canvas.Clear(kBackground);
+  PaintCell(canvas, ball_row_, ball_column_);
+  PaintCell(canvas, kRows - 1, paddle_column_);
+}
+
+}  // namespace rl::envs

@@ -1,0 +1,117 @@
+#include "envs/image/action_repeat.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "common/check.h"
+
+namespace rl::envs {
+
+ActionRepeat::ActionRepeat(std::unique_ptr<Env> env, const ImagePipelineConfig& config)
+    : env_(std::move(env)),
+      render_width_(config.render_width),
+      render_height_(config.render_height),
+      frame_skip_(config.frame_skip),
+      max_pool_(config.max_pool) {
+  if (env_ == nullptr) {
+    throw std::invalid_argument("ActionRepeat: the wrapped env must not be null");
+  }
+  config.Validate();
+  spec_ = env_->spec();
+  if (spec_.num_actions <= 0) {
+    throw std::invalid_argument(
+        "ActionRepeat: \"" + spec_.id +
+        "\" is a continuous env; the pixel pipeline needs discrete actions");
+  }
+  // ceil(max_episode_steps / frame_skip): the outer step that contains the inner limit.
+  spec_.max_episode_steps = static_cast<int>(
+      (static_cast<int64_t>(spec_.max_episode_steps) + frame_skip_ - 1) / frame_skip_);
+
+  // The raw size: the requested one, or the native one, learnt from a throwaway episode.
+  shape_ = ImageShape{.width = render_width_, .height = render_height_, .channels = 3};
+  if (render_width_ == 0) {
+    env_->Reset(0);
+    env_->Render(&frames_[0], &shape_.width, &shape_.height);
+  }
+  for (std::vector<uint8_t>& frame : frames_) frame.resize(shape_.bytes());
+}
+
+void ActionRepeat::Reset(uint64_t seed) {
+  env_->Reset(seed);
+  Capture(0);
+  current_ = 0;
+}
+
+void ActionRepeat::Reset() {
+  env_->Reset();
+  Capture(0);
+  current_ = 0;
+}
+
+StepResult ActionRepeat::Step(int action) {
+  if (current_ < 0) throw std::logic_error("ActionRepeat: call Reset() before Step()");
+
+  // Repeat the action, keeping the raw frames of the last two inner steps when max-pooling.
+  StepResult total;
+  int taken = 0;
+  while (taken < frame_skip_) {
+    const StepResult inner = env_->Step(action);
+    ++taken;
+    total.reward += inner.reward;
+    total.terminated = inner.terminated;
+    total.truncated = inner.truncated;
+    if (max_pool_) Capture(taken % 2);
+    if (inner.terminated || inner.truncated) break;
+  }
+
+  // The frame of this step: the last raw frame, or the max of the last two.
+  if (!max_pool_) {
+    Capture(0);
+    current_ = 0;
+  } else if (taken == 1) {
+    current_ = 1;
+  } else {
+    std::transform(frames_[0].begin(), frames_[0].end(), frames_[1].begin(), frames_[2].begin(),
+                   [](uint8_t a, uint8_t b) { return std::max(a, b); });
+    current_ = 2;
+  }
+  return total;
+}
+
+void ActionRepeat::Capture(int slot) {
+  std::vector<uint8_t>& frame = frames_[static_cast<std::size_t>(slot)];
+  if (render_width_ > 0) {
+    env_->RenderSized(render_width_, render_height_, &frame);
+  } else {
+    int width = 0;
+    int height = 0;
+    env_->Render(&frame, &width, &height);
+    if (width != shape_.width || height != shape_.height) {
+      throw std::logic_error("ActionRepeat: \"" + spec_.id + "\" rendered " +
+                             std::to_string(width) + "x" + std::to_string(height) +
+                             " after rendering " + std::to_string(shape_.width) + "x" +
+                             std::to_string(shape_.height) + "; the native size must not change");
+    }
+  }
+  RL_CHECK(frame.size() == shape_.bytes())
+      << "the wrapped env rendered " << frame.size() << " bytes, expected " << shape_.bytes();
+}
+
+std::span<const uint8_t> ActionRepeat::image() const {
+  if (current_ < 0) throw std::logic_error("ActionRepeat: call Reset() before image()");
+  return frames_[static_cast<std::size_t>(current_)];
+}
+
+void ActionRepeat::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
+  env_->Render(rgb, width, height);
+}
+
+void ActionRepeat::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
+  env_->RenderSized(width, height, rgb);
+}
+
+}  // namespace rl::envs

@@ -1,0 +1,28 @@
+// Env ids with an image pipeline: "<id>+pixels(<key>=<value>,...)".
+//
+// A run names its env with one string that every process reads (the preset's `env` key), so the
+// pixel pipeline is part of that string: "Catch-v0+pixels(width=5,height=10,stack=2)" is Catch
+// rendered, reduced to 10 x 5 grayscale frames and stacked by two. Keys (defaults as in
+// ImagePipelineConfig): width, height, stack, skip, max-pool, crop-top, crop-bottom, crop-left,
+// crop-right, render-width, render-height. Reward clipping is not a key: it is a training
+// choice (the actor's --clip-rewards), and evaluations score unclipped returns.
+#pragma once
+
+#include <string>
+
+#include "envs/image/pixel_env.h"
+
+namespace rl::envs {
+
+struct EnvIdParts {
+  std::string base;           // the registered id, e.g. "Catch-v0"
+  bool pixels = false;        // "+pixels(...)" was given
+  ImagePipelineConfig image;  // its settings (validated) when pixels is true
+};
+
+/// Splits and parses an env id. Throws std::invalid_argument naming the problem: an unknown key,
+/// a value that is not an integer (0/1 for max-pool), a missing ")" or text after it, or
+/// settings that ImagePipelineConfig::Validate() refuses.
+EnvIdParts ParseEnvId(const std::string& id);
+
+}  // namespace rl::envs

@@ -1,0 +1,241 @@
+// PixelTable: the replay daemon's storage for pixel transitions, where every frame is stored
+// once and observations are stacks rebuilt from frame references when sampled.
+//
+// Consecutive transitions of an episode share all but one frame of their stacks (obs of step
+// t+1 is next_obs of step t, which is obs of step t shifted by one frame), so storing stacks
+// would cost 2 * stack frames per transition where one suffices. Actors therefore send each
+// frame once, with an actor-local frame id (increasing per actor), and name a transition's obs
+// and next_obs stacks by frame ids, oldest first. The actor repeats an episode's first frame to
+// fill the stack at a reset, so the table never needs to know where episodes begin.
+//
+// Storage:
+//   - a ring of frame_capacity frames (height * width bytes each, grayscale, row-major),
+//     numbered globally in arrival order: frame g lives at g % frame_capacity and is still
+//     stored while g >= total_frames() - frame_capacity;
+//   - per actor, a ring of the last 4096 local ids mapped to global frame numbers (an entry
+//     keeps its local id, so that an id 4096 older, or one never received, is not mistaken for
+//     it): a transition may name only frames among its actor's last 4096;
+//   - per transition slot (capacity slots, filled in insertion order, the oldest overwritten):
+//     the global numbers of its 2 * stack frames, action, reward, discount, episode id and
+//     insert number.
+//
+// A transition is stored only if every frame it names is known and still stored; otherwise it
+// is skipped (counted in transitions_missing_frames(): typically a lost frame message) and the
+// rest of its batch is stored. A stored transition becomes stale when the frame ring overwrites
+// its oldest frame (frame_capacity too small for the frames that arrive while it is kept);
+// Sample() then removes it from the sampler and draws again (counted in stale_draws()).
+//
+// Memory: frame_capacity * height * width bytes + capacity * (16 * stack + 28) bytes + 64 KiB
+// per actor, allocated when the geometry becomes known (from the options, or the first batch),
+// plus the sampler's (16 bytes per slot for the uniform sampler, 32 to 64 for the prioritized
+// one). With the default frame_capacity (capacity * 1.125 + 4096) and 84 x 84 stacks of 4, a
+// transition costs about 1.125 frames (7938 bytes) + 92 bytes + the sampler's.
+//
+// The table knows nothing about LCM: the caller hands it views of its own arrays. Not
+// thread-safe: one thread inserts and samples.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <span>
+#include <vector>
+
+#include "replay/sampler.h"
+
+namespace rl::replay {
+
+struct PixelTableOptions {
+  // Transitions kept; when full, the oldest is overwritten.
+  int64_t capacity = 100000;
+  // Frames kept; when full, the oldest is overwritten. 0: capacity + capacity / 8 + 4096, enough
+  // for about one new frame per transition plus a reset frame per episode of 8 steps or more,
+  // and frames of transitions in flight.
+  int64_t frame_capacity = 0;
+  // Frame height and width in pixels (at most 4096 each), and frames per observation (at most
+  // 64); 0: taken from the first batch. Batches with other values are refused.
+  int height = 0;
+  int width = 0;
+  int stack = 0;
+
+  /// Throws std::invalid_argument naming the field when a value is out of range.
+  void Validate() const;
+  /// frame_capacity, or its default when 0.
+  int64_t frames_kept() const;
+};
+
+/// A batch from one actor, as views of the caller's arrays. num_frames new frames with their
+/// local ids (strictly increasing) and num_frames * height * width bytes; count transitions, each
+/// naming its obs and next_obs stacks by local frame id, oldest first (count * stack ids each;
+/// transition i at [i * stack, (i + 1) * stack)), which may be frames of this batch or of an
+/// earlier batch of the same actor. action, reward and discount hold count values; episode_id
+/// and priority hold count values or are empty (stored as -1, and "priority not known").
+struct PixelBatchView {
+  int32_t actor_id = 0;
+  int height = 0;
+  int width = 0;
+  int stack = 0;
+  int num_frames = 0;
+  std::span<const int64_t> frame_id;
+  std::span<const uint8_t> frames;
+  int count = 0;
+  std::span<const int64_t> obs_frames;
+  std::span<const int64_t> next_obs_frames;
+  std::span<const int32_t> action;
+  std::span<const float> reward;
+  std::span<const float> discount;
+  std::span<const int64_t> episode_id;
+  std::span<const float> priority;
+};
+
+/// Where Sample() writes a batch of `count` transitions: obs and next_obs have room for
+/// count * stack * height * width bytes (transition i's stack at [i * stack * height * width,
+/// ...), its frames oldest first), the others for count values each. index and weight as in
+/// SampleSpans (replay_table.h).
+struct PixelSampleSpans {
+  std::span<uint8_t> obs;
+  std::span<uint8_t> next_obs;
+  std::span<int32_t> action;
+  std::span<float> reward;
+  std::span<float> discount;
+  std::span<int64_t> index;
+  std::span<float> weight;
+};
+
+/// A batch that owns its arrays, for callers that have none of their own. Resize() allocates
+/// only when the batch grows.
+struct PixelSampleBatch {
+  int count = 0;
+  int height = 0;
+  int width = 0;
+  int stack = 0;
+  std::vector<uint8_t> obs;
+  std::vector<uint8_t> next_obs;
+  std::vector<int32_t> action;
+  std::vector<float> reward;
+  std::vector<float> discount;
+  std::vector<int64_t> index;
+  std::vector<float> weight;
+
+  void Resize(int new_count, int new_height, int new_width, int new_stack);
+  PixelSampleSpans spans();
+};
+
+class PixelTable {
+ public:
+  /// Throws std::invalid_argument when the options are bad. A null sampler means uniform; a
+  /// sampler given must have `capacity` slots.
+  explicit PixelTable(PixelTableOptions options, std::unique_ptr<Sampler> sampler = nullptr);
+  PixelTable(const PixelTable&) = delete;
+  PixelTable& operator=(const PixelTable&) = delete;
+  ~PixelTable();
+
+  /// Stores the batch's frames, then each of its transitions whose frames are all known (see
+  /// the top of the file), overwriting the oldest when full. Returns nullptr on success (even
+  /// when some transitions were skipped), or a short reason why the whole batch was refused
+  /// (nothing stored): actor_id outside [0, 65535], a geometry other than the table's or out of
+  /// range, views whose sizes do not match the counts, frame ids not strictly increasing within
+  /// the batch, no frames and no transitions, or a 1025th distinct actor. A batch whose first
+  /// frame id is not above the last one of its actor is taken to come from a restarted actor:
+  /// the ids of its earlier frames are forgotten. O(num_frames * height * width + count * stack);
+  /// allocates only for the first batch (when the geometry was not configured) and for the
+  /// first batch of each actor.
+  [[nodiscard]] const char* Insert(const PixelBatchView& batch);
+
+  /// Draws batch_size transitions with replacement, as the sampler decides, into `out`, whose
+  /// spans must have exactly the sizes batch_size and the geometry call for (a mismatch is a
+  /// caller bug and aborts). Weights as in ReplayTable::Sample(). A drawn transition that has
+  /// become stale is removed from the sampler and the element is drawn again (without
+  /// stratification); after 16 stale draws for one element, every stale transition is removed
+  /// in one pass over the table (O(capacity * stack)), so the next draw is fresh. Returns
+  /// false, writing nothing, when the table holds no transition that can be drawn.
+  /// O(batch_size * (stack * height * width + log capacity)); no allocation once a batch of this
+  /// size has been drawn.
+  bool Sample(int batch_size, std::mt19937_64* rng, const PixelSampleSpans& out);
+
+  /// As ReplayTable::UpdatePriorities(); transitions removed as stale are skipped too.
+  int64_t UpdatePriorities(std::span<const int64_t> index, std::span<const float> priority);
+
+  /// As ReplayTable::set_importance_exponent().
+  void set_importance_exponent(double beta);
+  double importance_exponent() const { return beta_; }
+
+  /// Transitions stored that can be drawn (at most capacity(); stale ones that Sample() has met
+  /// are no longer counted).
+  int64_t size() const { return size_; }
+  int64_t capacity() const { return options_.capacity; }
+  /// Frames kept (the effective frame_capacity).
+  int64_t frame_capacity() const { return frame_capacity_; }
+  /// Transitions ever stored (including overwritten ones; skipped ones are not counted).
+  int64_t total_inserts() const { return total_inserts_; }
+  /// Transitions ever drawn by Sample() (redraws count once).
+  int64_t total_samples() const { return total_samples_; }
+  /// Frames ever stored (including overwritten ones).
+  int64_t total_frames() const { return total_frames_; }
+  /// Frame geometry; 0 until known.
+  int height() const { return height_; }
+  int width() const { return width_; }
+  int stack() const { return stack_; }
+  /// Transitions skipped at Insert() because a frame they name is unknown or overwritten.
+  int64_t transitions_missing_frames() const { return missing_frames_; }
+  /// Draws made again because the drawn transition's oldest frame had been overwritten.
+  int64_t stale_draws() const { return stale_draws_; }
+  /// Bytes held by the table and its sampler (the capacities of their arrays).
+  int64_t memory_bytes() const;
+  /// The sampler, for inspection (probabilities, size).
+  const Sampler& sampler() const { return *sampler_; }
+
+ private:
+  // Where an actor's recent local frame ids are: entry local_id % kWindow.
+  struct FrameRef {
+    int64_t local_id = 0;
+    int64_t global = -1;  // -1: empty
+  };
+  struct ActorFrames {
+    int32_t actor_id = 0;
+    int64_t last_id = 0;  // local id of its newest frame, when any
+    bool any = false;     // whether a frame has been received
+    std::vector<FrameRef> window;
+  };
+
+  void Allocate(int height, int width, int stack);
+  // The actor's frames, or nullptr when it has none and no more actors can be held.
+  ActorFrames* FindOrAddActor(int32_t actor_id);
+  // Global frame numbers of `local` in *global; false when one is unknown or overwritten.
+  bool Resolve(const ActorFrames& actor, std::span<const int64_t> local, int64_t* global) const;
+  // Whether the slot's oldest frame has been overwritten.
+  bool Stale(int64_t slot) const;
+  // Takes a transition out of the table and its sampler.
+  void Drop(int64_t slot);
+  // Drops every stored transition that is stale.
+  void DropAllStale();
+
+  PixelTableOptions options_;
+  std::unique_ptr<Sampler> sampler_;
+  int64_t frame_capacity_ = 0;
+  int height_ = 0;
+  int width_ = 0;
+  int stack_ = 0;
+  int64_t size_ = 0;
+  int64_t total_inserts_ = 0;
+  int64_t total_samples_ = 0;
+  int64_t total_frames_ = 0;
+  int64_t missing_frames_ = 0;
+  int64_t stale_draws_ = 0;
+  double beta_ = 1.0;
+
+  std::vector<uint8_t> frames_;      // frame_capacity_ frames of height_ * width_ bytes
+  std::vector<ActorFrames> actors_;  // sorted by actor_id
+
+  // Per-slot storage (frame_refs_: 2 * stack_ global frame numbers per slot, obs then next_obs).
+  std::vector<int64_t> frame_refs_;
+  std::vector<int32_t> action_;
+  std::vector<float> reward_;
+  std::vector<float> discount_;
+  std::vector<int64_t> episode_id_;
+  std::vector<int64_t> insert_number_;  // -1: the slot holds no transition that can be drawn
+
+  std::vector<SampledItem> items_;  // scratch for Sample()
+};
+
+}  // namespace rl::replay

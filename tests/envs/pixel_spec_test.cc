@@ -1,0 +1,87 @@
+#include "envs/pixel_spec.h"
+
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "envs/registry.h"
+
+namespace rl::envs {
+namespace {
+
+TEST(PixelSpecTest, AnIdWithoutPixelsIsJustTheRegisteredId) {
+  const EnvIdParts p = ParseEnvId("CartPole-v1");
+  EXPECT_EQ(p.base, "CartPole-v1");
+  EXPECT_FALSE(p.pixels);
+}
+
+TEST(PixelSpecTest, ReadsEveryKey) {
+  const EnvIdParts p = ParseEnvId(
+      "Catch-v0+pixels(width=6,height=12,stack=3,skip=2,max-pool=0,crop-top=1,crop-bottom=2,"
+      "crop-left=3,crop-right=4,render-width=40,render-height=80)");
+  EXPECT_EQ(p.base, "Catch-v0");
+  ASSERT_TRUE(p.pixels);
+  EXPECT_EQ(p.image.width, 6);
+  EXPECT_EQ(p.image.height, 12);
+  EXPECT_EQ(p.image.stack, 3);
+  EXPECT_EQ(p.image.frame_skip, 2);
+  EXPECT_FALSE(p.image.max_pool);
+  EXPECT_EQ(p.image.crop_top, 1);
+  EXPECT_EQ(p.image.crop_bottom, 2);
+  EXPECT_EQ(p.image.crop_left, 3);
+  EXPECT_EQ(p.image.crop_right, 4);
+  EXPECT_EQ(p.image.render_width, 40);
+  EXPECT_EQ(p.image.render_height, 80);
+  EXPECT_FALSE(p.image.clip_rewards);
+}
+
+TEST(PixelSpecTest, KeepsTheDefaultsOfKeysNotGiven) {
+  const EnvIdParts p = ParseEnvId("CartPole-v1+pixels()");
+  const ImagePipelineConfig defaults;
+  EXPECT_TRUE(p.pixels);
+  EXPECT_EQ(p.image.width, defaults.width);
+  EXPECT_EQ(p.image.stack, defaults.stack);
+  EXPECT_EQ(p.image.max_pool, defaults.max_pool);
+}
+
+TEST(PixelSpecTest, RefusesBadSpecsWithTheReason) {
+  const auto message = [](const std::string& id) {
+    try {
+      ParseEnvId(id);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("Catch-v0+pixels(colour=1)").find("unknown pixels key 'colour'"),
+            std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(width=five)").find("width must be an integer"),
+            std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(width=5").find("ending in ')'"), std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(width=5)x").find("ending in ')'"), std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(stack)").find("expected key=value"), std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(max-pool=2)").find("max-pool is 0 or 1"), std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(stack=0)").find("stack"), std::string::npos);
+}
+
+TEST(PixelSpecTest, MakeEnvBuildsThePipelineTheIdDescribes) {
+  auto env = MakeEnv("Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)");
+  const EnvSpec& spec = env->spec();
+  EXPECT_EQ(spec.id, "Catch-v0");
+  EXPECT_EQ(spec.frame_width, 5);
+  EXPECT_EQ(spec.frame_height, 10);
+  EXPECT_EQ(spec.frame_stack, 2);
+  EXPECT_EQ(spec.observation_size, 100);
+  EXPECT_EQ(spec.num_actions, 3);
+  env->Reset(3);
+  // One pixel per cell: two bright pixels (the ball in row 0, the paddle in row 9, column 2).
+  int bright = 0;
+  for (uint8_t v : env->frame()) bright += v > 128;
+  EXPECT_EQ(bright, 2);
+  EXPECT_GT(env->frame()[9 * 5 + 2], 128);
+  EXPECT_THROW(MakeEnv("Nope-v0+pixels(stack=2)"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace rl::envs

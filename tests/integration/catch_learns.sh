@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The pipeline learns Catch from pixels: frames sent once and stacked again by the replay,
+# prioritized n-step replay with priorities from the learner, a dueling CNN. Within a bounded
+# time an evaluation over 100 episodes (epsilon 0.05) must reach the preset's goal of 0.8 (a
+# random paddle scores about -0.5), and nothing may be lost or dropped on the way.
+source "$(dirname "$0")/lib.sh"
+isolate "$@"
+scratch
+set +e
+launch catch --out "$dir/run" --seed 1 --time-budget 240 > "$dir/launch.log" 2>&1
+status=$?
+set -e
+tail -6 "$dir/launch.log"
+[ "$status" -eq 0 ] || fail "launch exited with $status"
+best=$(best_mean "$dir/run/eval.jsonl")
+awk -v b="$best" 'BEGIN{exit !(b >= 0.8)}' || fail "best evaluation mean $best < 0.8"
+# The replay stored pixel frames, applied the learner's priorities, and lost nothing.
+last=$(grep '^replay: size' "$dir/run/logs/replay.log" | tail -1)
+echo "$last"
+[ -n "$last" ] || fail "no progress line from the replay"
+field() { echo "$last" | sed -n "s/.* $1 \([0-9]*\).*/\1/p"; }
+[ "$(field frames)" -gt 0 ] || fail "the replay stored no frames"
+[ "$(field priorities)" -gt 0 ] || fail "the replay applied no priorities"
+[ "$(field lost)" -eq 0 ] || fail "the replay lost messages"
+[ "$(field dropped)" -eq 0 ] || fail "the replay dropped messages"
+[ "$(field missing_frames)" -eq 0 ] || fail "transitions named frames that never arrived"
+[ -s "$dir/run/report/best.webm" ] || fail "no video of the greedy policy"
+echo "PASS: Catch learned from pixels to a mean of $best"
