@@ -1,22 +1,60 @@
-// Replay throughput through LCM (udpm on loopback, the URLs of a run): a replay service in its
-// own thread with its own LCM sockets, and in the main thread an "actor" publishing batches of
-// 32 CartPole transitions as fast as it can, then a "learner" keeping 8 requests of 128
-// transitions in flight. Reports inserts/s (transitions stored per second, with the share lost)
-// and samples/s (transitions received by the learner per second). Rate limiting is off.
+// Replay throughput through LCM (udpm on loopback, the URLs of a run), and the memory of pixel
+// replay.
+//
+// Flat (CartPole) transitions: a replay service in its own thread with its own LCM sockets, and
+// in the main thread an "actor" publishing batches of 32 CartPole transitions as fast as it can,
+// then a "learner" keeping 8 requests of 128 transitions in flight. Reports inserts/s
+// (transitions stored per second, with the share lost) and samples/s (transitions received by
+// the learner per second). Rate limiting is off.
+//
+// Pixel (Nature DQN: 84 x 84 grayscale frames, stacks of 4) transitions, into a second replay
+// service (capacity 100,000, rate limiting off) on its own two ports:
+//   pixel_replay_insert       batches of 32 transitions with their new frames, built as
+//                             actor/actor.cc builds them (each frame sent once with an increasing
+//                             actor-local id, stacks named by frame ids, the first frame of an
+//                             episode repeated to fill the stack), published back to back from
+//                             the main thread; transitions/s and MB/s stored, and what was lost.
+//   pixel_replay_sample       the learner's path: 4 requests of 32 stacks in flight (the
+//                             learner's default), replies of ~1.8 MB on the bulk port.
+//   pixel_replay_8_actors     8 actor threads, each with its own bus, each publishing a batch
+//                             every 32 / 250 s (250 env steps/s per actor: an assumed nominal
+//                             rate for an Atari-like env with a Nature CNN policy on one core,
+//                             not measured here) for a few seconds, into the same service, nobody
+//                             sampling; transitions lost and delivered per second.
+//                             pixel_replay_8_actors_4x: the same at 4x, to show the headroom.
+//   pixel_replay_bytes_per_transition[_prioritized]  a PixelTable (no LCM) filled with 100,000
+//                             transitions from 8 simulated actors: memory_bytes() / size(), and
+//                             the process's VmRSS growth around filling it.
 //
 // Usage: bench_replay [repeats] [seconds] [port]   (run it in its own network namespace, or
-// give it a free port)
+// give it four free ports from `port` on)
+#include <malloc.h>
+
+#include <algorithm>
+#include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <random>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "bench/bench_util.h"
 #include "common/channels.h"
+#include "common/check.h"
 #include "common/clock.h"
+#include "replay/pixel_table.h"
+#include "replay/prioritized_sampler.h"
 #include "replay/replay_service.h"
+#include "replay/uniform_sampler.h"
+#include "rlmsg/flow_control_t.hpp"
+#include "rlmsg/pixel_batch_t.hpp"
+#include "rlmsg/pixel_sample_batch_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
 #include "rlmsg/stats_replay_t.hpp"
 
@@ -46,13 +84,8 @@ rlmsg::transition_batch_t Batch() {
   return m;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
-  const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
-  const int port = argc > 3 ? std::atoi(argv[3]) : 17667;
-
+// Flat CartPole transitions: replay_inserts_lcm and replay_samples_lcm, on `port` and port + 1.
+int RunFlat(int repeats, double seconds, int port) {
   // The replay service, on its own thread and sockets.
   std::atomic<bool> stop{false};
   std::atomic<int64_t> inserted{0};
@@ -154,5 +187,509 @@ int main(int argc, char** argv) {
                   repeats, "\"batch\": 128, \"in_flight\": 8, \"transport\": \"udpm\"");
   stop = true;
   service_thread.join();
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Pixel transitions.
+
+constexpr int kHeight = 84;
+constexpr int kWidth = 84;
+constexpr int kStack = 4;
+constexpr int kFrameBytes = kHeight * kWidth;  // 7056
+constexpr int kBatch = 32;                     // transitions per actor batch and per sample
+constexpr int kActors = 8;
+constexpr double kStepsPerActor = 250;    // assumed env steps/s of one actor (see the top)
+constexpr int64_t kCapacity = 100'000;    // transitions kept by the pixel replay service
+constexpr int64_t kMemoryFill = 100'000;  // transitions put in the table of the memory figure
+constexpr int kSampleInFlight = 4;        // the learner's default requests_in_flight
+
+// Episodes last between these many steps (uniformly), which decides how often a reset frame is
+// sent (one frame per step plus one per episode).
+constexpr int kMinEpisode = 200;
+constexpr int kMaxEpisode = 1800;
+
+// One actor's stream of pixel batches, as actor/actor.cc builds them with n-step 1: every step
+// adds one new frame, an episode's first frame fills its first stack, and a transition names its
+// stack and next stack by frame ids, oldest first. Frame contents are random bytes (the replay
+// never looks at them).
+class PixelActorSim {
+ public:
+  PixelActorSim(int32_t actor_id, uint64_t seed)
+      : rng_(seed), pattern_(static_cast<size_t>(2 * kBatch * kFrameBytes)) {
+    for (uint8_t& b : pattern_) b = static_cast<uint8_t>(rng_() >> 56);
+    m_.actor_id = actor_id;
+    m_.height = kHeight;
+    m_.width = kWidth;
+    m_.stack = kStack;
+    episode_steps_ = EpisodeLength();
+  }
+
+  /// The next batch of kBatch transitions with the frames new in it (valid until the next call).
+  rlmsg::pixel_batch_t* Next() {
+    m_.frame_id.clear();
+    m_.obs_frames.clear();
+    m_.next_obs_frames.clear();
+    m_.action.clear();
+    m_.reward.clear();
+    m_.discount.clear();
+    m_.episode_id.clear();
+    m_.priority.clear();
+    for (int i = 0; i < kBatch; ++i) {
+      if (step_ == 0) stack_.fill(AddFrame());  // a reset: the first frame fills the stack
+      std::array<int64_t, kStack> next{};
+      std::copy(stack_.begin() + 1, stack_.end(), next.begin());
+      next.back() = AddFrame();
+      const bool terminal = ++step_ >= episode_steps_;
+      m_.obs_frames.insert(m_.obs_frames.end(), stack_.begin(), stack_.end());
+      m_.next_obs_frames.insert(m_.next_obs_frames.end(), next.begin(), next.end());
+      m_.action.push_back(static_cast<int32_t>(rng_() % 18));
+      m_.reward.push_back(rng_() % 64 == 0 ? 1.0f : 0.0f);
+      m_.discount.push_back(terminal ? 0.0f : 0.99f);
+      m_.episode_id.push_back(episode_);
+      m_.priority.push_back(0.0f);
+      stack_ = next;
+      if (terminal) {
+        ++episode_;
+        step_ = 0;
+        episode_steps_ = EpisodeLength();
+      }
+    }
+    m_.num_frames = static_cast<int32_t>(m_.frame_id.size());
+    m_.num_bytes = m_.num_frames * kFrameBytes;
+    RL_CHECK(static_cast<size_t>(m_.num_bytes) <= pattern_.size()) << "more frames than expected";
+    m_.frames.assign(pattern_.begin(), pattern_.begin() + m_.num_bytes);
+    m_.count = kBatch;
+    m_.num_refs = kBatch * kStack;
+    return &m_;
+  }
+
+ private:
+  int64_t AddFrame() {
+    m_.frame_id.push_back(next_frame_id_);
+    return next_frame_id_++;
+  }
+  int EpisodeLength() {
+    return kMinEpisode + static_cast<int>(rng_() % (kMaxEpisode - kMinEpisode + 1));
+  }
+
+  std::mt19937_64 rng_;
+  std::vector<uint8_t> pattern_;
+  rlmsg::pixel_batch_t m_{};
+  std::array<int64_t, kStack> stack_{};
+  int64_t next_frame_id_ = 0;
+  int64_t episode_ = 0;
+  int step_ = 0;  // steps into the current episode (0: the next step starts one)
+  int episode_steps_ = 0;
+};
+
+rl::replay::PixelBatchView View(const rlmsg::pixel_batch_t& m) {
+  return rl::replay::PixelBatchView{m.actor_id,   m.height,          m.width,   m.stack,
+                                    m.num_frames, m.frame_id,        m.frames,  m.count,
+                                    m.obs_frames, m.next_obs_frames, m.action,  m.reward,
+                                    m.discount,   m.episode_id,      m.priority};
+}
+
+// What the pixel replay service's thread exposes to the main thread.
+struct ServiceProbe {
+  std::atomic<bool> stop{false};
+  std::atomic<int64_t> inserts{0};         // transitions stored
+  std::atomic<int64_t> missing_frames{0};  // transitions skipped for a frame never received
+  std::atomic<int64_t> lost{0};            // sequence gaps counted by the service's bus
+  std::atomic<int64_t> dropped{0};         // malformed, invalid or refused
+};
+
+void RunPixelService(int port, ServiceProbe* probe) {
+  rl::Bus bus(Config(port, "replay"));
+  rl::replay::ReplayServiceOptions o;
+  o.table.capacity = kCapacity;
+  o.limiter.samples_per_insert = 0;  // no rate limiting
+  o.limiter.min_size_to_sample = 128;
+  o.stats_hz = 20;
+  rl::replay::ReplayService service(&bus, o);
+  service.Run([&] {
+    probe->inserts.store(service.total_inserts());
+    if (const rl::replay::PixelTable* t = service.pixel_table()) {
+      probe->missing_frames.store(t->transitions_missing_frames());
+    }
+    const rl::BusCounters& c = bus.counters();
+    probe->lost.store(c.lost);
+    probe->dropped.store(c.malformed + c.invalid + service.counters().batches_refused);
+    return probe->stop.load();
+  });
+}
+
+// Handles the bus until the service's insert count reaches `target` or has not changed for
+// `quiet` seconds; returns the count and sets *when to the time it last changed.
+int64_t Settle(rl::Bus* bus, const ServiceProbe& probe, int64_t target, double quiet,
+               double* when) {
+  int64_t last = -1;
+  *when = rl::MonoSeconds();
+  while (true) {
+    bus->Handle(20);
+    const int64_t now_count = probe.inserts.load();
+    if (now_count != last) {
+      last = now_count;
+      *when = rl::MonoSeconds();
+    }
+    if (now_count >= target || rl::MonoSeconds() - *when > quiet) return now_count;
+  }
+}
+
+// pixel_replay_insert: one actor's batches published back to back from the main thread.
+bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double seconds) {
+  PixelActorSim sim(0, 1);
+
+  // The first batch makes the service allocate its table (about 0.8 GB for 100,000 stacks).
+  const double first_start = rl::MonoSeconds();
+  double first_sent = 0;
+  while (probe.inserts.load() == 0 && rl::MonoSeconds() - first_start < 10) {
+    if (rl::MonoSeconds() - first_sent > 2) {
+      bus->Publish(rl::channels::kPixelTransitions, sim.Next());
+      first_sent = rl::MonoSeconds();
+    }
+    bus->Handle(5);
+  }
+  if (probe.inserts.load() == 0) {
+    std::fprintf(stderr, "bench_replay: the pixel replay stored nothing\n");
+    return false;
+  }
+  const double first_batch_s = rl::MonoSeconds() - first_sent;
+
+  std::vector<double> rates, mb_rates, offered, loss;
+  int64_t sent_total = 0, lost_total = 0;
+  const int64_t gaps_before = probe.lost.load();
+  const int64_t missing_before = probe.missing_frames.load();
+  const int64_t dropped_before = probe.dropped.load();
+  double bytes_per_transition = 0;
+  for (int r = 0; r < repeats; ++r) {
+    const int64_t before = probe.inserts.load();
+    int64_t sent = 0;
+    double bytes = 0;
+    const double start = rl::MonoSeconds();
+    while (rl::MonoSeconds() - start < seconds) {
+      rlmsg::pixel_batch_t* m = sim.Next();
+      bus->Publish(rl::channels::kPixelTransitions, m);
+      sent += m->count;
+      bytes += m->getEncodedSize();
+      bus->Handle(0);
+    }
+    const double send_end = rl::MonoSeconds();
+    double settled = 0;
+    const int64_t stored = Settle(bus, probe, before + sent, 0.3, &settled) - before;
+    const double elapsed = settled - start;  // until the last insert was seen
+    bytes_per_transition = bytes / static_cast<double>(sent);
+    rates.push_back(static_cast<double>(stored) / elapsed);
+    mb_rates.push_back(rates.back() * bytes_per_transition / 1e6);
+    offered.push_back(static_cast<double>(sent) / (send_end - start));
+    loss.push_back(static_cast<double>(sent - stored) / static_cast<double>(sent));
+    sent_total += sent;
+    lost_total += sent - stored;
+  }
+  const auto mb = rl::bench::Summarize(mb_rates);
+  const auto loss_s = rl::bench::Summarize(loss);
+  char extra[768];
+  std::snprintf(
+      extra, sizeof(extra),
+      "\"batch\": %d, \"frame\": \"%dx%d\", \"stack\": %d, \"transport\": \"udpm\", "
+      "\"mb_per_s_median\": %.1f, \"mb_per_s_min\": %.1f, \"mb_per_s_max\": %.1f, "
+      "\"lcm_bytes_per_transition\": %.0f, \"published_per_s_median\": %.0f, "
+      "\"lost_fraction_median\": %.4f, \"lost_fraction_max\": %.4f, \"sent\": %lld, "
+      "\"lost\": %lld, \"lost_batches_seq_gaps\": %lld, \"transitions_missing_frames\": %lld, "
+      "\"dropped_invalid\": %lld, \"first_batch_s\": %.3f, \"capacity\": %lld",
+      kBatch, kHeight, kWidth, kStack, mb.median, mb.min, mb.max, bytes_per_transition,
+      rl::bench::Summarize(offered).median, loss_s.median, loss_s.max,
+      static_cast<long long>(sent_total), static_cast<long long>(lost_total),
+      static_cast<long long>(probe.lost.load() - gaps_before),
+      static_cast<long long>(probe.missing_frames.load() - missing_before),
+      static_cast<long long>(probe.dropped.load() - dropped_before), first_batch_s,
+      static_cast<long long>(kCapacity));
+  rl::bench::Emit("pixel_replay_insert", "transitions/s", rl::bench::Summarize(rates), repeats,
+                  extra);
+  return true;
+}
+
+// pixel_replay_sample: kSampleInFlight requests of kBatch stacks outstanding, as the learner
+// keeps them; a request without a reply after 0.5 s is given up and replaced.
+void PixelSample(rl::Bus* bus, int repeats, double seconds) {
+  // Shared with the handler, which stays subscribed after this function returns.
+  struct State {
+    std::map<int64_t, double> outstanding;  // request id -> when sent
+    int64_t received = 0, batches = 0;
+  };
+  auto state = std::make_shared<State>();
+  State& st = *state;
+  const std::string me = bus->config().sender;
+  bus->Subscribe<rlmsg::pixel_sample_batch_t>(
+      rl::channels::kPixelSamples,
+      [state, me](const rlmsg::pixel_sample_batch_t& m) {
+        if (m.requester != me || state->outstanding.erase(m.request_id) == 0) return;
+        state->received += m.count;
+        ++state->batches;
+      },
+      rl::Port::kBulk);
+  int64_t next_id = 0, timeouts = 0;
+  const int64_t gaps_before = bus->counters().lost;
+  std::vector<double> rates, batch_rates;
+  for (int r = 0; r < repeats; ++r) {
+    const int64_t before = st.received, batches_before = st.batches;
+    const double start = rl::MonoSeconds();
+    double now = start;
+    while (now - start < seconds) {
+      for (auto it = st.outstanding.begin(); it != st.outstanding.end();) {
+        if (now - it->second > 0.5) {
+          it = st.outstanding.erase(it);
+          ++timeouts;
+        } else {
+          ++it;
+        }
+      }
+      while (static_cast<int>(st.outstanding.size()) < kSampleInFlight) {
+        rlmsg::sample_request_t req{};
+        req.request_id = next_id++;
+        req.batch_size = kBatch;
+        bus->Publish(rl::channels::kSampleRequest, &req);
+        st.outstanding[req.request_id] = now;
+      }
+      bus->Handle(1);
+      now = rl::MonoSeconds();
+    }
+    const double elapsed = now - start;
+    rates.push_back(static_cast<double>(st.received - before) / elapsed);
+    batch_rates.push_back(static_cast<double>(st.batches - batches_before) / elapsed);
+  }
+  const auto b = rl::bench::Summarize(batch_rates);
+  const double reply_mb = 2.0 * kBatch * kStack * kFrameBytes / 1e6;
+  char extra[512];
+  std::snprintf(extra, sizeof(extra),
+                "\"batch\": %d, \"frame\": \"%dx%d\", \"stack\": %d, \"in_flight\": %d, "
+                "\"transport\": \"udpm\", \"port\": \"bulk\", \"batches_per_s_median\": %.1f, "
+                "\"batches_per_s_min\": %.1f, \"batches_per_s_max\": %.1f, \"reply_mb\": %.2f, "
+                "\"mb_per_s_median\": %.0f, \"replies_timed_out\": %lld, "
+                "\"replies_lost_seq_gaps\": %lld",
+                kBatch, kHeight, kWidth, kStack, kSampleInFlight, b.median, b.min, b.max, reply_mb,
+                b.median * reply_mb, static_cast<long long>(timeouts),
+                static_cast<long long>(bus->counters().lost - gaps_before));
+  rl::bench::Emit("pixel_replay_sample", "transitions/s", rl::bench::Summarize(rates), repeats,
+                  extra);
+}
+
+// pixel_replay_8_actors[_<m>x]: kActors actor threads, each with its own bus (subscribed to
+// RL_FLOW and handling it between batches, as actor/actor.cc does), publishing one batch every
+// kBatch / (kStepsPerActor * multiplier) seconds from a random phase. The delivered rate is
+// measured over `windows` windows of `seconds` once every actor has started; the loss over the
+// whole run, after the service has settled.
+void PixelActors(rl::Bus* bus, const ServiceProbe& probe, int port, int multiplier, int windows,
+                 double seconds, int32_t first_actor_id) {
+  const double rate = kStepsPerActor * multiplier;  // transitions/s of one actor
+  const double period = kBatch / rate;
+  std::atomic<int64_t> sent{0};
+  std::atomic<int64_t> sent_bytes{0};
+  std::atomic<int64_t> publish_failures{0};
+  std::atomic<int64_t> flow_messages{0};
+  const int64_t before = probe.inserts.load();
+  const int64_t gaps_before = probe.lost.load();
+  const int64_t missing_before = probe.missing_frames.load();
+  const int64_t dropped_before = probe.dropped.load();
+  // Each actor starts within one period after t0; the windows start once all have.
+  const double t0 = rl::MonoSeconds() + 0.5;  // time for the threads to open their sockets
+  const double t_start = t0 + period;
+  const double t_end = t_start + windows * seconds;
+  std::vector<std::thread> actors;
+  for (int a = 0; a < kActors; ++a) {
+    const int32_t id = first_actor_id + a;
+    actors.emplace_back([&, id] {
+      rl::Bus actor_bus(Config(port, "actor-" + std::to_string(id)));
+      actor_bus.Subscribe<rlmsg::flow_control_t>(
+          rl::channels::kFlow, [&](const rlmsg::flow_control_t&) { ++flow_messages; });
+      PixelActorSim sim(id, 1000 + static_cast<uint64_t>(id));
+      std::mt19937_64 rng(static_cast<uint64_t>(id));
+      const double phase = std::uniform_real_distribution<double>(0, period)(rng);
+      for (int64_t j = 0;; ++j) {
+        const double due = t0 + phase + static_cast<double>(j) * period;
+        if (due >= t_end) break;
+        rlmsg::pixel_batch_t* m = sim.Next();  // the actor's work happens before the due time
+        const double wait = due - rl::MonoSeconds();
+        if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
+        if (!actor_bus.Publish(rl::channels::kPixelTransitions, m)) ++publish_failures;
+        sent += m->count;
+        sent_bytes += m->getEncodedSize();
+        actor_bus.Handle(0);
+      }
+    });
+  }
+
+  // Windows: the learner's bus is handled meanwhile, as a learner process would.
+  auto handle_until = [&](double t) {
+    for (double now = rl::MonoSeconds(); now < t; now = rl::MonoSeconds()) {
+      bus->Handle(std::max(1, std::min(20, static_cast<int>((t - now) * 1000))));
+    }
+  };
+  handle_until(t_start);
+  std::vector<double> delivered;
+  int64_t mark = probe.inserts.load();
+  for (int w = 0; w < windows; ++w) {
+    handle_until(t_start + (w + 1) * seconds);
+    const int64_t now_count = probe.inserts.load();
+    delivered.push_back(static_cast<double>(now_count - mark) / seconds);
+    mark = now_count;
+  }
+  for (std::thread& t : actors) t.join();
+  double settled = 0;
+  const int64_t stored = Settle(bus, probe, before + sent.load(), 0.5, &settled) - before;
+  const int64_t lost = sent.load() - stored;
+
+  char name[64];
+  if (multiplier == 1) {
+    std::snprintf(name, sizeof(name), "pixel_replay_8_actors");
+  } else {
+    std::snprintf(name, sizeof(name), "pixel_replay_8_actors_%dx", multiplier);
+  }
+  const double offered = rate * kActors;
+  char extra[1024];
+  std::snprintf(
+      extra, sizeof(extra),
+      "\"actors\": %d, \"steps_per_actor_per_s\": %.0f, \"rate_multiplier\": %d, "
+      "\"offered_transitions_per_s\": %.0f, \"offered_mb_per_s\": %.2f, \"batch\": %d, "
+      "\"frame\": \"%dx%d\", \"stack\": %d, \"transport\": \"udpm\", \"seconds\": %.1f, "
+      "\"sent\": %lld, \"stored\": %lld, \"lost_transitions\": %lld, \"zero_loss\": %s, "
+      "\"lost_batches_seq_gaps\": %lld, \"transitions_missing_frames\": %lld, "
+      "\"dropped_invalid\": %lld, \"publish_failures\": %lld, \"flow_messages_seen\": %lld, "
+      "\"samples_per_insert\": 0",
+      kActors, kStepsPerActor, multiplier, offered,
+      offered * static_cast<double>(sent_bytes.load()) /
+          static_cast<double>(std::max<int64_t>(1, sent.load())) / 1e6,
+      kBatch, kHeight, kWidth, kStack, t_end - t0, static_cast<long long>(sent.load()),
+      static_cast<long long>(stored), static_cast<long long>(lost), lost == 0 ? "true" : "false",
+      static_cast<long long>(probe.lost.load() - gaps_before),
+      static_cast<long long>(probe.missing_frames.load() - missing_before),
+      static_cast<long long>(probe.dropped.load() - dropped_before),
+      static_cast<long long>(publish_failures.load()),
+      static_cast<long long>(flow_messages.load()));
+  rl::bench::Emit(name, "transitions/s", rl::bench::Summarize(delivered), windows, extra);
+}
+
+// Pixel benchmarks through LCM, on `port` and port + 1.
+int RunPixelLcm(int repeats, double seconds, int port) {
+  ServiceProbe probe;
+  std::thread service_thread([&] { RunPixelService(port, &probe); });
+  auto stop = [&] {
+    probe.stop = true;
+    service_thread.join();
+  };
+
+  rl::Bus bus(Config(port, "learner"));
+  bool replay_up = false;
+  bus.Subscribe<rlmsg::stats_replay_t>(rl::channels::kStatsReplay,
+                                       [&](const rlmsg::stats_replay_t&) { replay_up = true; });
+  const double ready_deadline = rl::MonoSeconds() + 10;
+  while (!replay_up && rl::MonoSeconds() < ready_deadline) bus.Handle(50);
+  if (!replay_up) {
+    std::fprintf(stderr, "bench_replay: the pixel replay service did not come up\n");
+    stop();
+    return 1;
+  }
+  if (!PixelInsert(&bus, probe, repeats, seconds)) {
+    stop();
+    return 1;
+  }
+  PixelSample(&bus, repeats, seconds);
+  const int windows = std::max(repeats, 3);
+  PixelActors(&bus, probe, port, 1, windows, seconds, 100);
+  PixelActors(&bus, probe, port, 4, windows, seconds, 200);
+  stop();
+  return 0;
+}
+
+// VmRSS of this process in bytes (0 when it cannot be read).
+int64_t RssBytes() {
+  std::FILE* f = std::fopen("/proc/self/status", "r");
+  if (f == nullptr) return 0;
+  char line[256];
+  int64_t kb = 0;
+  while (std::fgets(line, sizeof(line), f) != nullptr) {
+    if (std::strncmp(line, "VmRSS:", 6) == 0) {
+      kb = std::atoll(line + 6);
+      break;
+    }
+  }
+  std::fclose(f);
+  return kb * 1024;
+}
+
+// pixel_replay_bytes_per_transition[_prioritized]: a PixelTable of kMemoryFill transitions, its
+// own accounting and the process's RSS growth.
+void PixelMemory(bool prioritized) {
+  // Actors first (their message buffers are not the table's), then a clean baseline.
+  std::vector<PixelActorSim> sims;
+  std::vector<rlmsg::pixel_batch_t*> next;
+  sims.reserve(kActors);
+  for (int a = 0; a < kActors; ++a) {
+    sims.emplace_back(a, 500 + static_cast<uint64_t>(a));
+  }
+  for (PixelActorSim& s : sims) next.push_back(s.Next());
+  malloc_trim(0);
+  const int64_t rss_before = RssBytes();
+  const double start = rl::MonoSeconds();
+
+  rl::replay::PixelTableOptions o;
+  o.capacity = kMemoryFill;
+  o.height = kHeight;
+  o.width = kWidth;
+  o.stack = kStack;
+  std::unique_ptr<rl::replay::Sampler> sampler;
+  if (prioritized) {
+    sampler = std::make_unique<rl::replay::PrioritizedSampler>(kMemoryFill, 0.6, 1e-6);
+  } else {
+    sampler = std::make_unique<rl::replay::UniformSampler>(kMemoryFill);
+  }
+  rl::replay::PixelTable table(o, std::move(sampler));
+  const double alloc_s = rl::MonoSeconds() - start;
+  while (table.total_inserts() < kMemoryFill) {
+    for (size_t a = 0; a < sims.size() && table.total_inserts() < kMemoryFill; ++a) {
+      const char* why = table.Insert(View(*next[a]));
+      RL_CHECK(why == nullptr) << why;
+      next[a] = sims[a].Next();
+    }
+  }
+  const double fill_s = rl::MonoSeconds() - start;
+  const int64_t rss_growth = RssBytes() - rss_before;
+  RL_CHECK(table.transitions_missing_frames() == 0) << "the simulated actors lost frames";
+
+  const double size = static_cast<double>(table.size());
+  const double per = static_cast<double>(table.memory_bytes()) / size;
+  const double rss_per = static_cast<double>(rss_growth) / size;
+  char extra[768];
+  std::snprintf(
+      extra, sizeof(extra),
+      "\"sampler\": \"%s\", \"frame\": \"%dx%d\", \"stack\": %d, \"size\": %lld, "
+      "\"frame_capacity\": %lld, \"memory_bytes\": %lld, \"frames_per_transition\": %.4f, "
+      "\"gb_at_1m_transitions\": %.2f, \"rss_growth_bytes\": %lld, "
+      "\"rss_bytes_per_transition\": %.0f, \"rss_frames_per_transition\": %.4f, "
+      "\"rss_gb_at_1m_transitions\": %.2f, \"stacked_bytes_per_transition\": %d, "
+      "\"actors\": %d, \"episode_steps\": \"%d-%d\", \"alloc_s\": %.2f, \"fill_s\": %.2f",
+      prioritized ? "prioritized" : "uniform", kHeight, kWidth, kStack,
+      static_cast<long long>(table.size()), static_cast<long long>(table.frame_capacity()),
+      static_cast<long long>(table.memory_bytes()), per / kFrameBytes, per * 1e6 / 1e9,
+      static_cast<long long>(rss_growth), rss_per, rss_per / kFrameBytes, rss_per * 1e6 / 1e9,
+      2 * kStack * kFrameBytes, kActors, kMinEpisode, kMaxEpisode, alloc_s, fill_s);
+  rl::bench::Summary s;
+  s.min = s.median = s.max = per;
+  rl::bench::Emit(prioritized ? "pixel_replay_bytes_per_transition_prioritized"
+                              : "pixel_replay_bytes_per_transition",
+                  "bytes/transition", s, 1, extra);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
+  const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
+  const int port = argc > 3 ? std::atoi(argv[3]) : 17667;
+
+  if (const int rc = RunFlat(repeats, seconds, port); rc != 0) return rc;
+  if (const int rc = RunPixelLcm(repeats, seconds, port + 2); rc != 0) return rc;
+  PixelMemory(/*prioritized=*/false);
+  PixelMemory(/*prioritized=*/true);
   return 0;
 }

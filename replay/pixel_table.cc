@@ -53,7 +53,7 @@ void PixelTableOptions::Validate() const {
 }
 
 int64_t PixelTableOptions::frames_kept() const {
-  return frame_capacity > 0 ? frame_capacity : capacity + capacity / 8 + 4096;
+  return frame_capacity > 0 ? frame_capacity : capacity + capacity / 32 + 4096;
 }
 
 void PixelSampleBatch::Resize(int new_count, int new_height, int new_width, int new_stack) {

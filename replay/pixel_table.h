@@ -28,8 +28,8 @@
 // Memory: frame_capacity * height * width bytes + capacity * (16 * stack + 28) bytes + 64 KiB
 // per actor, allocated when the geometry becomes known (from the options, or the first batch),
 // plus the sampler's (16 bytes per slot for the uniform sampler, 32 to 64 for the prioritized
-// one). With the default frame_capacity (capacity * 1.125 + 4096) and 84 x 84 stacks of 4, a
-// transition costs about 1.125 frames (7938 bytes) + 92 bytes + the sampler's.
+// one). With the default frame_capacity (capacity * 1.03125 + 4096) and 84 x 84 stacks of 4, a
+// transition costs about 1.03 frames (7277 bytes) + 92 bytes + the sampler's.
 //
 // The table knows nothing about LCM: the caller hands it views of its own arrays. Not
 // thread-safe: one thread inserts and samples.
@@ -48,9 +48,10 @@ namespace rl::replay {
 struct PixelTableOptions {
   // Transitions kept; when full, the oldest is overwritten.
   int64_t capacity = 100000;
-  // Frames kept; when full, the oldest is overwritten. 0: capacity + capacity / 8 + 4096, enough
-  // for about one new frame per transition plus a reset frame per episode of 8 steps or more,
-  // and frames of transitions in flight.
+  // Frames kept; when full, the oldest is overwritten. 0: capacity + capacity / 32 + 4096, enough
+  // for one new frame per transition plus a reset frame per episode of 32 steps or more, and
+  // the frames of transitions in flight. Envs with shorter episodes need more (e.g. Catch, 9
+  // steps: capacity * 10 / 9); too few only shrinks the replay (stale_draws() counts it).
   int64_t frame_capacity = 0;
   // Frame height and width in pixels (at most 4096 each), and frames per observation (at most
   // 64); 0: taken from the first batch. Batches with other values are refused.

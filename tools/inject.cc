@@ -75,6 +75,53 @@ rlmsg::sample_batch_t Samples() {
   return m;
 }
 
+rlmsg::pixel_batch_t PixelTransitions() {
+  rlmsg::pixel_batch_t m{};
+  m.height = 2;
+  m.width = 2;
+  m.stack = 2;
+  m.num_frames = 2;
+  m.frame_id = {0, 1};
+  m.num_bytes = 8;
+  m.frames.assign(8, 100);
+  m.count = 1;
+  m.num_refs = 2;
+  m.obs_frames = {0, 0};
+  m.next_obs_frames = {0, 1};
+  m.action = {0};
+  m.reward = {1};
+  m.discount = {0.99f};
+  m.episode_id = {0};
+  m.priority = {0};
+  return m;
+}
+
+rlmsg::pixel_sample_batch_t PixelSamples() {
+  rlmsg::pixel_sample_batch_t m{};
+  m.requester = "learner";
+  m.height = 2;
+  m.width = 2;
+  m.stack = 2;
+  m.count = 1;
+  m.num_bytes = 8;
+  m.obs.assign(8, 0);
+  m.next_obs.assign(8, 0);
+  m.action = {0};
+  m.reward = {1};
+  m.discount = {0.99f};
+  m.index = {0};
+  m.weight = {1};
+  return m;
+}
+
+rlmsg::priority_update_t Priorities() {
+  rlmsg::priority_update_t m{};
+  m.count = 1;
+  m.index = {0};
+  m.priority = {1};
+  return m;
+}
+
 rlmsg::weights_chunk_t Chunk() {
   rlmsg::weights_chunk_t m{};
   m.version = 1;
@@ -117,6 +164,27 @@ std::vector<Target> Targets() {
                  m.obs[2] = nan;
                  return Encode(m, r);
                }});
+  t.push_back({rl::channels::kPixelTransitions, rl::Port::kMain,
+               [](int64_t r) { return Encode(PixelTransitions(), r); },
+               [](int64_t r) {
+                 auto m = PixelTransitions();
+                 m.frame_id = {1, 0};  // ids must increase
+                 return Encode(m, r);
+               }});
+  t.push_back({rl::channels::kPriorities, rl::Port::kMain,
+               [](int64_t r) { return Encode(Priorities(), r); },
+               [nan](int64_t r) {
+                 auto m = Priorities();
+                 m.priority[0] = nan;
+                 return Encode(m, r);
+               }});
+  t.push_back({rl::channels::kPixelSamples, rl::Port::kBulk,
+               [](int64_t r) { return Encode(PixelSamples(), r); },
+               [](int64_t r) {
+                 auto m = PixelSamples();
+                 m.discount[0] = 2;  // outside [0, 1]
+                 return Encode(m, r);
+               }});
   t.push_back({rl::channels::kWeights, rl::Port::kBulk,
                [](int64_t r) { return Encode(Chunk(), r); },
                [](int64_t r) {
@@ -157,8 +225,10 @@ std::vector<Target> Targets() {
 // Channels each role subscribes to (what its drop counters must reflect).
 const std::map<std::string, std::vector<std::string>>& RoleChannels() {
   static const std::map<std::string, std::vector<std::string>> m = {
-      {"replay", {rl::channels::kTransitions, rl::channels::kSampleRequest}},
-      {"learner", {rl::channels::kSamples}},
+      {"replay",
+       {rl::channels::kTransitions, rl::channels::kPixelTransitions, rl::channels::kSampleRequest,
+        rl::channels::kPriorities}},
+      {"learner", {rl::channels::kSamples, rl::channels::kPixelSamples}},
       {"actor", {rl::channels::kWeights, rl::channels::kFlow}},
       {"evaluator", {rl::channels::kCheckpoint}},
   };

@@ -196,7 +196,7 @@ std::set<int64_t> SampleAndCheck(PixelTable* table, const std::vector<Expected>&
 
 TEST(PixelTableTest, DefaultOptionsAreValid) {
   EXPECT_NO_THROW(PixelTableOptions{}.Validate());
-  EXPECT_EQ(PixelTableOptions{}.frames_kept(), 100000 + 12500 + 4096);
+  EXPECT_EQ(PixelTableOptions{}.frames_kept(), 100000 + 3125 + 4096);
 }
 
 TEST(PixelTableTest, RefusesBadOptions) {
@@ -209,8 +209,8 @@ TEST(PixelTableTest, RefusesBadOptions) {
 }
 
 TEST(PixelTableTest, StoresEachFrameOnceAndReportsItsMemory) {
-  // 84 x 84 stacks of 4, capacity 1000, default frame capacity 1000 + 125 + 4096.
-  constexpr int64_t kFrames = 1000 + 125 + 4096;
+  // 84 x 84 stacks of 4, capacity 1000, default frame capacity 1000 + 31 + 4096.
+  constexpr int64_t kFrames = 1000 + 31 + 4096;
   constexpr int64_t kFrameBytes = 84 * 84;
   PixelTable table(Options(1000, 0, 84, 84, 4));
   EXPECT_EQ(table.frame_capacity(), kFrames);
