@@ -10,6 +10,7 @@
 #include "common/shutdown.h"
 #include "envs/registry.h"
 #include "nn/checkpoint.h"
+#include "nn/parallel.h"
 #include "rlmsg/checkpoint_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
 #include "rlmsg/stats_learner_t.hpp"
@@ -31,6 +32,7 @@ void LearnerConfig::Validate() const {
   if (checkpoint_every < 1) throw std::invalid_argument("checkpoint-every must be >= 1");
   if (keep_checkpoints < 0) throw std::invalid_argument("keep-checkpoints must be >= 0");
   if (!(stats_hz > 0)) throw std::invalid_argument("stats-hz must be > 0");
+  if (threads < 1 || threads > 64) throw std::invalid_argument("threads must be in [1, 64]");
 }
 
 Learner::Learner(LearnerConfig config, Bus* bus)
@@ -40,6 +42,7 @@ Learner::Learner(LearnerConfig config, Bus* bus)
       dqn_(obs_size_, NumActions(config_.env_id), config_.dqn),
       weights_(bus),
       sender_(bus->config().sender) {
+  nn::SetNumThreads(config_.threads);
   std::filesystem::create_directories(std::filesystem::path(config_.out_dir) / "checkpoints");
   bus_->Subscribe<rlmsg::sample_batch_t>(
       channels::kSamples, [this](const rlmsg::sample_batch_t& m) { OnSamples(m); }, Port::kBulk);

@@ -31,6 +31,7 @@ struct LearnerConfig {
   int checkpoint_every = 1000;         // updates between checkpoints
   int keep_checkpoints = 0;            // newest checkpoint files kept on disk (0: all)
   bool prioritized = false;            // publish |TD errors| as priorities after every update
+  int threads = 1;                     // compute threads of the network library (nn::SetNumThreads)
   std::string out_dir = ".";           // checkpoints go to <out_dir>/checkpoints/
   int64_t max_updates = 0;             // stop after this many updates (0: until stopped)
   double stats_hz = 4.0;               // stats messages per second

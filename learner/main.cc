@@ -81,6 +81,9 @@ int Main(int argc, char** argv) {
        "updates between checkpoints")  //
       ("keep-checkpoints", rl::po::value(&c.keep_checkpoints)->default_value(c.keep_checkpoints),
        "newest checkpoint files kept on disk (0: all)")  //
+      ("threads", rl::po::value(&c.threads)->default_value(c.threads),
+       "compute threads for the network (convolutions and large products are split; 1 leaves "
+       "the other cores to the actors)")  //
       ("max-updates", rl::po::value(&c.max_updates)->default_value(c.max_updates),
        "stop after this many updates (0: until stopped)")  //
       ("stats-hz", rl::po::value(&c.stats_hz)->default_value(c.stats_hz),

@@ -14,6 +14,7 @@
 #include "common/check.h"
 #include "nn/gemm.h"
 #include "nn/init.h"
+#include "nn/parallel.h"
 
 namespace rl::nn {
 namespace {
@@ -205,9 +206,7 @@ Conv2d::Conv2d(int in_channels, int out_channels, int kernel, int stride, int pa
     }
   }
   dcols_front_ = (kernel + 15) / 16 * 16;
-  const auto steps = static_cast<size_t>((kernel + stride - 1) / stride);
-  runs_.resize(steps * steps);
-  if (!direct_) channel_grad_.resize(static_cast<int64_t>(stride) * stride * plane_h_ * plane_w_);
+  scratch_.resize(1);
 
   weight_.resize(taps_, out_channels);
   bias_.resize(out_channels, 1);
@@ -223,7 +222,7 @@ int Conv2d::GroupSize(int batch) const {
   return static_cast<int>(std::clamp<int64_t>(kColsBudget / per_sample, 1, std::max(batch, 1)));
 }
 
-void Conv2d::BuildPlanes(const Matrix& x, int b0, int count) {
+void Conv2d::BuildPlanes(const Matrix& x, int b0, int count, Scratch* scratch) const {
   if (direct_) return;
   const int s = stride_;
   const int p = padding_;
@@ -231,15 +230,15 @@ void Conv2d::BuildPlanes(const Matrix& x, int b0, int count) {
   const int w = in_.width;
   const int row_len = plane_w_ * s;  // A padded input row, extended to whole plane columns.
   const int64_t plane_size = static_cast<int64_t>(plane_h_) * plane_w_;
-  if (planes_.size() < plane_stride_ * count) planes_.resize(plane_stride_ * count);
-  if (padded_row_.size() < row_len) padded_row_.resize(row_len);
+  if (scratch->planes.size() < plane_stride_ * count) scratch->planes.resize(plane_stride_ * count);
+  if (scratch->padded_row.size() < row_len) scratch->padded_row.resize(row_len);
   // Plane (c, py, px) holds the pixels (Y * s + py, X * s + px) of the zero-padded channel c:
   // padded row Y * s + py is split into the s planes (c, py, .) at row Y. Without padding on the
   // left, input rows are split in place (the split reads zeros past their end); otherwise through
   // a zero-padded copy.
   for (int t = 0; t < count; ++t) {
     const float* image = x.col(b0 + t).data();
-    float* sample_planes = planes_.data() + t * plane_stride_;
+    float* sample_planes = scratch->planes.data() + t * plane_stride_;
     for (int c = 0; c < in_.channels; ++c) {
       const float* channel = image + static_cast<int64_t>(c) * h * w;
       for (int yp = 0; yp < plane_h_ * s; ++yp) {
@@ -258,7 +257,7 @@ void Conv2d::BuildPlanes(const Matrix& x, int b0, int count) {
           continue;
         }
         // The padding is rewritten every time: Backward() reuses this row.
-        float* padded = padded_row_.data();
+        float* padded = scratch->padded_row.data();
         std::fill(padded, padded + p, 0.0f);
         std::copy(row, row + w, padded + p);
         std::fill(padded + p + w, padded + row_len, 0.0f);
@@ -268,19 +267,19 @@ void Conv2d::BuildPlanes(const Matrix& x, int b0, int count) {
   }
 }
 
-const float* Conv2d::GroupPlanes(const Matrix& x, int b0) const {
-  return direct_ ? x.col(b0).data() : planes_.data();
+const float* Conv2d::GroupPlanes(const Matrix& x, int b0, const Scratch& scratch) const {
+  return direct_ ? x.col(b0).data() : scratch.planes.data();
 }
 
-void Conv2d::Im2col(const float* planes, int count, bool panels) {
+void Conv2d::Im2col(const float* planes, int count, bool panels, Scratch* scratch) const {
   const int s = stride_;
   const int k = kernel_;
   const int oh = out_.height;
   const int ow = out_.width;
   const int64_t m = static_cast<int64_t>(count) * pixels_;
   const int64_t plane_size = static_cast<int64_t>(plane_h_) * plane_w_;
-  if (panels) return Im2colPanels(planes, count);
-  if (cols_.size() < m * taps_) cols_.resize(m * taps_);
+  if (panels) return Im2colPanels(planes, count, scratch);
+  if (scratch->cols.size() < m * taps_) scratch->cols.resize(m * taps_);
   // Column (c, ky, kx) of the unfolded matrix, row (sample, oy, ox), holds the padded input pixel
   // (oy * s + ky, ox * s + kx) of channel c: pixel (oy + ky / s, ox + kx / s) of phase plane
   // (c, ky % s, kx % s). For each output row that is a contiguous run of ow plane pixels.
@@ -291,7 +290,7 @@ void Conv2d::Im2col(const float* planes, int count, bool panels) {
         const int64_t plane = (static_cast<int64_t>(c) * s + ky % s) * s + kx % s;
         const float* src0 =
             planes + plane * plane_size + static_cast<int64_t>(ky / s) * plane_w_ + kx / s;
-        float* dst = cols_.data() + tap * m;
+        float* dst = scratch->cols.data() + tap * m;
 #ifdef __AVX512F__
         if (window_span_ <= 16) {
           // The whole oh x ow window lies within 16 consecutive plane floats: one load, one
@@ -324,12 +323,14 @@ void Conv2d::Im2col(const float* planes, int count, bool panels) {
   }
 }
 
-void Conv2d::Im2colPanels(const float* planes, int count) {
+void Conv2d::Im2colPanels(const float* planes, int count, Scratch* scratch) const {
   using internal::kPanelRows;
   const int ow = out_.width;
   const int64_t m = static_cast<int64_t>(count) * pixels_;
   const int64_t panels = (m + kPanelRows - 1) / kPanelRows;
-  if (cols_.size() < panels * kPanelRows * taps_) cols_.setZero(panels * kPanelRows * taps_);
+  if (scratch->cols.size() < panels * kPanelRows * taps_) {
+    scratch->cols.setZero(panels * kPanelRows * taps_);
+  }
   // Panel by panel, so that the writes are sequential: the panel's rows (sample, oy, ox) fall
   // into a few runs of consecutive ox, each a run of consecutive plane pixels, which every tap
   // copies from its own plane and offset (tap_offset_).
@@ -351,7 +352,7 @@ void Conv2d::Im2colPanels(const float* planes, int count) {
                             static_cast<int>(r - q * kPanelRows), n};
       r += n;
     }
-    float* dst = cols_.data() + q * kPanelRows * taps_;
+    float* dst = scratch->cols.data() + q * kPanelRows * taps_;
     for (int tap = 0; tap < taps_; ++tap, dst += kPanelRows) {
       const float* src = planes + tap_offset_[tap];
       for (int i = 0; i < n_pieces; ++i) {
@@ -361,8 +362,8 @@ void Conv2d::Im2colPanels(const float* planes, int count) {
   }
 }
 
-void Conv2d::PlaneGradient(const float* dcols, int count, int t, int c, int py, int px,
-                           float* out) {
+void Conv2d::PlaneGradient(const float* dcols, int count, int t, int c, int py, int px, float* out,
+                           Scratch* scratch) const {
   const int s = stride_;
   const int k = kernel_;
   const int oh = out_.height;
@@ -376,7 +377,8 @@ void Conv2d::PlaneGradient(const float* dcols, int count, int t, int c, int py, 
   for (int ky = py, ky_step = 0; ky < k; ky += s, ++ky_step) {
     for (int kx = px, kx_step = 0; kx < k; kx += s, ++kx_step) {
       const int64_t tap = (static_cast<int64_t>(c) * k + ky) * k + kx;
-      runs_[n_runs] = {dcols + tap * m + static_cast<int64_t>(t) * pixels_, ky_step, kx_step};
+      scratch->runs[n_runs] = {dcols + tap * m + static_cast<int64_t>(t) * pixels_, ky_step,
+                               kx_step};
       ++n_runs;
     }
   }
@@ -386,7 +388,7 @@ void Conv2d::PlaneGradient(const float* dcols, int count, int t, int c, int py, 
     for (int x0 = 0; x0 < n; x0 += 16) {
       __m512 acc = _mm512_setzero_ps();
       for (int r = 0; r < n_runs; ++r) {
-        const Run& run = runs_[r];
+        const Run& run = scratch->runs[r];
         const int oy = y - run.dy;
         // Lanes x0 + l with 0 <= x0 + l - dx < ow. dcols has dcols_front_ >= kernel_ floats of
         // slack in front, so the address below stays inside the buffer.
@@ -403,7 +405,7 @@ void Conv2d::PlaneGradient(const float* dcols, int count, int t, int c, int py, 
 #else
     std::fill(row, row + n, 0.0f);
     for (int r = 0; r < n_runs; ++r) {
-      const Run& run = runs_[r];
+      const Run& run = scratch->runs[r];
       const int oy = y - run.dy;
       if (oy < 0 || oy >= oh) continue;
       const float* src = run.src + static_cast<int64_t>(oy) * ow;
@@ -414,13 +416,18 @@ void Conv2d::PlaneGradient(const float* dcols, int count, int t, int c, int py, 
   }
 }
 
-void Conv2d::FoldGradient(const Matrix& x, int b0, int count) {
+void Conv2d::FoldGradient(const Matrix& x, int b0, int count, Scratch* scratch) {
   const int s = stride_;
   const int p = padding_;
   const int h = in_.height;
   const int w = in_.width;
   const int64_t plane_size = static_cast<int64_t>(plane_h_) * plane_w_;
-  const float* dcols = dcols_.data() + dcols_front_;
+  const float* dcols = scratch->dcols.data() + dcols_front_;
+  const auto steps = static_cast<size_t>((kernel_ + s - 1) / s);
+  if (scratch->runs.size() < steps * steps) scratch->runs.resize(steps * steps);
+  if (!direct_ && scratch->channel_grad.size() < s * s * plane_size) {
+    scratch->channel_grad.resize(s * s * plane_size);
+  }
   for (int t = 0; t < count; ++t) {
     const float* image = x.col(b0 + t).data();
     float* dx_image = grad_input_.col(b0 + t).data();
@@ -428,15 +435,15 @@ void Conv2d::FoldGradient(const Matrix& x, int b0, int count) {
       const int64_t at = static_cast<int64_t>(c) * h * w;
       if (direct_) {
         // The input channel is its own phase plane.
-        PlaneGradient(dcols, count, t, c, 0, 0, dx_image + at);
+        PlaneGradient(dcols, count, t, c, 0, 0, dx_image + at, scratch);
       } else {
         // The s * s phase planes of the padded channel, then interleaved into d(loss)/d(x):
         // input pixel (iy, ix) is pixel ((iy + p) / s, (ix + p) / s) of plane
         // ((iy + p) % s, (ix + p) % s).
-        float* planes = channel_grad_.data();
+        float* planes = scratch->channel_grad.data();
         for (int py = 0; py < s; ++py) {
           for (int px = 0; px < s; ++px) {
-            PlaneGradient(dcols, count, t, c, py, px, planes + (py * s + px) * plane_size);
+            PlaneGradient(dcols, count, t, c, py, px, planes + (py * s + px) * plane_size, scratch);
           }
         }
         for (int iy = 0; iy < h; ++iy) {
@@ -470,52 +477,114 @@ void Conv2d::FoldGradient(const Matrix& x, int b0, int count) {
   }
 }
 
-const Matrix& Conv2d::Forward(const Matrix& x) {
-  RL_CHECK(x.rows() == in_.size()) << Describe() << " got an input with " << x.rows() << " rows";
-  input_ = &x;
-  const auto batch = static_cast<int>(x.cols());
+int Conv2d::PrepareTasks(int batch) {
+  const int64_t work = static_cast<int64_t>(batch) * pixels_ * taps_ * out_.channels;
+  const int tasks = internal::TasksFor(work, batch);
+  if (static_cast<int>(scratch_.size()) < tasks) scratch_.resize(static_cast<size_t>(tasks));
+  return tasks;
+}
+
+void Conv2d::ForwardSamples(const Matrix& x, int begin, int end, int group, Scratch* scratch) {
   const int oc = out_.channels;
-  output_.resize(out_.size(), batch);
-  const int group = GroupSize(batch);
   internal::Epilogue epilogue;
   epilogue.col_bias = bias_.data();
   epilogue.relu = fused_output_relu_;
   const internal::ConstView w{weight_.data(), taps_, oc, 1, taps_};
+  for (int b0 = begin; b0 < end; b0 += group) {
+    const int count = std::min(group, end - b0);
+    const int m = count * pixels_;
+    BuildPlanes(x, b0, count, scratch);
+    Im2col(GroupPlanes(x, b0, *scratch), count, /*panels=*/true, scratch);
+    if (count == 1) {
+      // One sample: its pixels x channels product is already the channel-major output.
+      internal::GemmPacked(scratch->cols.data(), m, taps_, w, {output_.col(b0).data(), m, oc, 1, m},
+                           /*accumulate=*/false, epilogue, &scratch->workspace);
+      continue;
+    }
+    Vector& group_out = scratch->group_out;
+    if (group_out.size() < static_cast<int64_t>(m) * oc) {
+      group_out.resize(static_cast<int64_t>(m) * oc);
+    }
+    internal::GemmPacked(scratch->cols.data(), m, taps_, w, {group_out.data(), m, oc, 1, m},
+                         /*accumulate=*/false, epilogue, &scratch->workspace);
+    // Row (t, pixel), column o of the product is output pixel (o, pixel) of sample b0 + t.
+    for (int t = 0; t < count; ++t) {
+      float* dst = output_.col(b0 + t).data();
+      for (int o = 0; o < oc; ++o) {
+        CopyRun(group_out.data() + static_cast<int64_t>(o) * m + static_cast<int64_t>(t) * pixels_,
+                pixels_, dst + static_cast<int64_t>(o) * pixels_);
+      }
+    }
+  }
+}
+
+const Matrix& Conv2d::Forward(const Matrix& x) {
+  RL_CHECK(x.rows() == in_.size()) << Describe() << " got an input with " << x.rows() << " rows";
+  input_ = &x;
+  const auto batch = static_cast<int>(x.cols());
+  output_.resize(out_.size(), batch);
   if (dense_) {
     // One output pixel whose patch is the whole image, taps in input order: y = W^T x + b.
     internal::Epilogue dense;
     dense.row_bias = bias_.data();
     dense.relu = fused_output_relu_;
+    const internal::ConstView w{weight_.data(), taps_, out_.channels, 1, taps_};
     internal::Gemm(w.Transposed(), internal::View(x), internal::View(&output_),
                    /*accumulate=*/false, dense, &workspace_);
     return output_;
   }
-  for (int b0 = 0; b0 < batch; b0 += group) {
-    const int count = std::min(group, batch - b0);
-    const int m = count * pixels_;
-    BuildPlanes(x, b0, count);
-    Im2col(GroupPlanes(x, b0), count, /*panels=*/true);
-    if (count == 1) {
-      // One sample: its pixels x channels product is already the channel-major output.
-      internal::GemmPacked(cols_.data(), m, taps_, w, {output_.col(b0).data(), m, oc, 1, m},
-                           /*accumulate=*/false, epilogue, &workspace_);
-      continue;
-    }
-    if (group_out_.size() < static_cast<int64_t>(m) * oc) {
-      group_out_.resize(static_cast<int64_t>(m) * oc);
-    }
-    internal::GemmPacked(cols_.data(), m, taps_, w, {group_out_.data(), m, oc, 1, m},
-                         /*accumulate=*/false, epilogue, &workspace_);
-    // Row (t, pixel), column o of the product is output pixel (o, pixel) of sample b0 + t.
-    for (int t = 0; t < count; ++t) {
-      float* dst = output_.col(b0 + t).data();
-      for (int o = 0; o < oc; ++o) {
-        CopyRun(group_out_.data() + static_cast<int64_t>(o) * m + static_cast<int64_t>(t) * pixels_,
-                pixels_, dst + static_cast<int64_t>(o) * pixels_);
-      }
-    }
-  }
+  const int group = GroupSize(batch);
+  const int tasks = PrepareTasks(batch);
+  internal::ParallelFor(tasks, [&](int task) {
+    ForwardSamples(x, batch * task / tasks, batch * (task + 1) / tasks, group,
+                   &scratch_[static_cast<size_t>(task)]);
+  });
   return output_;
+}
+
+void Conv2d::BackwardSamples(const Matrix& grad_out, int begin, int end, int group, bool input_grad,
+                             Matrix* weight_grad, Matrix* bias_grad, Scratch* scratch) {
+  const Matrix& x = *input_;
+  const int oc = out_.channels;
+  for (int b0 = begin; b0 < end; b0 += group) {
+    const int count = std::min(group, end - b0);
+    const int m = count * pixels_;
+    BuildPlanes(x, b0, count, scratch);
+    Im2col(GroupPlanes(x, b0, *scratch), count, /*panels=*/false, scratch);
+
+    // The output gradient of the group as an m x out_channels matrix (rows: sample, pixel).
+    const float* dy = grad_out.col(b0).data();
+    if (count > 1) {
+      Vector& group_out = scratch->group_out;
+      if (group_out.size() < static_cast<int64_t>(m) * oc) {
+        group_out.resize(static_cast<int64_t>(m) * oc);
+      }
+      for (int t = 0; t < count; ++t) {
+        const float* src = grad_out.col(b0 + t).data();
+        for (int o = 0; o < oc; ++o) {
+          CopyRun(
+              src + static_cast<int64_t>(o) * pixels_, pixels_,
+              group_out.data() + static_cast<int64_t>(o) * m + static_cast<int64_t>(t) * pixels_);
+        }
+      }
+      dy = group_out.data();
+    }
+    const internal::ConstView dy_view{dy, m, oc, 1, m};
+
+    // dW += cols^T dY; db += column sums of dY.
+    internal::Gemm({scratch->cols.data(), taps_, m, m, 1}, dy_view, internal::View(weight_grad),
+                   /*accumulate=*/true, {}, &scratch->workspace);
+    *bias_grad += Eigen::Map<const Matrix>(dy, m, oc).colwise().sum().transpose();
+    if (!input_grad) continue;
+
+    // dcols = dY W^T, folded back onto the input.
+    const int64_t dcols_size = dcols_front_ + static_cast<int64_t>(m) * taps_;
+    if (scratch->dcols.size() < dcols_size) scratch->dcols.setZero(dcols_size);
+    internal::Gemm(dy_view, {weight_.data(), oc, taps_, taps_, 1},
+                   {scratch->dcols.data() + dcols_front_, m, taps_, 1, m}, /*accumulate=*/false, {},
+                   &scratch->workspace);
+    FoldGradient(x, b0, count, scratch);
+  }
 }
 
 void Conv2d::BackwardImpl(const Matrix& grad_out, bool input_grad) {
@@ -525,8 +594,6 @@ void Conv2d::BackwardImpl(const Matrix& grad_out, bool input_grad) {
   RL_CHECK(grad_out.rows() == out_.size() && grad_out.cols() == batch)
       << Describe() << " got an output gradient of " << grad_out.rows() << "x" << grad_out.cols()
       << " for a batch of " << batch;
-  const int oc = out_.channels;
-  const int group = GroupSize(batch);
   if (input_grad) grad_input_.resize(in_.size(), batch);
   if (dense_) {
     // As a fully connected layer with weight W^T: dW += x dY^T, db += row sums of dY,
@@ -541,43 +608,24 @@ void Conv2d::BackwardImpl(const Matrix& grad_out, bool input_grad) {
                    /*accumulate=*/false, mask, &workspace_);
     return;
   }
-  for (int b0 = 0; b0 < batch; b0 += group) {
-    const int count = std::min(group, batch - b0);
-    const int m = count * pixels_;
-    BuildPlanes(x, b0, count);
-    Im2col(GroupPlanes(x, b0), count, /*panels=*/false);
-
-    // The output gradient of the group as an m x out_channels matrix (rows: sample, pixel).
-    const float* dy = grad_out.col(b0).data();
-    if (count > 1) {
-      if (group_out_.size() < static_cast<int64_t>(m) * oc) {
-        group_out_.resize(static_cast<int64_t>(m) * oc);
-      }
-      for (int t = 0; t < count; ++t) {
-        const float* src = grad_out.col(b0 + t).data();
-        for (int o = 0; o < oc; ++o) {
-          CopyRun(
-              src + static_cast<int64_t>(o) * pixels_, pixels_,
-              group_out_.data() + static_cast<int64_t>(o) * m + static_cast<int64_t>(t) * pixels_);
-        }
-      }
-      dy = group_out_.data();
+  const int group = GroupSize(batch);
+  const int tasks = PrepareTasks(batch);
+  internal::ParallelFor(tasks, [&](int task) {
+    Scratch& scratch = scratch_[static_cast<size_t>(task)];
+    Matrix* weight_grad = &weight_grad_;
+    Matrix* bias_grad = &bias_grad_;
+    if (task > 0) {
+      scratch.weight_grad.setZero(weight_grad_.rows(), weight_grad_.cols());
+      scratch.bias_grad.setZero(bias_grad_.rows(), 1);
+      weight_grad = &scratch.weight_grad;
+      bias_grad = &scratch.bias_grad;
     }
-    const internal::ConstView dy_view{dy, m, oc, 1, m};
-
-    // dW += cols^T dY; db += column sums of dY.
-    internal::Gemm({cols_.data(), taps_, m, m, 1}, dy_view, internal::View(&weight_grad_),
-                   /*accumulate=*/true, {}, &workspace_);
-    bias_grad_ += Eigen::Map<const Matrix>(dy, m, oc).colwise().sum().transpose();
-    if (!input_grad) continue;
-
-    // dcols = dY W^T, folded back onto the input.
-    const int64_t dcols_size = dcols_front_ + static_cast<int64_t>(m) * taps_;
-    if (dcols_.size() < dcols_size) dcols_.setZero(dcols_size);
-    internal::Gemm(dy_view, {weight_.data(), oc, taps_, taps_, 1},
-                   {dcols_.data() + dcols_front_, m, taps_, 1, m}, /*accumulate=*/false, {},
-                   &workspace_);
-    FoldGradient(x, b0, count);
+    BackwardSamples(grad_out, batch * task / tasks, batch * (task + 1) / tasks, group, input_grad,
+                    weight_grad, bias_grad, &scratch);
+  });
+  for (int task = 1; task < tasks; ++task) {
+    weight_grad_ += scratch_[static_cast<size_t>(task)].weight_grad;
+    bias_grad_ += scratch_[static_cast<size_t>(task)].bias_grad;
   }
 }
 

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "common/check.h"
+#include "nn/parallel.h"
 
 namespace rl::nn::internal {
 namespace {
@@ -519,16 +520,6 @@ void SmallMGemm(const ConstView& a, const ConstView& b, const MutView& c, bool a
 
 }  // namespace
 
-void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, bool accumulate,
-                const Epilogue& epilogue, Vector* workspace) {
-  RL_CHECK(k == b.rows && m == c.rows && b.cols == c.cols)
-      << "GemmPacked shapes: (" << m << "x" << k << ") * (" << b.rows << "x" << b.cols << ") -> ("
-      << c.rows << "x" << c.cols << ")";
-  if (m == 0 || c.cols == 0) return;
-  if (k == 0) return Gemm({a_packed, m, 0, 1, m}, b, c, accumulate, epilogue, workspace);
-  PanelGemm({nullptr, m, k, 0, 0}, b, c, accumulate, epilogue, workspace, a_packed);
-}
-
 void AddRowSums(const Matrix& g, float* out) {
   // Blocks of kRowVecs vectors of rows: add the columns one after another into registers.
   constexpr int kRowVecs = 8;
@@ -565,11 +556,11 @@ bool PreferGemm(int m, int n, int k) {
   return n >= 2 && (m >= kLanes || n >= kLanes) && static_cast<int64_t>(m) * n * k >= 8192;
 }
 
-void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& epilogue,
-          Vector* workspace) {
-  RL_CHECK(a.cols == b.rows && a.rows == c.rows && b.cols == c.cols)
-      << "Gemm shapes: (" << a.rows << "x" << a.cols << ") * (" << b.rows << "x" << b.cols
-      << ") -> (" << c.rows << "x" << c.cols << ")";
+namespace {
+
+// Gemm() on the calling thread alone.
+void GemmOneThread(const ConstView& a, const ConstView& b, const MutView& c, bool accumulate,
+                   const Epilogue& epilogue, Vector* workspace) {
   const int m = c.rows;
   const int n = c.cols;
   const int k = a.cols;
@@ -612,6 +603,99 @@ void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& 
       }
     }
   }
+}
+
+// Rows [i0, i0 + rows) of a, columns [j0, j0 + cols) of b, and that block of c.
+ConstView Rows(const ConstView& a, int i0, int rows) {
+  return {a.data + i0 * a.row_stride, rows, a.cols, a.row_stride, a.col_stride};
+}
+ConstView Cols(const ConstView& b, int j0, int cols) {
+  return {b.data + j0 * b.col_stride, b.rows, cols, b.row_stride, b.col_stride};
+}
+MutView Part(const MutView& c, int i0, int rows, int j0, int cols) {
+  return {c.data + i0 * c.row_stride + j0 * c.col_stride, rows, cols, c.row_stride, c.col_stride};
+}
+// The epilogue of the block of c that starts at (i0, j0).
+Epilogue ShiftEpilogue(Epilogue e, const MutView& c, int i0, int j0) {
+  if (e.row_bias != nullptr) e.row_bias += i0;
+  if (e.col_bias != nullptr) e.col_bias += j0;
+  if (e.mask != nullptr) e.mask += i0 * c.row_stride + j0 * c.col_stride;
+  return e;
+}
+
+// Scratch space of the tasks that do not run with the caller's workspace.
+Vector* TaskWorkspace() {
+  thread_local Vector workspace;
+  return &workspace;
+}
+
+// Splits an m x n result (at least kMaxMr rows) of `work` multiply-adds over the threads and
+// calls piece(i0, rows, j0, cols, workspace) for each block: by whole panels of rows when there
+// are at least two full ones (every block then holds a full panel, the last one also the ragged
+// rest), otherwise by blocks of kNr columns. Every block then takes PanelGemm() with the same
+// panels and the same order of operations per element as the whole product, so the results do
+// not depend on the split. A single piece runs directly with `workspace`.
+template <class F>
+void SplitResult(int m, int n, int64_t work, Vector* workspace, const F& piece) {
+  const int full_panels = m / kMaxMr;
+  const bool by_rows = full_panels >= 2;
+  const int units = by_rows ? full_panels : n / kNr;
+  const int tasks = TasksFor(work, units);
+  if (tasks <= 1) return piece(0, m, 0, n, workspace);
+  ParallelFor(tasks, [&](int task) {
+    const int u0 = units * task / tasks;
+    const int u1 = units * (task + 1) / tasks;
+    const bool last = task == tasks - 1;
+    Vector* ws = task == 0 ? workspace : TaskWorkspace();
+    if (by_rows) {
+      const int i0 = u0 * kMaxMr;
+      piece(i0, (last ? m : u1 * kMaxMr) - i0, 0, n, ws);
+    } else {
+      const int j0 = u0 * kNr;
+      piece(0, m, j0, (last ? n : u1 * kNr) - j0, ws);
+    }
+  });
+}
+
+}  // namespace
+
+void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& epilogue,
+          Vector* workspace) {
+  RL_CHECK(a.cols == b.rows && a.rows == c.rows && b.cols == c.cols)
+      << "Gemm shapes: (" << a.rows << "x" << a.cols << ") * (" << b.rows << "x" << b.cols
+      << ") -> (" << c.rows << "x" << c.cols << ")";
+  const int m = c.rows;
+  const int n = c.cols;
+  const int k = a.cols;
+  // Products with fewer rows take other paths than PanelGemm(); they are not split.
+  if (m < kMaxMr || n == 0 || k == 0) {
+    return GemmOneThread(a, b, c, accumulate, epilogue, workspace);
+  }
+  SplitResult(m, n, static_cast<int64_t>(m) * n * k, workspace,
+              [&](int i0, int rows, int j0, int cols, Vector* ws) {
+                GemmOneThread(Rows(a, i0, rows), Cols(b, j0, cols), Part(c, i0, rows, j0, cols),
+                              accumulate, ShiftEpilogue(epilogue, c, i0, j0), ws);
+              });
+}
+
+void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, bool accumulate,
+                const Epilogue& epilogue, Vector* workspace) {
+  RL_CHECK(k == b.rows && m == c.rows && b.cols == c.cols)
+      << "GemmPacked shapes: (" << m << "x" << k << ") * (" << b.rows << "x" << b.cols << ") -> ("
+      << c.rows << "x" << c.cols << ")";
+  const int n = c.cols;
+  if (m == 0 || n == 0) return;
+  if (k == 0) return Gemm({a_packed, m, 0, 1, m}, b, c, accumulate, epilogue, workspace);
+  if (m < kMaxMr) {
+    return PanelGemm({nullptr, m, k, 0, 0}, b, c, accumulate, epilogue, workspace, a_packed);
+  }
+  // A block of rows starting at i0 (a whole number of panels) starts at panel i0 / kMaxMr.
+  SplitResult(m, n, static_cast<int64_t>(m) * n * k, workspace,
+              [&](int i0, int rows, int j0, int cols, Vector* ws) {
+                PanelGemm({nullptr, rows, k, 0, 0}, Cols(b, j0, cols), Part(c, i0, rows, j0, cols),
+                          accumulate, ShiftEpilogue(epilogue, c, i0, j0), ws,
+                          a_packed + static_cast<int64_t>(i0) * k);
+              });
 }
 
 }  // namespace rl::nn::internal

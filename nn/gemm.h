@@ -70,7 +70,10 @@ constexpr int kPanelRows = 8;
 
 /// c = a * b (accumulate == false) or c += a * b (accumulate == true), followed by `epilogue`.
 /// `c` must not overlap `a`, `b` or the mask. `workspace` is scratch space; it only grows, so
-/// repeated calls with the same shapes do not allocate. O(m n k).
+/// repeated calls with the same shapes do not allocate. O(m n k). With SetNumThreads(n > 1)
+/// (nn/parallel.h) a large product (at least 24 rows and 8M multiply-adds) is split into blocks of
+/// whole 24-row panels (or of columns) over the threads, with the same result bit for bit; the
+/// other threads use their own scratch space.
 void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& epilogue,
           Vector* workspace);
 
@@ -78,7 +81,7 @@ void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& 
 /// place by a convolution): rows [q * kPanelRows, (q + 1) * kPanelRows) are at
 /// a_packed + q * kPanelRows * k, as k steps of kPanelRows floats (row i of the panel at step p
 /// is a_packed[q * kPanelRows * k + p * kPanelRows + i]). Rows past m in the last panel are read
-/// but do not affect c. O(m n k).
+/// but do not affect c. O(m n k). Split over threads as Gemm().
 void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, bool accumulate,
                 const Epilogue& epilogue, Vector* workspace);
 

@@ -7,8 +7,13 @@
 #include <immintrin.h>
 #endif
 
+#include "nn/parallel.h"
+
 namespace rl::nn::internal {
 namespace {
+
+// Outputs per block: at most 8 AVX-512 registers of accumulators.
+constexpr int kBlockRows = 128;
 
 #ifdef __AVX512F__
 // Outputs [i0, i0 + 16 * NV) (the last register masked by `tail`), all columns in one pass. The
@@ -69,17 +74,17 @@ void Narrow(const float* w, int out, int in, const float* x, const float* b, boo
 }
 #endif
 
-}  // namespace
-
-void Gemv(const float* w, int out, int in, const float* x, const float* b, bool relu, float* y) {
+// Outputs [i_begin, i_end) of Gemv(), i_begin a multiple of kBlockRows.
+void GemvRows(const float* w, int out, int in, const float* x, const float* b, bool relu, float* y,
+              int i_begin, int i_end) {
 #ifdef __AVX512F__
   if (out <= 16) {
     Narrow(w, out, in, x, b, relu, y, static_cast<__mmask16>((1U << out) - 1U));
     return;
   }
   // Blocks of up to 8 registers (128 outputs), each a single pass over the columns.
-  for (int i0 = 0; i0 < out; i0 += 128) {
-    const int rows = std::min(128, out - i0);
+  for (int i0 = i_begin; i0 < i_end; i0 += kBlockRows) {
+    const int rows = std::min(kBlockRows, i_end - i0);
     const int nv = (rows + 15) / 16;
     const int last = rows - 16 * (nv - 1);
     const auto tail = static_cast<__mmask16>(last == 16 ? 0xFFFFU : (1U << last) - 1U);
@@ -112,16 +117,33 @@ void Gemv(const float* w, int out, int in, const float* x, const float* b, bool 
   }
 #else
   // Portable: the same column walk, vectorised by the compiler over the outputs.
-  std::copy_n(b, out, y);
+  std::copy(b + i_begin, b + i_end, y + i_begin);
   for (int j = 0; j < in; ++j) {
     const float* col = w + static_cast<std::ptrdiff_t>(j) * out;
     const float xj = x[j];
-    for (int i = 0; i < out; ++i) y[i] += col[i] * xj;
+    for (int i = i_begin; i < i_end; ++i) y[i] += col[i] * xj;
   }
   if (relu) {
-    for (int i = 0; i < out; ++i) y[i] = std::max(y[i], 0.0f);
+    for (int i = i_begin; i < i_end; ++i) y[i] = std::max(y[i], 0.0f);
   }
 #endif
+}
+
+}  // namespace
+
+void Gemv(const float* w, int out, int in, const float* x, const float* b, bool relu, float* y) {
+  // Each thread takes whole blocks of outputs, which it computes exactly as a single thread
+  // would. The product is bound by reading the weight (one multiply-add per float loaded), so a
+  // multiply-add counts as several of a matrix product's when deciding whether to split.
+  constexpr int kMemoryBoundFactor = 4;
+  const int blocks = (out + kBlockRows - 1) / kBlockRows;
+  const int tasks =
+      out <= 16 ? 1 : TasksFor(static_cast<int64_t>(out) * in * kMemoryBoundFactor, blocks);
+  ParallelFor(tasks, [&](int task) {
+    const int i_begin = blocks * task / tasks * kBlockRows;
+    const int i_end = std::min(out, blocks * (task + 1) / tasks * kBlockRows);
+    GemvRows(w, out, in, x, b, relu, y, i_begin, i_end);
+  });
 }
 
 }  // namespace rl::nn::internal

@@ -11,7 +11,9 @@
 namespace rl::nn::internal {
 
 /// y = w x + b for a column-major `out` x `in` matrix w, then max(y, 0) when `relu`.
-/// `y` must not overlap the inputs. O(out in), no allocation.
+/// `y` must not overlap the inputs. O(out in), no allocation. With SetNumThreads(n > 1)
+/// (nn/parallel.h) a large product splits its outputs, in blocks of 128, over the threads, with
+/// the same result bit for bit.
 void Gemv(const float* w, int out, int in, const float* x, const float* b, bool relu, float* y);
 
 }  // namespace rl::nn::internal

@@ -6,7 +6,10 @@
 #
 # Usage: scripts/bench.sh [--no-setup] [--build-dir DIR] [--skip-goal] [--skip-peer]
 # Environment: REPEATS (5), SECONDS_PER (1.0, per measurement), GOAL_SEEDS ("1 2 3"),
-#              PEER_REPEATS (3), PEER_DQN (1: also time the peer's full CartPole DQN run).
+#              PEER_REPEATS (3), PEER_DQN (1: also time the peer's full CartPole DQN run),
+#              CNN_REPEATS (REPEATS) and CNN_SECONDS (SECONDS_PER) for bench_cnn, CNN_THREADS
+#              ("1,2": the thread counts of bench_cnn and of the peer's CNN modes), PEER_CNN (1:
+#              run the peer's nature, small and latency modes; 0: skip them).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -44,6 +47,9 @@ echo "bench: ours" >&2
 "$bin/bench_actor" "$repeats" "$seconds" >> "$ours"
 "$bin/bench_learner" "$repeats" "$seconds" >> "$ours"
 isolated "$bin/bench_replay" "$repeats" "$seconds" >> "$ours"
+# Pixel networks (Nature and grasp CNN): updates/s, latency, convolution GFLOP/s, the FMA peak.
+cnn_threads=${CNN_THREADS:-1,2}
+"$bin/bench_cnn" "${CNN_REPEATS:-$repeats}" "${CNN_SECONDS:-$seconds}" "$cnn_threads" >> "$ours"
 
 # Time from launch to goal for CartPole, start-up and evaluation included.
 if [ "$skip_goal" -eq 0 ]; then
@@ -90,6 +96,13 @@ if [ "$skip_peer" -eq 0 ] && [ -f "$peer_dir/micro.py" ] && "$py" -c 'import tor
     echo "bench: peer micro, repeat $r" >&2
     (cd "$peer_dir" && "$py" micro.py --only env,mlp,actor --threads 1 --min-time 2 --tag "r$r") >> "$peer"
   done
+  if [ "${PEER_CNN:-1}" = 1 ]; then
+    for r in $(seq "${PEER_REPEATS:-3}"); do
+      echo "bench: peer micro CNN (nature, small, latency; threads $cnn_threads), repeat $r" >&2
+      (cd "$peer_dir" && "$py" micro.py --only nature,small,latency --threads "$cnn_threads" \
+        --min-time 2 --tag "cnn-r$r") >> "$peer"
+    done
+  fi
   if [ "${PEER_DQN:-1}" = 1 ] && [ "$skip_goal" -eq 0 ]; then
     echo "bench: peer DQN on CartPole (500,000 steps)" >&2
     start=$(date +%s.%N)
@@ -109,25 +122,39 @@ ours = [json.loads(l) for l in open(sys.argv[1]) if l.strip()]
 peer = [json.loads(l) for l in open(sys.argv[2]) if l.strip().startswith("{")]
 def peer_lines(pred):
     return [p for p in peer if "rate" in p and pred(p)]
+def peer_updates(net):
+    return lambda o: lambda p: (p["bench"] == "updates" and p.get("net") == net
+                                and p.get("batch") == o.get("batch")
+                                and p.get("threads") == o.get("threads"))
+# Our bench -> (which peer lines, "higher" or "lower" is better[, factor from the peer's unit to
+# ours]).
 match = {
     "cartpole_env_steps": (lambda o: lambda p: p["bench"] == "env_steps", "higher"),
     "actor_steps": (lambda o: lambda p: p["bench"] == "actor_steps" and p.get("threads") == 1, "higher"),
     "learner_updates_mlp": (lambda o: lambda p: p["bench"] == "updates" and p.get("net") == "mlp"
                             and p.get("batch") == o.get("batch") and p.get("threads") == 1, "higher"),
     "cartpole_time_to_goal": (lambda o: lambda p: p["bench"] == "peer_dqn_wall", "lower"),
+    "learner_updates_nature_cnn": (peer_updates("nature_cnn"), "higher"),
+    "learner_updates_grasp_cnn": (peer_updates("small_cnn_bn"), "higher"),
+    # The peer reports microseconds per call (a mean over calls); ours are milliseconds (median).
+    "inference_latency_nature_cnn": (lambda o: lambda p: p["bench"] == "latency"
+                                     and p.get("net") == "nature_cnn"
+                                     and p.get("threads") == o.get("threads"), "lower", 1e-3),
 }
 for o in ours:
     m = match.get(o["bench"])
     if m:
         lines = peer_lines(m[0](o))
         if lines:
-            p = statistics.median([l["rate"] for l in lines])
-            o["peer"] = round(p, 3)
+            p = statistics.median([l["rate"] for l in lines]) * (m[2] if len(m) > 2 else 1)
+            o["peer"] = round(p, 6 if p < 1 else 3)
             o["peer_repeats"] = len(lines)
             if lines[0].get("blas"):
                 o["peer_blas"] = lines[0]["blas"]
             o["ratio"] = round(o["value"] / p if m[1] == "higher" else p / o["value"], 2)
             if o["bench"] == "cartpole_time_to_goal":
                 o["peer_note"] = "wall time of the peer's full 500,000-step CleanRL DQN run"
+            if o["bench"].startswith("inference_latency_"):
+                o["peer_note"] = "micro.py latency: mean over calls, converted to ms"
     print(json.dumps(o))
 PY

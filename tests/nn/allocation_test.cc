@@ -8,6 +8,7 @@
 
 #include "nn/losses.h"
 #include "nn/optimizers.h"
+#include "nn/parallel.h"
 #include "nn/pixels.h"
 #include "nn/presets.h"
 #include "nn/sequential.h"
@@ -138,6 +139,39 @@ TEST(AllocationTest, GraspCnnUpdateDoesNotAllocateOnceShapesAreStable) {
   const int64_t before = AllocationCount();
   for (int i = 0; i < 3; ++i) update();
   EXPECT_EQ(AllocationCount() - before, 0);
+}
+
+// With two threads (nn/parallel.h) the pool hands out work without allocating and every task
+// keeps its scratch space: convolutions split by samples, products by rows.
+TEST(AllocationTest, PixelNetworksDoNotAllocateWithTwoThreads) {
+  ASSERT_TRUE(AllocationCountingAvailable()) << "this test needs glibc without a sanitizer";
+  SetNumThreads(2);
+  std::mt19937 rng(0);
+  Sequential nature = MakeNatureCnn(7, &rng);
+  Sequential grasp = MakeGraspCnn(7, &rng);
+  // Networks for single observations apart: a network that changes batch size reallocates.
+  Sequential nature_actor = nature;
+  Sequential grasp_actor = grasp;
+  const int64_t sections = internal::ParallelSections();
+  const Matrix nature_x = testing::RandomMatrix(nature.InputSize(), 4, &rng).cwiseAbs();
+  const Matrix grasp_x = testing::RandomMatrix(grasp.InputSize(), 32, &rng).cwiseAbs();
+  const Matrix nature_dq = testing::RandomMatrix(7, 4, &rng);
+  const Matrix grasp_dq = testing::RandomMatrix(7, 32, &rng);
+  auto work = [&] {
+    nature.Forward(nature_x);
+    nature.BackwardParams(nature_dq);
+    grasp.Forward(grasp_x);
+    grasp.BackwardParams(grasp_dq);
+    return nature_actor.Argmax(nature_x.data(), nature.InputSize()) +
+           grasp_actor.Argmax(grasp_x.data(), grasp.InputSize());
+  };
+  int sum = work();
+  const int64_t before = AllocationCount();
+  for (int i = 0; i < 3; ++i) sum += work();
+  const int64_t allocations = AllocationCount() - before;
+  SetNumThreads(1);
+  EXPECT_EQ(allocations, 0) << sum;
+  EXPECT_GT(internal::ParallelSections(), sections) << "nothing ran on two threads";
 }
 
 }  // namespace

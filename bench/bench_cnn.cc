@@ -1,0 +1,508 @@
+// Pixel networks at 1 and 2 threads (nn::SetNumThreads), beside the PyTorch peer's micro.py modes
+// `nature`, `small` and `latency`:
+//
+//   learner_updates_nature_cnn, learner_updates_grasp_cnn (updates/s): DQN updates of
+//     MakeNatureCnn(7) on 4x84x84 and MakeGraspCnn(7) on 4x40x40 uint8 frames at batch 32, the
+//     work micro.py's `nature` and `small` modes time (see kUpdateWork).
+//   inference_latency_nature_cnn, inference_latency_grasp_cnn (ms): one uint8 observation to a
+//     greedy action, median over calls, as micro.py's `latency` (which has the Nature CNN only).
+//   conv_gflops_nature_cnn, conv_gflops_grasp_cnn (GFLOP/s): the convolution layers of the
+//     network alone, at batch 32: "forward", "backward" (weight gradients, and input gradients
+//     of all but the first layer, as in an update) and "update" (two forward passes and one
+//     backward pass, the convolution work of one update). FLOPs are 2 x multiply-adds, counted
+//     from the layer shapes.
+//   peak_fp32_gflops (GFLOP/s): the FMA throughput of the machine, measured with independent
+//     chains of vector FMAs (per core at 1 thread; at 2 threads the sum of two cores).
+//
+// Every line has "threads" (the SetNumThreads() setting) and "threads_used": the setting if the
+// measured operation ran parallel sections ("parallel_sections_per_call"), else 1 (a
+// single observation is too small to be split, so its latency is the 1-thread path).
+//
+// Usage: bench_cnn [repeats (5)] [seconds per measurement (1.0)] [thread counts ("1,2")]
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#if defined(__AVX512F__) || defined(__FMA__)
+#include <immintrin.h>
+#endif
+
+#include "bench/bench_util.h"
+#include "nn/activations.h"
+#include "nn/conv2d.h"
+#include "nn/linear.h"
+#include "nn/losses.h"
+#include "nn/optimizers.h"
+#include "nn/parallel.h"
+#include "nn/pixels.h"
+#include "nn/presets.h"
+#include "nn/sequential.h"
+
+namespace {
+
+using rl::nn::Matrix;
+using rl::nn::Sequential;
+using rl::nn::Vector;
+using Clock = std::chrono::steady_clock;
+
+// What micro.py uses for both CNNs (make_update, NatureCNN/SmallCNN defaults).
+constexpr int kBatch = 32;
+constexpr int kActions = 7;
+constexpr float kGamma = 0.99f;
+constexpr float kLearningRate = 1e-4f;
+constexpr int kBatches = 8;  // Pre-generated batches, cycled.
+constexpr double kDoneProbability = 0.05;
+
+const char* const kUpdateWork =
+    "uint8 next_obs and obs to x/255, target forward on next_obs (eval mode, no gradients), max "
+    "over actions, TD target r + 0.99 max (1 - done), online forward on obs (training mode), "
+    "gather of the taken actions, Huber loss (smooth_l1, mean), zero grad, backward (parameter "
+    "gradients only, no input gradient: the peer's input does not require grad), Adam step (lr "
+    "1e-4); no gradient clipping, no target copy, 8 pre-generated batches cycled: micro.py's "
+    "update()";
+
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.6g", v);
+  return buf;
+}
+
+struct NetSpec {
+  std::string name;      // Our bench-name suffix: nature_cnn, grasp_cnn.
+  std::string peer_net;  // micro.py's name, or "" if the peer has no such measurement.
+  std::function<Sequential(std::mt19937*)> make;
+};
+
+// FLOPs (2 x multiply-adds) of the matrix products of one DQN update at `batch`: forward passes
+// of the target and the online network, then weight gradients of every layer and input
+// gradients of every layer but the first (Sequential::BackwardParams()).
+struct Flops {
+  double conv_forward = 0;   // One forward pass, convolutions only.
+  double conv_backward = 0;  // One backward pass, convolutions only.
+  double other_forward = 0;  // Linear layers.
+  double other_backward = 0;
+  double ConvUpdate() const { return 2 * conv_forward + conv_backward; }
+  double Update() const { return ConvUpdate() + 2 * other_forward + other_backward; }
+};
+
+Flops CountFlops(const Sequential& net, int batch) {
+  Flops f;
+  for (int i = 0; i < net.num_layers(); ++i) {
+    const rl::nn::Layer& layer = net.layer(i);
+    const int gradients = i == 0 ? 1 : 2;  // dW, plus dX after the first layer.
+    if (const auto* conv = dynamic_cast<const rl::nn::Conv2d*>(&layer)) {
+      const rl::nn::ImageShape in = conv->input_shape();
+      const rl::nn::ImageShape out = conv->output_shape();
+      const double taps = static_cast<double>(in.channels) * conv->kernel() * conv->kernel();
+      const double pass = 2.0 * batch * out.height * out.width * out.channels * taps;
+      f.conv_forward += pass;
+      f.conv_backward += gradients * pass;
+    } else if (dynamic_cast<const rl::nn::Linear*>(&layer) != nullptr) {
+      const double pass = 2.0 * batch * layer.input_size() * layer.output_size();
+      f.other_forward += pass;
+      f.other_backward += gradients * pass;
+    }
+  }
+  return f;
+}
+
+std::vector<uint8_t> RandomPixels(size_t n, std::mt19937* rng) {
+  std::uniform_int_distribution<int> byte(0, 255);
+  std::vector<uint8_t> v(n);
+  for (uint8_t& b : v) b = static_cast<uint8_t>(byte(*rng));
+  return v;
+}
+
+// One DQN update as micro.py's make_update(): see kUpdateWork.
+class DqnUpdate {
+ public:
+  DqnUpdate(Sequential net, int batch, std::mt19937* rng)
+      : online_(std::move(net)),
+        target_(online_),
+        adam_(online_.Params(), kLearningRate),
+        batch_(batch),
+        features_(online_.InputSize()) {
+    target_.set_training(false);
+    std::uniform_int_distribution<int> action(0, kActions - 1);
+    std::bernoulli_distribution done(kDoneProbability);
+    for (int i = 0; i < kBatches; ++i) {
+      Batch d;
+      d.obs = RandomPixels(static_cast<size_t>(features_) * batch, rng);
+      d.next_obs = RandomPixels(static_cast<size_t>(features_) * batch, rng);
+      for (int j = 0; j < batch; ++j) {
+        d.action.push_back(action(*rng));
+        d.reward.push_back(1.0f);
+        d.done.push_back(done(*rng) ? 1.0f : 0.0f);
+      }
+      data_.push_back(std::move(d));
+    }
+    td_target_.resize(batch);
+    q_taken_.resize(batch);
+    grad_q_.resize(kActions, batch);
+  }
+
+  void Run() {
+    const Batch& d = data_[next_++ % data_.size()];
+    rl::nn::PixelsToMatrix(d.next_obs.data(), features_, batch_, &next_obs_);
+    const Matrix& q_next = target_.Forward(next_obs_);
+    for (int j = 0; j < batch_; ++j) {
+      td_target_[j] = d.reward[j] + kGamma * q_next.col(j).maxCoeff() * (1.0f - d.done[j]);
+    }
+    rl::nn::PixelsToMatrix(d.obs.data(), features_, batch_, &obs_);
+    const Matrix& q = online_.Forward(obs_);
+    for (int j = 0; j < batch_; ++j) q_taken_[j] = q(d.action[j], j);
+    rl::nn::HuberLoss(q_taken_, td_target_, &grad_);
+    grad_q_.setZero();
+    for (int j = 0; j < batch_; ++j) grad_q_(d.action[j], j) = grad_[j];
+    online_.ZeroGrad();
+    online_.BackwardParams(grad_q_);
+    adam_.Step();
+  }
+
+ private:
+  struct Batch {
+    std::vector<uint8_t> obs, next_obs;
+    std::vector<int> action;
+    std::vector<float> reward, done;
+  };
+  Sequential online_;
+  Sequential target_;
+  rl::nn::Adam adam_;
+  int batch_;
+  int features_;
+  std::vector<Batch> data_;
+  size_t next_ = 0;
+  Matrix obs_, next_obs_, grad_q_;
+  Vector td_target_, q_taken_, grad_;
+};
+
+// The convolution layers of a network, rebuilt alone with the same shapes and the same fused
+// ReLUs as inside it (a ReLU after a layer is applied by it; the backward pass of a ReLU before
+// it too), fed random inputs of the right shapes.
+class ConvStack {
+ public:
+  ConvStack(const Sequential& net, int batch, std::mt19937* rng) {
+    std::normal_distribution<float> normal;
+    std::uniform_real_distribution<float> unit;
+    auto is_relu = [&net](int i) {
+      return i >= 0 && i < net.num_layers() &&
+             dynamic_cast<const rl::nn::ReLU*>(&net.layer(i)) != nullptr;
+    };
+    for (int i = 0; i < net.num_layers(); ++i) {
+      const auto* conv = dynamic_cast<const rl::nn::Conv2d*>(&net.layer(i));
+      if (conv == nullptr) continue;
+      const rl::nn::ImageShape in = conv->input_shape();
+      auto layer = std::make_unique<rl::nn::Conv2d>(in.channels, conv->output_shape().channels,
+                                                    conv->kernel(), conv->stride(), conv->padding(),
+                                                    in.height, in.width, rng);
+      if (is_relu(i + 1)) layer->FuseOutputRelu();
+      if (is_relu(i - 1)) layer->FuseInputReluGrad();
+      Matrix x(in.size(), batch);
+      // Pixels / 255 for the first layer, ReLU outputs for the others.
+      for (float& v : x.reshaped()) v = i == 0 ? unit(*rng) : std::max(normal(*rng), 0.0f);
+      Matrix g(layer->output_size(), batch);
+      for (float& v : g.reshaped()) v = 1e-3f * normal(*rng);
+      first_.push_back(i == 0);
+      layers_.push_back(std::move(layer));
+      inputs_.push_back(std::move(x));
+      grads_.push_back(std::move(g));
+    }
+  }
+
+  void Forward() {
+    for (size_t c = 0; c < layers_.size(); ++c) layers_[c]->Forward(inputs_[c]);
+  }
+  void Backward() {
+    for (size_t c = 0; c < layers_.size(); ++c) {
+      if (first_[c]) {
+        layers_[c]->BackwardParams(grads_[c]);
+      } else {
+        layers_[c]->Backward(grads_[c]);
+      }
+    }
+  }
+
+ private:
+  std::vector<std::unique_ptr<rl::nn::Conv2d>> layers_;
+  std::vector<Matrix> inputs_;
+  std::vector<Matrix> grads_;
+  std::vector<bool> first_;
+};
+
+// Median time of one greedy action for a uint8 observation, including its conversion to x/255
+// (micro.py's latency: from_numpy, forward with x.float() / 255, argmax, item), timing each call.
+struct Latency {
+  double median_ms = 0;
+  double mean_ms = 0;
+};
+
+Latency MeasureLatency(Sequential* net, const std::vector<uint8_t>& obs, double seconds) {
+  const int size = net->InputSize();
+  Matrix x;
+  int sink = 0;
+  auto act = [&] {
+    rl::nn::PixelsToMatrix(obs.data(), size, 1, &x);
+    sink += net->Argmax(x.data(), size);
+  };
+  for (int i = 0; i < 3; ++i) act();
+  std::vector<double> ms;
+  ms.reserve(1 << 16);
+  const auto start = Clock::now();
+  do {
+    const auto t0 = Clock::now();
+    act();
+    const auto t1 = Clock::now();
+    ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+  } while (std::chrono::duration<double>(Clock::now() - start).count() < seconds || ms.size() < 20);
+  Latency l;
+  for (double v : ms) l.mean_ms += v;
+  l.mean_ms /= static_cast<double>(ms.size());
+  l.median_ms = rl::bench::Summarize(ms).median;
+  if (sink < 0) std::printf("%d\n", sink);  // Keeps the calls.
+  return l;
+}
+
+// Peak FP32 throughput of one core: kChains independent chains of vector FMAs (more than the FMA
+// latency times the number of FMA pipes of current x86 cores, 4 x 2), so that only throughput
+// limits them. Each chain computes acc = acc * m + a, which converges to 1 without denormals.
+template <class V, V (*kSet)(float), V (*kFma)(V, V, V), int kLanes>
+double FmaGflops(double seconds) {
+  constexpr int kChains = 16;
+  constexpr int64_t kInner = 1 << 14;
+  V acc[kChains];
+  for (int c = 0; c < kChains; ++c) acc[c] = kSet(1.0f + 0.001f * static_cast<float>(c));
+  const V mul = kSet(0.999999f);
+  const V add = kSet(1e-6f);
+  int64_t fmas = 0;
+  const auto start = Clock::now();
+  double elapsed = 0;
+  do {
+    for (int64_t i = 0; i < kInner; ++i) {
+#pragma GCC unroll 16
+      for (int c = 0; c < kChains; ++c) acc[c] = kFma(acc[c], mul, add);
+    }
+    fmas += kInner * kChains;
+    elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+  } while (elapsed < seconds);
+  float sum = 0;
+  for (int c = 0; c < kChains; ++c) {
+    alignas(64) float lanes[kLanes];
+    std::memcpy(lanes, &acc[c], sizeof(lanes));
+    for (float v : lanes) sum += v;
+  }
+  if (sum < 0) std::printf("%g\n", static_cast<double>(sum));  // Keeps the chains.
+  return 2.0 * kLanes * static_cast<double>(fmas) / elapsed / 1e9;
+}
+
+#if defined(__AVX512F__)
+__m512 Set512(float x) { return _mm512_set1_ps(x); }
+__m512 Fma512(__m512 a, __m512 b, __m512 c) { return _mm512_fmadd_ps(a, b, c); }
+#endif
+#if defined(__FMA__)
+__m256 Set256(float x) { return _mm256_set1_ps(x); }
+__m256 Fma256(__m256 a, __m256 b, __m256 c) { return _mm256_fmadd_ps(a, b, c); }
+// With 256-bit vectors, the width the product kernel of nn/gemm.cc uses.
+double Fma256Gflops(double seconds) { return FmaGflops<__m256, Set256, Fma256, 8>(seconds); }
+#endif
+
+// GFLOP/s of the widest FMA this build has (512-bit or 256-bit), and its width in bits; 0 when
+// the build has no FMA instructions.
+double WidestFmaGflops(double seconds, int* bits) {
+#if defined(__AVX512F__)
+  *bits = 512;
+  return FmaGflops<__m512, Set512, Fma512, 16>(seconds);
+#elif defined(__FMA__)
+  *bits = 256;
+  return Fma256Gflops(seconds);
+#else
+  *bits = 0;
+  static_cast<void>(seconds);
+  return 0;
+#endif
+}
+
+// The sum over `threads` threads running the FMA loop at the same time.
+double ParallelFmaGflops(int threads, double seconds, int* bits) {
+  std::vector<double> rates(static_cast<size_t>(threads));
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) {
+    pool.emplace_back([&, t] {
+      int unused = 0;
+      rates[static_cast<size_t>(t)] = WidestFmaGflops(seconds, &unused);
+    });
+  }
+  rates[0] = WidestFmaGflops(seconds, bits);
+  for (std::thread& t : pool) t.join();
+  double sum = 0;
+  for (double r : rates) sum += r;
+  return sum;
+}
+
+// The "threads" fields of a measurement at `threads` threads whose operation ran `sections`
+// parallel sections (nn::internal::ParallelSections()): a computation too small to be split runs
+// on one thread whatever the setting, and says so.
+std::string ThreadFields(int threads, int64_t sections) {
+  return "\"threads\": " + std::to_string(threads) +
+         ", \"threads_used\": " + std::to_string(sections > 0 ? rl::nn::NumThreads() : 1) +
+         ", \"parallel_sections_per_call\": " + std::to_string(sections);
+}
+
+// Parallel sections run by one call of `op`.
+int64_t SectionsOf(const std::function<void()>& op) {
+  const int64_t before = rl::nn::internal::ParallelSections();
+  op();
+  return rl::nn::internal::ParallelSections() - before;
+}
+
+std::vector<int> ParseThreads(const char* arg) {
+  std::vector<int> out;
+  std::stringstream ss(arg);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (!item.empty()) out.push_back(std::atoi(item.c_str()));
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
+  const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
+  const std::vector<int> thread_counts = ParseThreads(argc > 3 ? argv[3] : "1,2");
+  if (repeats < 1 || seconds <= 0 || thread_counts.empty()) {
+    std::fprintf(stderr, "usage: bench_cnn [repeats] [seconds] [threads, e.g. 1,2]\n");
+    return 2;
+  }
+  const std::vector<NetSpec> nets = {
+      {"nature_cnn", "nature_cnn",
+       [](std::mt19937* rng) { return rl::nn::MakeNatureCnn(kActions, rng); }},
+      {"grasp_cnn", "small_cnn_bn",
+       [](std::mt19937* rng) { return rl::nn::MakeGraspCnn(kActions, rng); }},
+  };
+
+  for (int threads : thread_counts) {
+    rl::nn::SetNumThreads(threads);
+
+    // The machine's peak, for reference.
+    int bits = 0;
+    std::vector<double> peaks;
+    for (int r = 0; r < repeats; ++r) {
+      peaks.push_back(ParallelFmaGflops(threads, std::min(seconds, 0.5), &bits));
+    }
+    const rl::bench::Summary peak = rl::bench::Summarize(peaks);
+    std::string narrow;
+#if defined(__FMA__)
+    if (threads == 1) {
+      std::vector<double> v;
+      for (int r = 0; r < repeats; ++r) v.push_back(Fma256Gflops(std::min(seconds, 0.5)));
+      narrow = ", \"gflops_256bit\": " + Num(rl::bench::Summarize(v).median);
+    }
+#endif
+    rl::bench::Emit("peak_fp32_gflops", "GFLOP/s", peak, repeats,
+                    "\"threads\": " + std::to_string(threads) + ", \"threads_used\": " +
+                        std::to_string(threads) + ", \"cores\": " + std::to_string(threads) +
+                        ", \"per_core\": " + Num(peak.median / threads) +
+                        ", \"vector_bits\": " + std::to_string(bits) +
+                        ", \"method\": \"16 independent chains of " + std::to_string(bits) +
+                        "-bit FMA instructions on each of " + std::to_string(threads) +
+                        " threads at once; 2 FLOPs per lane and FMA\"" + narrow);
+
+    for (const NetSpec& spec : nets) {
+      std::mt19937 rng(1);
+      Sequential net = spec.make(&rng);
+      const Flops flops = CountFlops(net, kBatch);
+      const std::string net_fields = "\"net\": \"" + spec.name +
+                                     "\", \"batch\": " + std::to_string(kBatch) +
+                                     ", \"actions\": " + std::to_string(kActions);
+
+      // 1. DQN updates per second.
+      {
+        DqnUpdate update(net, kBatch, &rng);
+        for (int i = 0; i < 3; ++i) update.Run();
+        const int64_t sections = SectionsOf([&] { update.Run(); });
+        const rl::bench::Summary s = rl::bench::Repeat(
+            repeats, [&] { return rl::bench::Rate([&] { update.Run(); }, 1, seconds, 1); });
+        rl::bench::Emit("learner_updates_" + spec.name, "updates/s", s, repeats,
+                        net_fields + ", " + ThreadFields(threads, sections) +
+                            ", \"loss\": \"huber\", \"optimizer\": \"adam\"" +
+                            ", \"gflop_per_update\": " + Num(flops.Update() / 1e9) +
+                            ", \"conv_gflop_per_update\": " + Num(flops.ConvUpdate() / 1e9) +
+                            ", \"peer_mode\": \"micro.py " +
+                            (spec.name == "nature_cnn" ? "nature" : "small") + "\", \"work\": \"" +
+                            kUpdateWork + "\"");
+      }
+
+      // 2. Latency of one greedy action.
+      {
+        Sequential actor = net;
+        std::mt19937 obs_rng(0);
+        const std::vector<uint8_t> obs =
+            RandomPixels(static_cast<size_t>(actor.InputSize()), &obs_rng);
+        const int64_t sections = SectionsOf([&] {
+          Matrix x;
+          rl::nn::PixelsToMatrix(obs.data(), actor.InputSize(), 1, &x);
+          actor.Argmax(x.data(), actor.InputSize());
+        });
+        std::vector<double> medians;
+        double mean = 0;
+        for (int r = 0; r < repeats; ++r) {
+          const Latency l = MeasureLatency(&actor, obs, seconds);
+          medians.push_back(l.median_ms);
+          mean += l.mean_ms / repeats;
+        }
+        rl::bench::Emit(
+            "inference_latency_" + spec.name, "ms", rl::bench::Summarize(medians), repeats,
+            "\"net\": \"" + spec.name + "\", \"batch\": 1, " + ThreadFields(threads, sections) +
+                ", \"statistic\": \"median over calls (per repeat)\", \"mean_ms\": " + Num(mean) +
+                ", \"work\": \"uint8 observation to x/255 (PixelsToMatrix), forward in "
+                "evaluation mode, argmax (Sequential::Argmax)\"" +
+                (spec.peer_net == "nature_cnn" ? ", \"peer_mode\": \"micro.py latency\"" : ""));
+      }
+
+      // 3. GFLOP/s of the convolution layers alone.
+      {
+        ConvStack convs(net, kBatch, &rng);
+        convs.Forward();
+        convs.Backward();
+        struct Pass {
+          const char* name;
+          double flops;
+          std::function<void()> run;
+        };
+        const Pass passes[] = {
+            {"forward", flops.conv_forward, [&] { convs.Forward(); }},
+            {"backward", flops.conv_backward, [&] { convs.Backward(); }},
+            {"update", flops.ConvUpdate(),
+             [&] {
+               convs.Forward();
+               convs.Forward();
+               convs.Backward();
+             }},
+        };
+        for (const Pass& pass : passes) {
+          const int64_t sections = SectionsOf(pass.run);
+          const rl::bench::Summary s = rl::bench::Repeat(
+              repeats, [&] { return pass.flops / 1e9 * rl::bench::Rate(pass.run, 1, seconds, 1); });
+          rl::bench::Emit("conv_gflops_" + spec.name, "GFLOP/s", s, repeats,
+                          net_fields + ", " + ThreadFields(threads, sections) + ", \"pass\": \"" +
+                              pass.name + "\", \"gflop_per_call\": " + Num(pass.flops / 1e9) +
+                              ", \"peak_gflops\": " + Num(peak.median) +
+                              ", \"fraction_of_peak\": " + Num(s.median / peak.median));
+        }
+      }
+    }
+  }
+  rl::nn::SetNumThreads(1);
+  return 0;
+}
