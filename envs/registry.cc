@@ -8,6 +8,7 @@
 #include "envs/box2d/lunar_lander.h"
 #include "envs/cartpole.h"
 #include "envs/catch.h"
+#include "envs/kuka/kuka_diverse_object_env.h"
 #include "envs/pixel_spec.h"
 #include "envs/time_limit.h"
 
@@ -39,6 +40,19 @@ constexpr std::array kRegistrations = {
     Registration{"Catch-v0",
                  []() -> std::unique_ptr<Env> {
                    return std::make_unique<TimeLimit>(std::make_unique<Catch>(), 9);
+                 }},
+    // KUKA grasping from a camera: 15 steps on the training objects; the held-out test objects
+    // with the 20 steps of evaluation. An episode also ends at its grasp attempt.
+    Registration{"KukaDiverseObjectGrasping-v0",
+                 []() -> std::unique_ptr<Env> {
+                   return std::make_unique<TimeLimit>(std::make_unique<KukaDiverseObjectEnv>(), 15);
+                 }},
+    Registration{"KukaDiverseObjectGraspingTest-v0",
+                 []() -> std::unique_ptr<Env> {
+                   return std::make_unique<TimeLimit>(
+                       std::make_unique<KukaDiverseObjectEnv>(
+                           KukaDiverseObjectConfig{.is_test = true, .max_steps = 20}),
+                       20);
                  }},
 };
 

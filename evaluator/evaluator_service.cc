@@ -77,13 +77,14 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
 }
 
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
-                               double epsilon, uint64_t first_seed) {
+                               double epsilon, uint64_t first_seed,
+                               const std::function<void()>& after_episode) {
   nn::CheckpointMeta meta;
   nn::Sequential net = LoadPolicyNetwork(path, env_id, &meta);
 
   // Score.
   const double start = MonoSeconds();
-  const EvalScore score = ScorePolicy(&net, env_id, episodes, epsilon, first_seed);
+  const EvalScore score = ScorePolicy(&net, env_id, episodes, epsilon, first_seed, after_episode);
   EvalRecord r;
   r.checkpoint = FileName(path);
   r.update = meta.update;
@@ -207,8 +208,12 @@ bool EvaluatorService::ScorePending() {
   // Load and score; a refused file is logged and counted.
   EvalRecord record;
   try {
+    // Stats keep flowing during a long evaluation (KUKA: about a second per episode), so the
+    // monitor never mistakes a busy evaluator for a dead one.
     record = ScoreCheckpointFile(announced.path, config_.env_id, config_.episodes, config_.epsilon,
-                                 config_.seed_base);
+                                 config_.seed_base, [this] {
+                                   if (MonoSeconds() >= next_stats_time_) PublishStats();
+                                 });
   } catch (const std::exception& e) {
     ++refused_;
     busy_ = false;

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -61,9 +62,10 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
 /// The record's update, env_steps and wall_seconds come from the file's metadata. Throws
 /// std::runtime_error with the reason when the file is refused: it does not load (missing,
 /// truncated, corrupted, foreign), its architecture does not build, its parameters do not fit
-/// the architecture, or the network does not fit the env.
+/// the architecture, or the network does not fit the env. `after_episode` as in ScorePolicy.
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
-                               double epsilon, uint64_t first_seed);
+                               double epsilon, uint64_t first_seed,
+                               const std::function<void()>& after_episode = {});
 
 /// The service. Not thread-safe: construct it, call Poll() or Run() and read it from one thread,
 /// the thread that uses `bus`.

@@ -45,6 +45,7 @@ int Main(int argc, char** argv) {
   rl::evaluator::EvaluatorConfig config;
   std::string checkpoint;
   std::string run_config_file;
+  std::string eval_env;
   double goal = 0;
 
   rl::po::options_description desc("Options");
@@ -53,7 +54,10 @@ int Main(int argc, char** argv) {
       ("checkpoint", rl::po::value(&checkpoint),
        "standalone mode: score this checkpoint file, print one JSON object and exit")  //
       ("env", rl::po::value(&config.env_id)->default_value(config.env_id),
-       "environment the checkpoints are scored on")  //
+       "environment of the run (the checkpoints are scored on it unless --eval-env is given)")  //
+      ("eval-env", rl::po::value(&eval_env),
+       "environment the checkpoints are scored on, when it differs from the run's (e.g. "
+       "held-out objects and the longer evaluation episodes of KUKA grasping)")  //
       ("episodes", rl::po::value(&config.episodes)->default_value(config.episodes),
        "evaluation episodes per checkpoint")  //
       ("epsilon", rl::po::value(&config.epsilon)->default_value(config.epsilon, "0.05"),
@@ -81,6 +85,7 @@ int Main(int argc, char** argv) {
 
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "evaluator", kUsage, desc, &vm)) return 0;
+  if (!eval_env.empty()) config.env_id = eval_env;
 
   // Standalone mode: one file, one JSON object.
   if (!checkpoint.empty()) {

@@ -29,7 +29,8 @@ EvalScore Summarize(std::vector<double> returns) {
 }
 
 EvalScore ScoreGreedyPolicy(const GreedyPolicy& greedy, const std::string& env_id, int episodes,
-                            double epsilon, uint64_t first_seed) {
+                            double epsilon, uint64_t first_seed,
+                            const std::function<void()>& after_episode) {
   if (episodes < 1) {
     throw std::invalid_argument("episodes must be at least 1, got " + std::to_string(episodes));
   }
@@ -64,6 +65,7 @@ EvalScore ScoreGreedyPolicy(const GreedyPolicy& greedy, const std::string& env_i
       if (step.terminated || step.truncated) break;
     }
     returns.push_back(episode_return);
+    if (after_episode) after_episode();
   }
   return Summarize(std::move(returns));
 }
@@ -86,14 +88,14 @@ std::string CheckNetworkFitsEnv(int input_size, int output_size, const envs::Env
 }
 
 EvalScore ScorePolicy(nn::Sequential* net, const std::string& env_id, int episodes, double epsilon,
-                      uint64_t first_seed) {
+                      uint64_t first_seed, const std::function<void()>& after_episode) {
   const std::string why =
       CheckNetworkFitsEnv(net->InputSize(), net->OutputSize(), envs::MakeEnv(env_id)->spec());
   if (!why.empty()) throw std::invalid_argument(why);
   const GreedyPolicy greedy = [net](std::span<const float> obs) {
     return net->Argmax(obs.data(), static_cast<int>(obs.size()));
   };
-  return ScoreGreedyPolicy(greedy, env_id, episodes, epsilon, first_seed);
+  return ScoreGreedyPolicy(greedy, env_id, episodes, epsilon, first_seed, after_episode);
 }
 
 }  // namespace rl::evaluator

@@ -45,8 +45,11 @@ using GreedyPolicy = std::function<int(std::span<const float> observation)>;
 /// std::mt19937_64 seeded with first_seed, so the same arguments give the same score.
 /// Throws std::invalid_argument for episodes < 1, epsilon outside [0, 1], an unknown env id or
 /// a greedy action outside the env's action range.
+/// `after_episode`, when set, is called after every episode (the evaluator publishes its stats
+/// from there, so that a long evaluation does not look like a silent process).
 EvalScore ScoreGreedyPolicy(const GreedyPolicy& greedy, const std::string& env_id, int episodes,
-                            double epsilon, uint64_t first_seed = kDefaultEvalSeedBase);
+                            double epsilon, uint64_t first_seed = kDefaultEvalSeedBase,
+                            const std::function<void()>& after_episode = {});
 
 /// ScoreGreedyPolicy with the network's argmax as the greedy action. Throws
 /// std::invalid_argument when the network's input or output size does not match the env's
@@ -54,7 +57,8 @@ EvalScore ScoreGreedyPolicy(const GreedyPolicy& greedy, const std::string& env_i
 /// changed.
 EvalScore ScorePolicy(nn::Sequential* net, const std::string& env_id, int episodes,
                       double epsilon = kDefaultEvalEpsilon,
-                      uint64_t first_seed = kDefaultEvalSeedBase);
+                      uint64_t first_seed = kDefaultEvalSeedBase,
+                      const std::function<void()>& after_episode = {});
 
 /// Empty when a network with these input and output sizes fits the env (input size =
 /// observation size, output size = number of actions), else a sentence saying what differs.

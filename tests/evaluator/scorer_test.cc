@@ -93,6 +93,23 @@ TEST(ScorerTest, RunsTheRequestedNumberOfEpisodes) {
   }
 }
 
+TEST(ScorerTest, CallsTheEpisodeHookOnceAfterEveryEpisode) {
+  int calls = 0;
+  int steps_at_last_call = -1;
+  int steps = 0;
+  const GreedyPolicy count_steps = [&steps](std::span<const float>) {
+    ++steps;
+    return 0;
+  };
+  ScoreGreedyPolicy(count_steps, "CartPole-v1", 4, 0.0, 1000, [&] {
+    ++calls;
+    EXPECT_GT(steps, steps_at_last_call);  // an episode was played since the last call
+    steps_at_last_call = steps;
+  });
+  EXPECT_EQ(calls, 4);
+  EXPECT_EQ(steps_at_last_call, steps);
+}
+
 TEST(ScorerTest, EpsilonOneNeverAsksThePolicyAndEpsilonZeroAlwaysDoes) {
   int calls = 0;
   const GreedyPolicy counting = [&calls](std::span<const float>) {

@@ -1,0 +1,148 @@
+// kuka_probe: measures KukaDiverseObjectEnv: physics steps/s, rendered frames/s, env steps/s
+// with rendering, and the grasp success rates of the scripted oracle and of a random policy.
+// Rates are given per second of this process's CPU time (what one actor gets from one free core)
+// and per wall-clock second (lower on a busy machine).
+//
+//   kuka_probe [--episodes N] [--test] [--seed S] [--iterations I] [--reference-physics]
+//              [--no-render] [--frames F]
+//
+// --test draws held-out objects with 20 steps an episode (evaluation); --reference-physics uses
+// the reference's 150 solver iterations and compliant fingertips.
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "envs/kuka/kuka_diverse_object_env.h"
+#include "envs/kuka/kuka_oracle.h"
+#include "envs/rng.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+
+// CPU time of this process, seconds.
+double CpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+struct Rates {
+  int episodes = 0;
+  int successes = 0;
+  int64_t env_steps = 0;
+  int64_t physics_steps = 0;
+  double seconds = 0;
+  double cpu_seconds = 0;
+};
+
+// Runs `episodes` episodes with the oracle (or uniformly random actions), rendering every
+// observation at the native size when `render` is set.
+Rates Run(rl::envs::KukaDiverseObjectEnv& env, int episodes, uint64_t seed, bool oracle,
+          bool render) {
+  Rates r;
+  std::mt19937_64 rng(seed);
+  std::vector<uint8_t> rgb;
+  int w = 0, h = 0;
+  const auto start = Clock::now();
+  const double cpu_start = CpuSeconds();
+  for (int e = 0; e < episodes; ++e) {
+    env.Reset(seed + e);
+    if (render) env.Render(&rgb, &w, &h);
+    bool done = false;
+    double reward = 0;
+    while (!done) {
+      const int action = oracle ? rl::envs::kuka::OracleAction(env)
+                                : static_cast<int>(rl::envs::UniformInt(rng, 0, 7));
+      const rl::envs::StepResult s = env.Step(action);
+      if (render) env.Render(&rgb, &w, &h);
+      reward += s.reward;
+      done = s.terminated || s.truncated;
+      ++r.env_steps;
+    }
+    r.physics_steps += env.physics_steps();
+    r.successes += reward > 0 ? 1 : 0;
+    ++r.episodes;
+  }
+  r.seconds = Seconds(start, Clock::now());
+  r.cpu_seconds = CpuSeconds() - cpu_start;
+  return r;
+}
+
+void Print(const char* name, const Rates& r) {
+  std::printf(
+      "%-7s episodes %d  success %.3f  steps/episode %.2f  physics steps/episode %.0f\n"
+      "        per CPU second: env steps %.1f  physics steps %.0f  (per wall second: %.1f, %.0f)\n",
+      name, r.episodes, static_cast<double>(r.successes) / r.episodes,
+      static_cast<double>(r.env_steps) / r.episodes,
+      static_cast<double>(r.physics_steps) / r.episodes, r.env_steps / r.cpu_seconds,
+      r.physics_steps / r.cpu_seconds, r.env_steps / r.seconds, r.physics_steps / r.seconds);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int episodes = 20;
+  int frames = 500;
+  uint64_t seed = 1;
+  bool render = true;
+  rl::envs::KukaDiverseObjectConfig config;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--episodes" && i + 1 < argc) {
+      episodes = std::atoi(argv[++i]);
+    } else if (arg == "--frames" && i + 1 < argc) {
+      frames = std::atoi(argv[++i]);
+    } else if (arg == "--seed" && i + 1 < argc) {
+      seed = std::strtoull(argv[++i], nullptr, 10);
+    } else if (arg == "--test") {
+      config.is_test = true;
+      config.max_steps = 20;
+    } else if (arg == "--iterations" && i + 1 < argc) {
+      config.solver_iterations = std::atoi(argv[++i]);
+    } else if (arg == "--reference-physics") {
+      config.solver_iterations = 150;
+      config.rigid_fingertips = false;
+    } else if (arg == "--no-render") {
+      render = false;
+    } else {
+      std::fprintf(stderr,
+                   "usage: kuka_probe [--episodes N] [--test] [--seed S] [--iterations I] "
+                   "[--reference-physics] [--no-render] [--frames F]\n");
+      return 2;
+    }
+  }
+  rl::envs::KukaDiverseObjectEnv env(config);
+
+  // Rendering alone at the native size.
+  env.Reset(seed);
+  std::vector<uint8_t> rgb;
+  int w = 0, h = 0;
+  env.Render(&rgb, &w, &h);
+  double c0 = CpuSeconds();
+  for (int i = 0; i < frames; ++i) env.Render(&rgb, &w, &h);
+  std::printf("render  %dx%d frames per CPU second %.0f (LP_NUM_THREADS=%s)\n", w, h,
+              frames / (CpuSeconds() - c0), std::getenv("LP_NUM_THREADS"));
+
+  // Physics alone: the arm moving over resting (sleeping) objects.
+  c0 = CpuSeconds();
+  const int64_t before = env.physics_steps();
+  env.Step(0);
+  env.Step(0);
+  std::printf("physics (arm moving, objects asleep) steps per CPU second %.0f\n",
+              (env.physics_steps() - before) / (CpuSeconds() - c0));
+
+  Print("oracle", Run(env, episodes, seed, true, render));
+  Print("random", Run(env, episodes, seed + 1000000, false, render));
+  return 0;
+}
