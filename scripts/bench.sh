@@ -9,7 +9,8 @@
 #              PEER_REPEATS (3), PEER_DQN (1: also time the peer's full CartPole DQN run),
 #              CNN_REPEATS (REPEATS) and CNN_SECONDS (SECONDS_PER) for bench_cnn, CNN_THREADS
 #              ("1,2": the thread counts of bench_cnn and of the peer's CNN modes), PEER_CNN (1:
-#              run the peer's nature, small and latency modes; 0: skip them).
+#              run the peer's nature, small and latency modes; 0: skip them), KUKA_EPISODES
+#              (20: episodes of each policy in kuka_probe).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -50,6 +51,9 @@ isolated "$bin/bench_replay" "$repeats" "$seconds" >> "$ours"
 # Pixel networks (Nature and grasp CNN): updates/s, latency, convolution GFLOP/s, the FMA peak.
 cnn_threads=${CNN_THREADS:-1,2}
 "$bin/bench_cnn" "${CNN_REPEATS:-$repeats}" "${CNN_SECONDS:-$seconds}" "$cnn_threads" >> "$ours"
+# KUKA grasping (Bullet, OSMesa at 48x48, one llvmpipe thread): rendered frames/s, physics and
+# env steps/s and episodes per hour of one actor (per CPU second), oracle and random success.
+"$bin/kuka_probe" --json --episodes "${KUKA_EPISODES:-20}" >> "$ours"
 
 # Time from launch to goal for CartPole, start-up and evaluation included.
 if [ "$skip_goal" -eq 0 ]; then

@@ -4,7 +4,10 @@
 // and per wall-clock second (lower on a busy machine).
 //
 //   kuka_probe [--episodes N] [--test] [--seed S] [--iterations I] [--reference-physics]
-//              [--no-render] [--frames F]
+//              [--no-render] [--frames F] [--json]
+//
+// --json prints the figures as JSON lines in the format of the bench/ programs (one measurement
+// each, no repeats), which is how scripts/bench.sh reports them.
 //
 // --test draws held-out objects with 20 steps an episode (evaluation); --reference-physics uses
 // the reference's 150 solver iterations and compliant fingertips.
@@ -89,6 +92,31 @@ void Print(const char* name, const Rates& r) {
       r.physics_steps / r.cpu_seconds, r.env_steps / r.seconds, r.physics_steps / r.seconds);
 }
 
+// The Rates of one policy as JSON lines: env steps/s, physics steps/s and episodes per hour per
+// CPU second of one actor, and the success rate.
+void PrintJson(const char* policy, const Rates& r, bool test) {
+  const char* objects = test ? "held-out" : "training";
+  std::printf(
+      "{\"bench\": \"kuka_env_steps\", \"value\": %.2f, \"unit\": \"steps/s\", \"policy\": \"%s\", "
+      "\"per\": \"cpu second of one actor\", \"wall_value\": %.2f, \"render\": \"48x48 every "
+      "step\", "
+      "\"objects\": \"%s\", \"episodes\": %d}\n",
+      r.env_steps / r.cpu_seconds, policy, r.env_steps / r.seconds, objects, r.episodes);
+  std::printf(
+      "{\"bench\": \"kuka_physics_steps\", \"value\": %.0f, \"unit\": \"steps/s\", \"policy\": "
+      "\"%s\", \"per\": \"cpu second\", \"wall_value\": %.0f}\n",
+      r.physics_steps / r.cpu_seconds, policy, r.physics_steps / r.seconds);
+  std::printf(
+      "{\"bench\": \"kuka_episodes_per_hour_per_actor\", \"value\": %.0f, \"unit\": "
+      "\"episodes/h\", "
+      "\"policy\": \"%s\", \"steps_per_episode\": %.2f}\n",
+      3600.0 * r.episodes / r.cpu_seconds, policy, static_cast<double>(r.env_steps) / r.episodes);
+  std::printf(
+      "{\"bench\": \"kuka_grasp_success\", \"value\": %.3f, \"unit\": \"fraction\", \"policy\": "
+      "\"%s\", \"objects\": \"%s\", \"episodes\": %d}\n",
+      static_cast<double>(r.successes) / r.episodes, policy, objects, r.episodes);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -96,6 +124,7 @@ int main(int argc, char** argv) {
   int frames = 500;
   uint64_t seed = 1;
   bool render = true;
+  bool json = false;
   rl::envs::KukaDiverseObjectConfig config;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -115,10 +144,12 @@ int main(int argc, char** argv) {
       config.rigid_fingertips = false;
     } else if (arg == "--no-render") {
       render = false;
+    } else if (arg == "--json") {
+      json = true;
     } else {
       std::fprintf(stderr,
                    "usage: kuka_probe [--episodes N] [--test] [--seed S] [--iterations I] "
-                   "[--reference-physics] [--no-render] [--frames F]\n");
+                   "[--reference-physics] [--no-render] [--frames F] [--json]\n");
       return 2;
     }
   }
@@ -131,18 +162,35 @@ int main(int argc, char** argv) {
   env.Render(&rgb, &w, &h);
   double c0 = CpuSeconds();
   for (int i = 0; i < frames; ++i) env.Render(&rgb, &w, &h);
-  std::printf("render  %dx%d frames per CPU second %.0f (LP_NUM_THREADS=%s)\n", w, h,
-              frames / (CpuSeconds() - c0), std::getenv("LP_NUM_THREADS"));
+  const double fps = frames / (CpuSeconds() - c0);
+  const char* lp_threads = std::getenv("LP_NUM_THREADS");
+  if (json) {
+    std::printf(
+        "{\"bench\": \"kuka_render_frames\", \"value\": %.0f, \"unit\": \"frames/s\", \"size\": "
+        "\"%dx%d\", \"per\": \"cpu second\", \"llvmpipe_threads\": \"%s\"}\n",
+        fps, w, h, lp_threads != nullptr ? lp_threads : "default");
+  } else {
+    std::printf("render  %dx%d frames per CPU second %.0f (LP_NUM_THREADS=%s)\n", w, h, fps,
+                lp_threads);
+  }
 
   // Physics alone: the arm moving over resting (sleeping) objects.
   c0 = CpuSeconds();
   const int64_t before = env.physics_steps();
   env.Step(0);
   env.Step(0);
-  std::printf("physics (arm moving, objects asleep) steps per CPU second %.0f\n",
-              (env.physics_steps() - before) / (CpuSeconds() - c0));
+  const double physics = (env.physics_steps() - before) / (CpuSeconds() - c0);
+  if (!json)
+    std::printf("physics (arm moving, objects asleep) steps per CPU second %.0f\n", physics);
 
-  Print("oracle", Run(env, episodes, seed, true, render));
-  Print("random", Run(env, episodes, seed + 1000000, false, render));
+  const Rates oracle = Run(env, episodes, seed, true, render);
+  const Rates random = Run(env, episodes, seed + 1000000, false, render);
+  if (json) {
+    PrintJson("oracle", oracle, config.is_test);
+    PrintJson("random", random, config.is_test);
+  } else {
+    Print("oracle", oracle);
+    Print("random", random);
+  }
   return 0;
 }
