@@ -207,13 +207,23 @@ bool EvaluatorService::ScorePending() {
 
   // Load and score; a refused file is logged and counted.
   EvalRecord record;
+  // Thrown between episodes when a stop was requested: an unfinished evaluation is dropped.
+  struct Stopped {};
   try {
     // Stats keep flowing during a long evaluation (KUKA: about a second per episode), so the
-    // monitor never mistakes a busy evaluator for a dead one.
+    // monitor never mistakes a busy evaluator for a dead one, and a stop request is honoured
+    // after the current episode.
     record = ScoreCheckpointFile(announced.path, config_.env_id, config_.episodes, config_.epsilon,
                                  config_.seed_base, [this] {
+                                   if (StopRequested()) throw Stopped{};
                                    if (MonoSeconds() >= next_stats_time_) PublishStats();
                                  });
+  } catch (const Stopped&) {
+    busy_ = false;
+    std::printf("evaluator: stopped during an evaluation; %s is left unscored\n",
+                announced.path.c_str());
+    std::fflush(stdout);
+    return false;
   } catch (const std::exception& e) {
     ++refused_;
     busy_ = false;
