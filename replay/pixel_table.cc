@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "common/check.h"
+#include "replay/priorities.h"
 #include "replay/uniform_sampler.h"
 
 namespace rl::replay {
@@ -293,20 +294,7 @@ bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const PixelSampleS
 
 int64_t PixelTable::UpdatePriorities(std::span<const int64_t> index,
                                      std::span<const float> priority) {
-  RL_CHECK(index.size() == priority.size()) << "index and priority must have the same size, got "
-                                            << index.size() << " and " << priority.size();
-  int64_t applied = 0;
-  for (size_t i = 0; i < index.size(); ++i) {
-    // The slot must still hold that very transition: not overwritten, not dropped as stale.
-    const int64_t number = index[i];
-    if (number < 0 || number >= total_inserts_) continue;
-    const int64_t slot = number % options_.capacity;
-    if (insert_number_[static_cast<size_t>(slot)] != number) continue;
-    if (!std::isfinite(priority[i]) || priority[i] < 0.0f) continue;
-    sampler_->Update(slot, priority[i]);
-    ++applied;
-  }
-  return applied;
+  return ApplyPriorities(index, priority, insert_number_, total_inserts_, sampler_.get());
 }
 
 void PixelTable::set_importance_exponent(double beta) {

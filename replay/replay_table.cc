@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "common/check.h"
+#include "replay/priorities.h"
 #include "replay/uniform_sampler.h"
 
 namespace rl::replay {
@@ -159,21 +160,7 @@ void ReplayTable::set_importance_exponent(double beta) {
 
 int64_t ReplayTable::UpdatePriorities(std::span<const int64_t> index,
                                       std::span<const float> priority) {
-  RL_CHECK(index.size() == priority.size()) << "index and priority must have the same size, got "
-                                            << index.size() << " and " << priority.size();
-  int64_t applied = 0;
-  for (size_t i = 0; i < index.size(); ++i) {
-    // The slot must still hold that very transition: this rules out overwritten ones (the slot
-    // holds a later insert) and ones never inserted.
-    const int64_t number = index[i];
-    if (number < 0 || number >= total_inserts_) continue;
-    const int64_t slot = number % options_.capacity;
-    if (insert_number_[static_cast<size_t>(slot)] != number) continue;
-    if (!std::isfinite(priority[i]) || priority[i] < 0.0f) continue;
-    sampler_->Update(slot, priority[i]);
-    ++applied;
-  }
-  return applied;
+  return ApplyPriorities(index, priority, insert_number_, total_inserts_, sampler_.get());
 }
 
 int64_t ReplayTable::memory_bytes() const {
