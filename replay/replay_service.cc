@@ -346,7 +346,7 @@ void ReplayService::PublishStats(double now) {
   stats_.samples_per_second = stats_sample_rate_.Take(total_samples(), now);
   stats_.prioritized = options_.prioritized ? 1 : 0;
   stats_.beta = beta();
-  stats_.memory_bytes = table_.memory_bytes() + (pixels_ ? pixels_->memory_bytes() : 0);
+  stats_.memory_bytes = memory_bytes();
   stats_.frames = pixels_ ? std::min(pixels_->total_frames(), pixels_->frame_capacity()) : 0;
   stats_.priorities_applied = counters_.priorities_applied;
   stats_.priorities_stale = counters_.priorities_stale;
@@ -374,8 +374,7 @@ void ReplayService::PrintProgress(double now) {
       insert_allowed_ ? 1 : 0, pending_requests(),
       static_cast<long long>(bus.malformed + bus.foreign + bus.invalid + counters_.batches_refused +
                              counters_.requests_refused + counters_.requests_dropped),
-      static_cast<long long>(bus.lost),
-      static_cast<double>(table_.memory_bytes() + (pixels_ ? pixels_->memory_bytes() : 0)) / 1e6);
+      static_cast<long long>(bus.lost), static_cast<double>(memory_bytes()) / 1e6);
   if (options_.prioritized) {
     std::printf(" beta %.3f priorities %lld stale %lld", beta(),
                 static_cast<long long>(counters_.priorities_applied),

@@ -134,6 +134,10 @@ class ReplayService {
   int64_t total_samples() const {
     return pixels_ ? pixels_->total_samples() : table_.total_samples();
   }
+  /// Bytes held by both tables and their samplers (the flat table holds little in a pixel run).
+  int64_t memory_bytes() const {
+    return table_.memory_bytes() + (pixels_ ? pixels_->memory_bytes() : 0);
+  }
   /// Importance-sampling exponent for the next batch (1 when sampling is uniform).
   double beta() const;
   const RateLimiter& limiter() const { return limiter_; }
