@@ -1,5 +1,6 @@
 #include "evaluator/evaluator_service.h"
 
+#include "evaluator/frame_grid.h"
 #include "evaluator/video.h"
 
 #include <algorithm>
@@ -105,6 +106,7 @@ EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* 
   // The goal defaults to the env's reward threshold (MakeEnv throws for an unknown id).
   const envs::EnvSpec spec = envs::MakeEnv(config_.env_id)->spec();
   goal_ = std::isnan(config_.goal) ? spec.reward_threshold : config_.goal;
+  has_frames_ = spec.frame_height > 0;
   char epsilon[32];
   std::snprintf(epsilon, sizeof(epsilon), "%g", config_.epsilon);
   const uint64_t last_seed = config_.seed_base + static_cast<uint64_t>(config_.episodes) - 1;
@@ -297,6 +299,25 @@ void EvaluatorService::RecordVideo(const std::string& path, const EvalRecord& re
     std::fprintf(stderr, "evaluator: no video: %s\n", e.what());
     std::fflush(stderr);
   }
+  if (!has_frames_) return;
+  try {
+    nn::Sequential net = LoadPolicyNetwork(path, config_.env_id);
+    const FrameGridResult g = WriteFrameGrid(
+        &net, config_.env_id, config_.seed_base, kFrameGridEpisodes, kFrameGridColumns,
+        (std::filesystem::path(report_dir_) / kFrameGrid).string());
+    char caption[384];
+    std::snprintf(caption, sizeof(caption),
+                  "%d greedy episodes (epsilon 0, seeds %llu to %llu) of %s (update %lld), one row "
+                  "each: the camera image as rendered (left) and the frame the network receives "
+                  "(right) after reset and after every step; mean return %.2f.",
+                  g.episodes, static_cast<unsigned long long>(config_.seed_base),
+                  static_cast<unsigned long long>(config_.seed_base + g.episodes - 1),
+                  record.checkpoint.c_str(), static_cast<long long>(record.update), g.mean_return);
+    frames_caption_ = caption;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "evaluator: no frame grid: %s\n", e.what());
+    std::fflush(stderr);
+  }
 }
 
 void EvaluatorService::WriteReportNow() {
@@ -309,6 +330,10 @@ void EvaluatorService::WriteReportNow() {
   if (!video_caption_.empty()) {
     info.video_file = kBestVideo;
     info.video_caption = video_caption_;
+  }
+  if (!frames_caption_.empty()) {
+    info.frames_file = kFrameGrid;
+    info.frames_caption = frames_caption_;
   }
   info.run_config = config_.run_config_text;
   info.eval_settings = eval_settings_;

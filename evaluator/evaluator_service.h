@@ -44,7 +44,8 @@ struct EvaluatorConfig {
   std::string run_config_text;        // shown in the report
   std::string run_name;               // shown in the report's title; empty: out_dir's folder name
   double stats_period_seconds = 0.3;  // stats_evaluator_t period (about 3 Hz)
-  bool videos = false;    // record a greedy episode of every new best checkpoint (report/)
+  bool videos = false;    // record a greedy episode of every new best checkpoint (report/), and
+                          // for pixel envs a grid of its camera frames
   int video_width = 360;  // video frame size in pixels
   int video_height = 240;
   double video_fps = 30;  // frames per second of the videos
@@ -140,7 +141,9 @@ class EvaluatorService {
   int64_t skipped_ = 0;
   int64_t refused_ = 0;
   double best_video_mean_ = -std::numeric_limits<double>::infinity();
-  std::string video_caption_;  // empty until a video was recorded
+  std::string video_caption_;   // empty until a video was recorded
+  bool has_frames_ = false;     // a pixel env: the report gets a grid of camera frames
+  std::string frames_caption_;  // empty until a frame grid was written
   int64_t duplicates_ = 0;
   double last_mean_ = 0;
   bool busy_ = false;

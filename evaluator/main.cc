@@ -11,6 +11,7 @@
 #include "common/options.h"
 #include "common/shutdown.h"
 #include "evaluator/evaluator_service.h"
+#include "evaluator/frame_grid.h"
 #include "evaluator/report.h"
 
 namespace {
@@ -25,8 +26,10 @@ constexpr char kUsage[] =
     "      SIGTERM, or with --stop-at-goal once a checkpoint reaches the goal, and then prints\n"
     "      'evaluator: goal reached' or 'evaluator: goal not reached (best X)'; exit status 0.\n"
     "  evaluator --checkpoint FILE [--env ID] [--episodes N] [--epsilon E] [--seed-base S]\n"
+    "            [--frames PNG]\n"
     "      Standalone mode: scores one checkpoint file and prints one JSON object (checkpoint,\n"
     "      update, env_steps, wall_seconds, mean, std, min, max, episodes, eval_seconds).\n"
+    "      --frames also writes the grid of camera frames the report shows (pixel envs).\n"
     "      A refused file prints 'evaluator: error: <reason>' and exits with status 2.\n"
     "\n"
     "Episode i of an evaluation is reset with seed seed-base + i; the default seed base is far\n"
@@ -46,6 +49,7 @@ int Main(int argc, char** argv) {
   std::string checkpoint;
   std::string run_config_file;
   std::string eval_env;
+  std::string frames_file;
   double goal = 0;
 
   rl::po::options_description desc("Options");
@@ -80,6 +84,9 @@ int Main(int argc, char** argv) {
        "video frame height in pixels")  //
       ("video-fps", rl::po::value(&config.video_fps)->default_value(config.video_fps),
        "video frames per second")  //
+      ("frames", rl::po::value(&frames_file),
+       "standalone mode, pixel envs: also write a grid of camera frames and network inputs of "
+       "greedy episodes to this PNG file")  //
       ("run-config", rl::po::value(&run_config_file),
        "text file shown in the report as the run's config (default: the --config file)");
 
@@ -94,6 +101,12 @@ int Main(int argc, char** argv) {
         checkpoint, config.env_id, config.episodes, config.epsilon, config.seed_base);
     record.checkpoint = checkpoint;
     std::cout << rl::evaluator::ToJson(record) << std::endl;
+    if (!frames_file.empty()) {
+      rl::nn::Sequential net = rl::evaluator::LoadPolicyNetwork(checkpoint, config.env_id);
+      rl::evaluator::WriteFrameGrid(&net, config.env_id, config.seed_base,
+                                    rl::evaluator::kFrameGridEpisodes,
+                                    rl::evaluator::kFrameGridColumns, frames_file);
+    }
     return 0;
   }
 

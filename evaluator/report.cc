@@ -366,6 +366,14 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
          HtmlEscape(info.video_caption) + "</figcaption></figure>\n</section>\n";
   }
 
+  // What the network sees.
+  if (!info.frames_file.empty()) {
+    h += "<section>\n<h2>Camera frames</h2>\n<figure><img src=\"" + HtmlEscape(info.frames_file) +
+         "\" alt=\"a grid of camera frames and network inputs, one row per greedy "
+         "episode\"><figcaption>" +
+         HtmlEscape(info.frames_caption) + "</figcaption></figure>\n</section>\n";
+  }
+
   // Table of every checkpoint, newest first.
   h += "<section>\n<h2>Checkpoints</h2>\n";
   if (records.empty()) {

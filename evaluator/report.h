@@ -56,6 +56,8 @@ struct ReportInfo {
   int64_t checkpoints_refused = 0;  // files that failed to load or did not fit the env
   std::string video_file;           // a video in the report folder to show (empty: none)
   std::string video_caption;        // what the video shows
+  std::string frames_file;          // a grid of camera frames (PNG) in the report folder, or empty
+  std::string frames_caption;       // what the grid shows
 };
 
 /// Names of the files WriteReport writes into `dir`.
@@ -63,6 +65,10 @@ inline constexpr char kReportIndex[] = "index.html";
 inline constexpr char kCurveEnvSteps[] = "curve_env_steps.svg";
 inline constexpr char kCurveWallTime[] = "curve_wall_time.svg";
 inline constexpr char kBestVideo[] = "best.webm";
+inline constexpr char kFrameGrid[] = "frames.png";
+/// Greedy episodes (rows) and cells per row of the frame grid of a pixel env's report.
+inline constexpr int kFrameGridEpisodes = 4;
+inline constexpr int kFrameGridColumns = 8;
 
 /// Writes dir/index.html, dir/curve_env_steps.svg and dir/curve_wall_time.svg (creating dir if
 /// needed). Each file is written to a temporary file in dir, synced and renamed over the old

@@ -10,7 +10,9 @@
 #              CNN_REPEATS (REPEATS) and CNN_SECONDS (SECONDS_PER) for bench_cnn, CNN_THREADS
 #              ("1,2": the thread counts of bench_cnn and of the peer's CNN modes), PEER_CNN (1:
 #              run the peer's nature, small and latency modes; 0: skip them), KUKA_EPISODES
-#              (20: episodes of each policy in kuka_probe).
+#              (20: episodes of each policy in kuka_probe), KUKA_PIPELINE_SECONDS (300: length of
+#              the kuka_grasp launch that measures the whole pipeline's episodes per hour; 0 or
+#              --skip-goal: skip it).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -88,6 +90,30 @@ if [ "$skip_goal" -eq 0 ]; then
       "$work/lunar-$seed/eval.jsonl" 2>/dev/null)
     echo "{\"bench\": \"lunar_lander_time_to_200\", \"value\": $(awk -v a="$start" -v b="$end" 'BEGIN{printf "%.1f", b - a}'), \"unit\": \"s\", \"seed\": $seed, \"solved\": $ok, \"env_steps\": ${steps:-null}, \"actors\": ${n_actors:-null}}" >> "$ours"
   done
+fi
+
+# KUKA grasping, the whole pipeline (actors, replay, learner, evaluator on held-out objects) for
+# KUKA_PIPELINE_SECONDS: episodes per hour and env steps/s after the first minute (start-up,
+# replay warm-up), from the monitor's progress lines.
+kuka_seconds=${KUKA_PIPELINE_SECONDS:-300}
+if [ "$skip_goal" -eq 0 ] && [ "$kuka_seconds" -gt 90 ]; then
+  echo "bench: launch kuka_grasp for $kuka_seconds s" >&2
+  isolated "$root/scripts/launch.sh" kuka_grasp --no-setup --build-dir "$build_dir" --seed 1 \
+    --time-budget "$kuka_seconds" --out "$work/kuka" > "$work/kuka.log" 2>&1 || true
+  n_actors=$(sed -n 's/^# actors = \([0-9]*\).*/\1/p' "$work/kuka/config.ini" 2>/dev/null)
+  # Progress lines: "[  499.6s] steps 16,049  episodes 2,221  ...".
+  tr -d ',' < "$work/kuka/logs/monitor.log" | awk -v actors="${n_actors:-null}" '
+    /^\[ *[0-9.]+s\] steps [0-9]+ +episodes [0-9]+/ {
+      t = $0; sub(/^\[ */, "", t); sub(/s\].*/, "", t)
+      match($0, /steps [0-9]+/); s = substr($0, RSTART + 6, RLENGTH - 6)
+      match($0, /episodes [0-9]+/); e = substr($0, RSTART + 9, RLENGTH - 9)
+      if (t + 0 >= 60 && t0 == "") { t0 = t; s0 = s; e0 = e }
+      t1 = t; s1 = s; e1 = e
+    }
+    END {
+      if (t0 == "" || t1 - t0 < 10) { print "bench.sh: kuka_grasp ran too briefly to measure" > "/dev/stderr"; exit }
+      printf "{\"bench\": \"kuka_pipeline_episodes_per_hour\", \"value\": %.0f, \"unit\": \"episodes/h\", \"env_steps_per_s\": %.1f, \"seconds\": %.0f, \"actors\": %s, \"note\": \"whole pipeline on this machine, learner and evaluator included, after the first minute\"}\n", (e1 - e0) * 3600 / (t1 - t0), (s1 - s0) / (t1 - t0), t1 - t0, actors
+    }' >> "$ours"
 fi
 
 # The PyTorch peer, in the same run.

@@ -132,6 +132,24 @@ std::vector<Points> RandomHull(std::mt19937_64& rng) {
   return {p};
 }
 
+// A colour whose luma is within kMinLumaContrastWithTray of the tray's becomes darker (by scaling)
+// when `side` < 0.5, else lighter (by mixing with white), to a luma `depth` (in [0, 1]) of the way
+// into the band of 0.15 beyond the contrast limit. Both draws are made for every object, so the
+// random stream (and the shapes of later ids' draws) does not depend on the branch taken.
+void KeepLumaAwayFromTray(double side, double depth, std::array<float, 3>* rgb) {
+  const double tray = Luma(kTrayColor);
+  const double y = Luma(*rgb);
+  if (std::abs(y - tray) >= kMinLumaContrastWithTray) return;
+  if (side < 0.5) {
+    const double target = std::max(0.05, tray - kMinLumaContrastWithTray - 0.15 * depth);
+    for (float& c : *rgb) c = static_cast<float>(c * target / y);
+  } else {
+    const double target = std::min(0.97, tray + kMinLumaContrastWithTray + 0.15 * depth);
+    const double t = (target - y) / (1 - y);
+    for (float& c : *rgb) c = static_cast<float>(c + t * (1 - c));
+  }
+}
+
 // An RGB colour from hue, saturation and value in [0, 1].
 std::array<float, 3> HsvToRgb(double h, double s, double v) {
   const double c = v * s;
@@ -217,6 +235,7 @@ ObjectShape GenerateObject(int id) {
   shape.mass = UniformDouble(rng, 0.05, 0.2);
   shape.color = HsvToRgb(UniformDouble(rng, 0, 1), UniformDouble(rng, 0.5, 1.0),
                          UniformDouble(rng, 0.55, 1.0));
+  KeepLumaAwayFromTray(UniformDouble(rng, 0, 1), UniformDouble(rng, 0, 1), &shape.color);
   return shape;
 }
 

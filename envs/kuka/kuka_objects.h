@@ -7,7 +7,9 @@
 // lumps in a chain (like the reference's objects), irregular boxes, prisms (5..10 sides),
 // L/T shapes of two or three bars, and single random convex hulls. Sizes: longest dimension about
 // 5..15 cm, smallest at least 2.4 cm. Mass uniform in [0.05, 0.2] kg (the reference uses 0.1 for
-// all); lateral friction 1.0 as in the reference URDFs; a random saturated colour.
+// all); lateral friction 1.0 as in the reference URDFs; a random saturated colour whose luma
+// (Rec. 601, as in a grayscale conversion) differs from the tray's by at least
+// kMinLumaContrastWithTray, so that every object stays visible in grayscale camera frames.
 #pragma once
 
 #include <array>
@@ -18,6 +20,17 @@
 #include "envs/kuka/kuka_geometry.h"
 
 namespace rl::envs::kuka {
+
+/// The tray's colour (RGB in [0, 1]; drawn by the scene) and the least luma difference between an
+/// object's colour and it. Without it about a third of the objects (greens, cyans, light reds) were
+/// nearly invisible on the tray in the grayscale frames a DQN receives.
+inline constexpr std::array<float, 3> kTrayColor = {0.55f, 0.57f, 0.62f};
+inline constexpr double kMinLumaContrastWithTray = 0.25;
+
+/// Rec. 601 luma of an RGB colour in [0, 1] (the weights of OpenCV's RGB-to-gray conversion).
+inline double Luma(const std::array<float, 3>& rgb) {
+  return 0.299 * rgb[0] + 0.587 * rgb[1] + 0.114 * rgb[2];
+}
 
 /// Number of object ids; valid ids are 0 .. kNumObjectIds - 1.
 inline constexpr int kNumObjectIds = 1000;

@@ -39,7 +39,6 @@ constexpr double kResetMotorForce = 200;
 // Drawing colours (approximations of the textures of the reference).
 constexpr std::array<float, 3> kPlaneColor = {0.45f, 0.45f, 0.45f};
 constexpr std::array<float, 3> kTableColor = {0.72f, 0.58f, 0.42f};
-constexpr std::array<float, 3> kTrayColor = {0.55f, 0.57f, 0.62f};
 
 btVector3 ToBt(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 Eigen::Vector3d ToEigen(const btVector3& v) { return {v.x(), v.y(), v.z()}; }

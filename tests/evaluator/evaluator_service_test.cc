@@ -154,11 +154,40 @@ TEST_F(EvaluatorServiceTest, RecordsAVideoOfEachNewBestCheckpointAndShowsItInThe
   const std::string html = ReadFile(service.report_dir() + "/index.html");
   EXPECT_NE(html.find("<video src=\"best.webm\""), std::string::npos);
   EXPECT_NE(html.find("ckpt_100.bin (update 100"), std::string::npos);
+  // CartPole has no camera frames: no frame grid.
+  EXPECT_FALSE(std::filesystem::exists(service.report_dir() + "/frames.png"));
+  EXPECT_EQ(html.find("frames.png"), std::string::npos);
   // The same policy scores the same: no new best, so the video stays that of update 100.
   Announce(WriteCheckpoint(200), 200);
   ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 2; }));
   EXPECT_NE(ReadFile(service.report_dir() + "/index.html").find("ckpt_100.bin (update 100"),
             std::string::npos);
+}
+
+TEST_F(EvaluatorServiceTest, ShowsAGridOfCameraFramesForAPixelEnv) {
+  EvaluatorConfig c = Config();
+  c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2)";
+  c.videos = true;
+  c.video_width = 64;
+  c.video_height = 64;
+  std::mt19937 rng(5);
+  nn::Sequential net = nn::MakeMlp(2 * 10 * 5, {8}, 3, &rng);
+  nn::Checkpoint ckpt;
+  ckpt.architecture = net.Architecture();
+  net.GetFlat(&ckpt.params);
+  ckpt.meta.update = 50;
+  ckpt.meta.run_id = 77;
+  const std::string path = dir_ / "ckpt_50.bin";
+  nn::SaveCheckpoint(path, ckpt);
+  EvaluatorService service(c, &bus_, nullptr);
+  Announce(path, 50);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  const std::string frames = service.report_dir() + "/frames.png";
+  ASSERT_TRUE(std::filesystem::exists(frames));
+  EXPECT_GT(std::filesystem::file_size(frames), 100U);
+  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  EXPECT_NE(html.find("<img src=\"frames.png\""), std::string::npos);
+  EXPECT_NE(html.find("4 greedy episodes"), std::string::npos);
 }
 
 TEST_F(EvaluatorServiceTest, RefusesACorruptedCheckpointAndStillScoresTheNextGoodOne) {

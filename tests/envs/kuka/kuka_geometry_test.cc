@@ -1,5 +1,8 @@
 #include "envs/kuka/kuka_geometry.h"
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <set>
 #include <stdexcept>
 #include <vector>
@@ -103,6 +106,27 @@ TEST(KukaObjectsTest, ObjectsAreDeterministicSmallAndDiverse) {
   EXPECT_GT(max_mass - min_mass, 0.1);
   EXPECT_THROW(GenerateObject(-1), std::out_of_range);
   EXPECT_THROW(GenerateObject(kNumObjectIds), std::out_of_range);
+}
+
+TEST(KukaObjectsTest, EveryObjectStandsOutFromTheTrayInGrayscale) {
+  const double tray = Luma(kTrayColor);
+  int darker = 0, lighter = 0;
+  std::set<int> hues;  // the dominant channel, a coarse hue
+  for (int id = 0; id < kNumObjectIds; ++id) {
+    const std::array<float, 3> c = GenerateObject(id).color;
+    for (float v : c) {
+      EXPECT_GE(v, 0.0f) << "id " << id;
+      EXPECT_LE(v, 1.0f) << "id " << id;
+    }
+    const double y = Luma(c);
+    EXPECT_GE(std::abs(y - tray), kMinLumaContrastWithTray - 1e-6) << "id " << id;
+    (y < tray ? darker : lighter) += 1;
+    hues.insert(static_cast<int>(std::max_element(c.begin(), c.end()) - c.begin()));
+  }
+  // Both sides of the tray's luma occur, and the colours still span the hues.
+  EXPECT_GT(darker, kNumObjectIds / 5);
+  EXPECT_GT(lighter, kNumObjectIds / 5);
+  EXPECT_EQ(hues.size(), 3u);
 }
 
 }  // namespace
