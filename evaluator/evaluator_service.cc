@@ -282,8 +282,16 @@ bool EvaluatorService::ScorePending() {
 }
 
 void EvaluatorService::RecordVideo(const std::string& path, const EvalRecord& record) {
+  // One load serves the video and the frame grid.
+  nn::Sequential net;
   try {
-    nn::Sequential net = LoadPolicyNetwork(path, config_.env_id);
+    net = LoadPolicyNetwork(path, config_.env_id);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "evaluator: no video: %s\n", e.what());
+    std::fflush(stderr);
+    return;
+  }
+  try {
     const VideoResult v = RecordGreedyVideo(
         &net, config_.env_id, config_.seed_base, config_.video_width, config_.video_height,
         config_.video_fps, (std::filesystem::path(report_dir_) / kBestVideo).string());
@@ -301,7 +309,6 @@ void EvaluatorService::RecordVideo(const std::string& path, const EvalRecord& re
   }
   if (!has_frames_) return;
   try {
-    nn::Sequential net = LoadPolicyNetwork(path, config_.env_id);
     const FrameGridResult g = WriteFrameGrid(
         &net, config_.env_id, config_.seed_base, kFrameGridEpisodes, kFrameGridColumns,
         (std::filesystem::path(report_dir_) / kFrameGrid).string());

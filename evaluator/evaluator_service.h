@@ -97,7 +97,8 @@ class EvaluatorService {
 
   /// Rewrites out_dir/report/ (no-op without out_dir). Logs, never throws.
   void WriteReportNow();
-  /// Records report/best.webm, a greedy episode of the checkpoint at `path`.
+  /// Records report/best.webm, a greedy episode of the checkpoint at `path`, and for pixel envs
+  /// report/frames.png, its grid of camera frames.
   void RecordVideo(const std::string& path, const EvalRecord& record);
 
   /// Publishes stats_evaluator_t now.
