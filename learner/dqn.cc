@@ -56,10 +56,16 @@ std::string QNetworkArchitecture(const DqnConfig& config, int obs_size, int num_
     if (obs_size % (40 * 40) != 0) throw fail("takes stacks of 40 x 40 frames");
     return nn::GraspCnnArchitecture(num_actions, obs_size / (40 * 40), config.dueling);
   }
-  if (config.network.find('(') == std::string::npos) {
-    throw fail("expected mlp, nature, grasp or an architecture string");
+  if (config.network == "grasp48") {
+    if (obs_size % (48 * 48) != 0) throw fail("takes stacks of 48 x 48 frames");
+    return nn::Grasp48CnnArchitecture(num_actions, obs_size / (48 * 48), config.dueling);
   }
-  if (config.dueling) throw fail("dueling applies to mlp, nature and grasp; write dueling(...)");
+  if (config.network.find('(') == std::string::npos) {
+    throw fail("expected mlp, nature, grasp, grasp48 or an architecture string");
+  }
+  if (config.dueling) {
+    throw fail("dueling applies to mlp, nature, grasp and grasp48; write dueling(...)");
+  }
   return config.network;
 }
 

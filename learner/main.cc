@@ -40,11 +40,11 @@ int Main(int argc, char** argv) {
        "run folder; checkpoints go to <out>/checkpoints")  //
       ("network", rl::po::value(&d.network)->default_value(d.network),
        "Q network: mlp, nature (Mnih et al. 2015, 4x84x84 frames), grasp (stacks of 40x40 "
-       "frames) or an architecture string")  //
+       "frames), grasp48 (stacks of 48x48 frames, a 6x6 map) or an architecture string")  //
       ("hidden", rl::po::value(&hidden)->default_value(hidden),
        "hidden layer widths of the MLP")  //
       ("dueling", rl::po::value(&d.dueling)->default_value(d.dueling),
-       "dueling value and advantage streams (1/0; mlp, nature, grasp)")  //
+       "dueling value and advantage streams (1/0; mlp, nature, grasp, grasp48)")  //
       ("prioritized", rl::po::value(&c.prioritized)->default_value(c.prioritized),
        "send |TD errors| to the replay as priorities after every update (1/0)")  //
       ("batch-size", rl::po::value(&c.batch_size)->default_value(c.batch_size),

@@ -13,12 +13,13 @@ void RequirePositive(int value, const char* what) {
   }
 }
 
-// The fully connected part: hidden 512 units, then the Q values.
-std::string Head(int in, int num_actions, bool dueling) {
+// The fully connected part: `hidden` units, then the Q values.
+std::string Head(int in, int num_actions, bool dueling, int hidden = 512) {
   const std::string a = std::to_string(num_actions);
   const std::string i = std::to_string(in);
-  return dueling ? "dueling(" + i + ",512," + a + ")"
-                 : "linear(" + i + ",512),relu,linear(512," + a + ")";
+  const std::string h = std::to_string(hidden);
+  return dueling ? "dueling(" + i + "," + h + "," + a + ")"
+                 : "linear(" + i + "," + h + "),relu,linear(" + h + "," + a + ")";
 }
 
 }  // namespace
@@ -45,6 +46,19 @@ std::string GraspCnnArchitecture(int num_actions, int in_channels, bool dueling)
 
 Sequential MakeGraspCnn(int num_actions, std::mt19937* rng, int in_channels, bool dueling) {
   return BuildFromArchitecture(GraspCnnArchitecture(num_actions, in_channels, dueling), rng);
+}
+
+std::string Grasp48CnnArchitecture(int num_actions, int in_channels, bool dueling) {
+  RequirePositive(num_actions, "Grasp48Cnn: num_actions");
+  RequirePositive(in_channels, "Grasp48Cnn: in_channels");
+  return "conv2d(" + std::to_string(in_channels) +
+         ",16,5,2,2,48,48),relu,conv2d(16,32,3,2,1,24,24),relu,conv2d(32,32,3,2,1,12,12),relu,"
+         "flatten," +
+         Head(32 * 6 * 6, num_actions, dueling, 256);
+}
+
+Sequential MakeGrasp48Cnn(int num_actions, std::mt19937* rng, int in_channels, bool dueling) {
+  return BuildFromArchitecture(Grasp48CnnArchitecture(num_actions, in_channels, dueling), rng);
 }
 
 }  // namespace rl::nn

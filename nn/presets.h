@@ -31,4 +31,17 @@ std::string GraspCnnArchitecture(int num_actions, int in_channels = 4, bool duel
 Sequential MakeGraspCnn(int num_actions, std::mt19937* rng, int in_channels = 4,
                         bool dueling = false);
 
+/// A network for stacks of `in_channels` 48 x 48 grayscale frames at the KUKA camera's native
+/// size, keeping where things are: three stride-2 convolutions (48 -> 24 -> 12 -> 6) and a 6 x 6
+/// map into the head, no batch normalisation:
+///   conv2d(C,16,5,2,2,48,48),relu,conv2d(16,32,3,2,1,24,24),relu,
+///   conv2d(32,32,3,2,1,12,12),relu,flatten,linear(1152,256),relu,linear(256,num_actions)
+/// With `dueling` the last two layers become dueling(1152,256,num_actions). The grasp network
+/// above reduces 3-pixel objects through an 8 x 8 stride-4 layer to a 1 x 1 map. Throws
+/// std::invalid_argument unless num_actions and in_channels are positive.
+std::string Grasp48CnnArchitecture(int num_actions, int in_channels = 4, bool dueling = false);
+/// BuildFromArchitecture(Grasp48CnnArchitecture(num_actions, in_channels, dueling), rng).
+Sequential MakeGrasp48Cnn(int num_actions, std::mt19937* rng, int in_channels = 4,
+                          bool dueling = false);
+
 }  // namespace rl::nn

@@ -134,17 +134,20 @@ std::vector<Points> RandomHull(std::mt19937_64& rng) {
 
 // A colour whose luma is within kMinLumaContrastWithTray of the tray's becomes darker (by scaling)
 // when `side` < 0.5, else lighter (by mixing with white), to a luma `depth` (in [0, 1]) of the way
-// into the band of 0.15 beyond the contrast limit. Both draws are made for every object, so the
+// into the band of 0.15 beyond the contrast limit. A side without room for that band (darker than
+// a luma of 0.05, lighter than 0.97) is never taken. Both draws are made for every object, so the
 // random stream (and the shapes of later ids' draws) does not depend on the branch taken.
 void KeepLumaAwayFromTray(double side, double depth, std::array<float, 3>* rgb) {
   const double tray = Luma(kTrayColor);
   const double y = Luma(*rgb);
   if (std::abs(y - tray) >= kMinLumaContrastWithTray) return;
-  if (side < 0.5) {
-    const double target = std::max(0.05, tray - kMinLumaContrastWithTray - 0.15 * depth);
+  const bool room_below = tray - kMinLumaContrastWithTray - 0.15 >= 0.05;
+  const bool room_above = tray + kMinLumaContrastWithTray + 0.15 <= 0.97;
+  if ((side < 0.5 && room_below) || !room_above) {
+    const double target = tray - kMinLumaContrastWithTray - 0.15 * depth;
     for (float& c : *rgb) c = static_cast<float>(c * target / y);
   } else {
-    const double target = std::min(0.97, tray + kMinLumaContrastWithTray + 0.15 * depth);
+    const double target = tray + kMinLumaContrastWithTray + 0.15 * depth;
     const double t = (target - y) / (1 - y);
     for (float& c : *rgb) c = static_cast<float>(c + t * (1 - c));
   }

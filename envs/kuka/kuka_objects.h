@@ -22,9 +22,12 @@
 namespace rl::envs::kuka {
 
 /// The tray's colour (RGB in [0, 1]; drawn by the scene) and the least luma difference between an
-/// object's colour and it. Without it about a third of the objects (greens, cyans, light reds) were
-/// nearly invisible on the tray in the grayscale frames a DQN receives.
-inline constexpr std::array<float, 3> kTrayColor = {0.55f, 0.57f, 0.62f};
+/// object's colour and it. A DQN sees grayscale frames: on the earlier mid-grey tray (luma 0.57)
+/// the 0.6-grey gripper differed by about 8 of 255 levels where it covered the tray, so the network
+/// could not see where the gripper was, and without the contrast limit about a third of the
+/// objects vanished too. The reference's tray is textured, in a colour not known here; a dark tray
+/// (luma 0.15) keeps the gripper, the arm and every object apart from it.
+inline constexpr std::array<float, 3> kTrayColor = {0.13f, 0.15f, 0.19f};
 inline constexpr double kMinLumaContrastWithTray = 0.25;
 
 /// Rec. 601 luma of an RGB colour in [0, 1] (the weights of OpenCV's RGB-to-gray conversion).

@@ -153,6 +153,13 @@ TEST(DqnTest, NamesTheQNetworksItKnowsAndRefusesMismatches) {
   EXPECT_NE(QNetworkArchitecture(c, 2 * 40 * 40, 7).find("conv2d(2,32,8,4,0,40,40)"),
             std::string::npos);
   EXPECT_THROW(QNetworkArchitecture(c, 100, 7), std::invalid_argument);
+  c.network = "grasp48";
+  c.dueling = true;
+  const std::string grasp48 = QNetworkArchitecture(c, 4 * 48 * 48, 7);
+  EXPECT_NE(grasp48.find("conv2d(4,16,5,2,2,48,48)"), std::string::npos);
+  EXPECT_NE(grasp48.find("dueling(1152,256,7)"), std::string::npos);
+  EXPECT_THROW(QNetworkArchitecture(c, 4 * 40 * 40, 7), std::invalid_argument);
+  c.dueling = false;
   c.network = "resnet";
   EXPECT_THROW(QNetworkArchitecture(c, 3, 2), std::invalid_argument);
   // An architecture string that does not fit the env is refused when the Dqn is built.

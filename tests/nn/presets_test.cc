@@ -75,6 +75,35 @@ TEST(PresetsTest, GraspCnnHasThePyTorchShapesAndParameterCount) {
   EXPECT_EQ(q.cols(), 5);
 }
 
+TEST(PresetsTest, Grasp48CnnKeepsASixBySixMap) {
+  std::mt19937 rng(6);
+  Sequential net = MakeGrasp48Cnn(7, &rng);
+  EXPECT_EQ(net.Architecture(), Grasp48CnnArchitecture(7, 4));
+  EXPECT_EQ(net.InputSize(), 4 * 48 * 48);
+  // 48 -> 24 -> 12 -> 6.
+  EXPECT_EQ(net.layer(0).output_shape(), (ImageShape{16, 24, 24}));
+  EXPECT_EQ(net.layer(2).output_shape(), (ImageShape{32, 12, 12}));
+  EXPECT_EQ(net.layer(4).output_shape(), (ImageShape{32, 6, 6}));
+  const int64_t expected = (4 * 16 * 5 * 5 + 16)     // conv1: 1,616
+                           + (16 * 32 * 3 * 3 + 32)  // conv2: 4,640
+                           + (32 * 32 * 3 * 3 + 32)  // conv3: 9,248
+                           + (1152 * 256 + 256)      // fc: 295,168
+                           + (256 * 7 + 7);          // out: 1,799
+  EXPECT_EQ(expected, 312471);
+  EXPECT_EQ(net.NumParams(), 312471);
+  EXPECT_EQ(net.NumBuffers(), 0);
+  EXPECT_EQ(MakeGrasp48Cnn(3, &rng, /*in_channels=*/1).InputSize(), 48 * 48);
+  const Sequential dueling = MakeGrasp48Cnn(7, &rng, 4, /*dueling=*/true);
+  EXPECT_NE(dueling.Architecture().find("flatten,dueling(1152,256,7)"), std::string::npos);
+
+  const Matrix x = RandomMatrix(net.InputSize(), 5, &rng, 0.5f).array() + 0.5f;
+  const Matrix& q = net.Forward(x);
+  EXPECT_EQ(q.rows(), 7);
+  EXPECT_EQ(q.cols(), 5);
+  EXPECT_THROW(Grasp48CnnArchitecture(0), std::invalid_argument);
+  EXPECT_THROW(MakeGrasp48Cnn(3, &rng, 0), std::invalid_argument);
+}
+
 TEST(PresetsTest, DuelingVariantsReplaceTheFullyConnectedHead) {
   std::mt19937 rng(2);
   const Sequential nature = MakeNatureCnn(6, &rng, /*dueling=*/true);

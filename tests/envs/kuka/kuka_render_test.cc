@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -16,6 +17,10 @@ namespace {
 
 bool IsWhite(const std::vector<uint8_t>& rgb, int i) {
   return rgb[3 * i] == 255 && rgb[3 * i + 1] == 255 && rgb[3 * i + 2] == 255;
+}
+
+double Luma(const std::vector<uint8_t>& rgb, int i) {
+  return 0.299 * rgb[3 * i] + 0.587 * rgb[3 * i + 1] + 0.114 * rgb[3 * i + 2];
 }
 
 int CountDifferentPixels(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
@@ -120,6 +125,40 @@ TEST(KukaRenderTest, GripperAppearsWhereTheCameraModelProjectsIt) {
       EXPECT_NEAR(y1 + 1, clip(py1), 1.5) << "seed " << seed << " move " << move;
       // And the gripper is well inside the picture, not a sliver at its edge.
       EXPECT_GT((x1 - x0) * (y1 - y0), 50);
+    }
+  }
+}
+
+TEST(KukaRenderTest, GripperStandsOutFromTheTrayInGrayscale) {
+  // A DQN sees grayscale frames, so where the gripper covers the tray its luma must differ
+  // clearly from the tray's, or the network cannot tell where the gripper is. Compare the 48 x 48
+  // image with and without the gripper on the pixels the gripper covers, as it descends.
+  KukaDiverseObjectEnv env;
+  KukaRenderer renderer;
+  constexpr int kSize = 48;
+  for (uint64_t seed : {5, 6}) {
+    env.Reset(seed);
+    for (int step = 0; step < 5; ++step) {
+      std::vector<DrawItem> all, without, gripper;
+      env.scene().CollectDrawItems(&all);
+      for (const DrawItem& d : all) {
+        (d.group == DrawGroup::kGripper ? gripper : without).push_back(d);
+      }
+      std::vector<uint8_t> full, hidden, alone;
+      renderer.Render(env.camera(), all, kSize, kSize, &full);
+      renderer.Render(env.camera(), without, kSize, kSize, &hidden);
+      renderer.Render(env.camera(), gripper, kSize, kSize, &alone);
+      double sum = 0;
+      int covered = 0;
+      for (int i = 0; i < kSize * kSize; ++i) {
+        if (IsWhite(alone, i) || IsWhite(hidden, i)) continue;
+        sum += std::abs(Luma(full, i) - Luma(hidden, i));
+        ++covered;
+      }
+      ASSERT_GT(covered, 5) << "seed " << seed << " step " << step;
+      // About 8 levels of 255 on the earlier mid-grey tray; 41..73 on the dark one.
+      EXPECT_GT(sum / covered, 30.0) << "seed " << seed << " step " << step;
+      env.Step(0);  // stay: the gripper only descends
     }
   }
 }
