@@ -46,6 +46,9 @@ void EvaluatorConfig::Validate() const {
   if (!(epsilon >= 0.0 && epsilon <= 1.0)) {
     throw std::invalid_argument("epsilon must be in [0, 1], got " + std::to_string(epsilon));
   }
+  if (!(gamma >= 0.0 && gamma <= 1.0)) {
+    throw std::invalid_argument("gamma must be in [0, 1], got " + std::to_string(gamma));
+  }
   if (!(stats_period_seconds > 0.0)) {
     throw std::invalid_argument("stats period must be positive");
   }
@@ -78,14 +81,15 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
 }
 
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
-                               double epsilon, uint64_t first_seed,
+                               double epsilon, uint64_t first_seed, double gamma,
                                const std::function<void()>& after_episode) {
   nn::CheckpointMeta meta;
   nn::Sequential net = LoadPolicyNetwork(path, env_id, &meta);
 
   // Score.
   const double start = MonoSeconds();
-  const EvalScore score = ScorePolicy(&net, env_id, episodes, epsilon, first_seed, after_episode);
+  const EvalScore score =
+      ScorePolicy(&net, env_id, episodes, epsilon, first_seed, gamma, after_episode);
   EvalRecord r;
   r.checkpoint = FileName(path);
   r.update = meta.update;
@@ -97,6 +101,12 @@ EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_i
   r.max = score.max;
   r.episodes = score.episodes;
   r.eval_seconds = MonoSeconds() - start;
+  if (score.values) {
+    r.value_steps = score.values->steps;
+    r.value_estimate = score.values->estimate;
+    r.value_return = score.values->actual;
+    if (std::isfinite(score.values->correlation)) r.value_correlation = score.values->correlation;
+  }
   return r;
 }
 
@@ -107,12 +117,14 @@ EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* 
   const envs::EnvSpec spec = envs::MakeEnv(config_.env_id)->spec();
   goal_ = std::isnan(config_.goal) ? spec.reward_threshold : config_.goal;
   has_frames_ = spec.frame_height > 0;
-  char epsilon[32];
+  char epsilon[32], gamma[32];
   std::snprintf(epsilon, sizeof(epsilon), "%g", config_.epsilon);
+  std::snprintf(gamma, sizeof(gamma), "%g", config_.gamma);
   const uint64_t last_seed = config_.seed_base + static_cast<uint64_t>(config_.episodes) - 1;
   eval_settings_ = "Each checkpoint is scored on " + std::to_string(config_.episodes) +
                    " episodes (seeds " + std::to_string(config_.seed_base) + " to " +
-                   std::to_string(last_seed) + ") with epsilon " + epsilon + ".";
+                   std::to_string(last_seed) + ") with epsilon " + epsilon +
+                   "; returns G are discounted with gamma " + gamma + ".";
 
   // Resume the history of the run folder.
   if (!config_.out_dir.empty()) {
@@ -216,7 +228,7 @@ bool EvaluatorService::ScorePending() {
     // monitor never mistakes a busy evaluator for a dead one, and a stop request is honoured
     // after the current episode.
     record = ScoreCheckpointFile(announced.path, config_.env_id, config_.episodes, config_.epsilon,
-                                 config_.seed_base, [this] {
+                                 config_.seed_base, config_.gamma, [this] {
                                    if (StopRequested()) throw Stopped{};
                                    if (MonoSeconds() >= next_stats_time_) PublishStats();
                                  });

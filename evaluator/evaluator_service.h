@@ -37,6 +37,7 @@ struct EvaluatorConfig {
   std::string env_id = "CartPole-v1";         // env the checkpoints are scored on
   int episodes = 100;                         // evaluation episodes per checkpoint
   double epsilon = kDefaultEvalEpsilon;       // exploration rate while scoring
+  double gamma = kDefaultGamma;               // discount of the value estimates (the actors' gamma)
   uint64_t seed_base = kDefaultEvalSeedBase;  // episode i is reset with seed seed_base + i
   std::string out_dir;  // run folder: out_dir/eval.jsonl and out_dir/report/; empty: no files
   double goal = std::nan("");         // mean return that counts as solved; NaN: the env's threshold
@@ -59,13 +60,14 @@ struct EvaluatorConfig {
 nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env_id,
                                  nn::CheckpointMeta* meta = nullptr);
 
-/// Loads a checkpoint file, builds its network and scores it on `env_id` (see ScorePolicy).
+/// Loads a checkpoint file, builds its network and scores it on `env_id` (see ScorePolicy), with
+/// its value estimates against the returns (discount gamma).
 /// The record's update, env_steps and wall_seconds come from the file's metadata. Throws
 /// std::runtime_error with the reason when the file is refused: it does not load (missing,
 /// truncated, corrupted, foreign), its architecture does not build, its parameters do not fit
 /// the architecture, or the network does not fit the env. `after_episode` as in ScorePolicy.
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
-                               double epsilon, uint64_t first_seed,
+                               double epsilon, uint64_t first_seed, double gamma = kDefaultGamma,
                                const std::function<void()>& after_episode = {});
 
 /// The service. Not thread-safe: construct it, call Poll() or Run() and read it from one thread,

@@ -26,9 +26,11 @@ constexpr char kUsage[] =
     "      SIGTERM, or with --stop-at-goal once a checkpoint reaches the goal, and then prints\n"
     "      'evaluator: goal reached' or 'evaluator: goal not reached (best X)'; exit status 0.\n"
     "  evaluator --checkpoint FILE [--env ID] [--episodes N] [--epsilon E] [--seed-base S]\n"
-    "            [--frames PNG]\n"
+    "            [--gamma G] [--frames PNG]\n"
     "      Standalone mode: scores one checkpoint file and prints one JSON object (checkpoint,\n"
-    "      update, env_steps, wall_seconds, mean, std, min, max, episodes, eval_seconds).\n"
+    "      update, env_steps, wall_seconds, mean, std, min, max, episodes, eval_seconds, and\n"
+    "      value_steps, value_estimate, value_return, value_correlation: the network's value\n"
+    "      estimates of the actions taken against the discounted returns that followed).\n"
     "      --frames also writes the grid of camera frames the report shows (pixel envs).\n"
     "      A refused file prints 'evaluator: error: <reason>' and exits with status 2.\n"
     "\n"
@@ -66,6 +68,9 @@ int Main(int argc, char** argv) {
        "evaluation episodes per checkpoint")  //
       ("epsilon", rl::po::value(&config.epsilon)->default_value(config.epsilon, "0.05"),
        "exploration rate while scoring (0.05 as in Mnih et al. 2015)")  //
+      ("gamma", rl::po::value(&config.gamma)->default_value(config.gamma, "0.99"),
+       "discount of the returns the network's value estimates are compared with: the actors' "
+       "gamma (put gamma at the top of a preset so that both read it)")  //
       ("seed-base", rl::po::value(&config.seed_base)->default_value(config.seed_base),
        "seed of the first evaluation episode (episode i: seed-base + i); keep it away from "
        "training seeds")  //
@@ -98,7 +103,7 @@ int Main(int argc, char** argv) {
   if (!checkpoint.empty()) {
     config.Validate();
     rl::evaluator::EvalRecord record = rl::evaluator::ScoreCheckpointFile(
-        checkpoint, config.env_id, config.episodes, config.epsilon, config.seed_base);
+        checkpoint, config.env_id, config.episodes, config.epsilon, config.seed_base, config.gamma);
     record.checkpoint = checkpoint;
     std::cout << rl::evaluator::ToJson(record) << std::endl;
     if (!frames_file.empty()) {

@@ -35,6 +35,9 @@ std::string Format(const char* fmt, double v) {
   return buf;
 }
 
+// A return or a value: two decimals below 10 (success rates such as 0.36), else one.
+std::string Score(double v) { return Format(std::fabs(v) < 10 ? "%.2f" : "%.1f", v); }
+
 // 1234567 -> "1,234,567".
 std::string Thousands(int64_t v) {
   std::string digits = std::to_string(v < 0 ? -v : v);
@@ -126,6 +129,13 @@ std::string ToJson(const EvalRecord& r) {
   s += ", \"max\": " + JsonNumber(r.max);
   s += ", \"episodes\": " + std::to_string(r.episodes);
   s += ", \"eval_seconds\": " + JsonNumber(r.eval_seconds);
+  if (r.value_steps > 0) {
+    s += ", \"value_steps\": " + std::to_string(r.value_steps);
+    s += ", \"value_estimate\": " + JsonNumber(r.value_estimate);
+    s += ", \"value_return\": " + JsonNumber(r.value_return);
+    s += ", \"value_correlation\": " +
+         (r.value_correlation ? JsonNumber(*r.value_correlation) : std::string("null"));
+  }
   s += "}";
   return s;
 }
@@ -149,6 +159,13 @@ bool ParseJson(const std::string& line, EvalRecord* record) {
   r.max = GetJsonDouble(obj, "max").value_or(r.mean);
   r.episodes = static_cast<int>(GetJsonInt(obj, "episodes").value_or(0));
   r.eval_seconds = GetJsonDouble(obj, "eval_seconds").value_or(0);
+  r.value_steps = GetJsonInt(obj, "value_steps").value_or(0);
+  if (r.value_steps > 0) {
+    r.value_estimate = GetJsonDouble(obj, "value_estimate").value_or(0);
+    r.value_return = GetJsonDouble(obj, "value_return").value_or(0);
+    const std::optional<double> c = GetJsonDouble(obj, "value_correlation");
+    if (c && std::isfinite(*c)) r.value_correlation = *c;
+  }
   *record = std::move(r);
   return true;
 }
@@ -329,10 +346,9 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
   h += "</div></div>\n";
   h += "<div class=\"card\"><div class=\"label\">Best mean return</div>";
   if (best != nullptr) {
-    h += "<div class=\"value\">" + Format("%.1f", best->mean) + " <small>\xC2\xB1 " +
-         Format("%.1f", best->std) + "</small></div><div class=\"detail\">update " +
-         Thousands(best->update) + ", " + Thousands(best->env_steps) + " env steps, " +
-         Duration(best->wall_seconds) + "</div>";
+    h += "<div class=\"value\">" + Score(best->mean) + " <small>\xC2\xB1 " + Score(best->std) +
+         "</small></div><div class=\"detail\">update " + Thousands(best->update) + ", " +
+         Thousands(best->env_steps) + " env steps, " + Duration(best->wall_seconds) + "</div>";
   } else {
     h += "<div class=\"value\">\xE2\x80\x94</div><div class=\"detail\">no checkpoint scored "
          "yet</div>";
@@ -340,10 +356,9 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
   h += "</div>\n";
   h += "<div class=\"card\"><div class=\"label\">Latest checkpoint</div>";
   if (latest != nullptr) {
-    h += "<div class=\"value\">" + Format("%.1f", latest->mean) + " <small>\xC2\xB1 " +
-         Format("%.1f", latest->std) + "</small></div><div class=\"detail\">update " +
-         Thousands(latest->update) + ", " + Thousands(latest->env_steps) + " env steps, " +
-         Duration(latest->wall_seconds) + "</div>";
+    h += "<div class=\"value\">" + Score(latest->mean) + " <small>\xC2\xB1 " + Score(latest->std) +
+         "</small></div><div class=\"detail\">update " + Thousands(latest->update) + ", " +
+         Thousands(latest->env_steps) + " env steps, " + Duration(latest->wall_seconds) + "</div>";
   } else {
     h += "<div class=\"value\">\xE2\x80\x94</div>";
   }
@@ -386,9 +401,19 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
     });
     double bar_scale = has_goal ? info.goal : 0;
     for (const EvalRecord* r : rows) bar_scale = std::max(bar_scale, r->mean);
+    const bool has_values = std::any_of(records.begin(), records.end(),
+                                        [](const EvalRecord& r) { return r.value_steps > 0; });
+    if (has_values) {
+      h += "<p>Q is the network's mean value estimate of the actions taken in the evaluation "
+           "episodes; G is the mean discounted return that followed them (van Hasselt et al. "
+           "2016: Q well above G is overestimation); r is the correlation of the two across the "
+           "steps (near 0: the network cannot tell good states from bad ones).</p>\n";
+    }
     h += "<div class=\"scroll\"><table>\n<thead><tr><th>checkpoint</th><th>update</th>"
          "<th>env steps</th><th>wall time</th><th>mean</th><th>std</th><th>min</th><th>max</th>"
-         "<th>episodes</th><th>eval time</th></tr></thead>\n<tbody>\n";
+         "<th>episodes</th><th>eval time</th>";
+    if (has_values) h += "<th>Q</th><th>G</th><th>r</th>";
+    h += "</tr></thead>\n<tbody>\n";
     for (const EvalRecord* r : rows) {
       std::string cls;
       if (r == best) cls += "best";
@@ -400,12 +425,20 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
       h += "<td>" + Thousands(r->env_steps) + "</td>";
       h += "<td>" + Duration(r->wall_seconds) + "</td>";
       h += "<td class=\"mean\"><span class=\"bar\" style=\"width:" + Format("%.1f", bar) +
-           "%\"></span>" + Format("%.1f", r->mean) + "</td>";
-      h += "<td>" + Format("%.1f", r->std) + "</td>";
+           "%\"></span>" + Score(r->mean) + "</td>";
+      h += "<td>" + Score(r->std) + "</td>";
       h += "<td>" + Format("%g", r->min) + "</td>";
       h += "<td>" + Format("%g", r->max) + "</td>";
       h += "<td>" + std::to_string(r->episodes) + "</td>";
       h += "<td>" + Format("%.2f s", r->eval_seconds) + "</td>";
+      if (has_values && r->value_steps > 0) {
+        h += "<td>" + Score(r->value_estimate) + "</td><td>" + Score(r->value_return) +
+             "</td><td>" +
+             (r->value_correlation ? Format("%.2f", *r->value_correlation) : "\xE2\x80\x94") +
+             "</td>";
+      } else if (has_values) {
+        h += "<td></td><td></td><td></td>";
+      }
       h += "</tr>\n";
     }
     h += "</tbody>\n</table></div>\n";

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,14 +22,21 @@ struct EvalRecord {
   double max = 0;
   int episodes = 0;         // evaluation episodes
   double eval_seconds = 0;  // seconds the scoring took
+  // The network's value estimates against the returns that followed (ValueCalibration); all
+  // zero and no correlation when not measured (value_steps 0).
+  int64_t value_steps = 0;
+  double value_estimate = 0;                // mean Q(s_t, a_t) of the actions taken
+  double value_return = 0;                  // mean discounted return that followed them
+  std::optional<double> value_correlation;  // unset when undefined (a constant series)
 
   bool operator==(const EvalRecord&) const = default;
 };
 
 /// One line of eval.jsonl, without the newline: {"checkpoint": ..., "update": ..., "env_steps":
 /// ..., "wall_seconds": ..., "mean": ..., "std": ..., "min": ..., "max": ..., "episodes": ...,
-/// "eval_seconds": ...}. Numbers are written in their shortest form that reads back exactly;
-/// a non-finite number is written as null.
+/// "eval_seconds": ...}, and when value_steps > 0 also "value_steps", "value_estimate",
+/// "value_return" and "value_correlation" (null when unset). Numbers are written in their
+/// shortest form that reads back exactly; a non-finite number is written as null.
 std::string ToJson(const EvalRecord& record);
 
 /// Parses one line written by ToJson (keys in any order, unknown keys ignored, whitespace

@@ -4,6 +4,8 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -23,6 +25,24 @@ inline constexpr uint64_t kDefaultEvalSeedBase = 1'000'000'000;
 /// in the env's dynamics from scoring on a single lucky trajectory).
 inline constexpr double kDefaultEvalEpsilon = 0.05;
 
+/// Discount of the value estimates: the actors' default (a run's evaluator must use its actors').
+inline constexpr double kDefaultGamma = 0.99;
+
+/// A step of an episode cut by its time limit counts in a ValueCalibration only while the part of
+/// the return after the cut, which nobody saw, weighs at most this much (gamma^k <= 0.01).
+inline constexpr double kUnseenTailWeight = 0.01;
+
+/// How a Q-network's value estimates compare with the returns that actually followed, as in van
+/// Hasselt et al. (2016): for every step t of the evaluation, Q(s_t, a_t) of the action taken
+/// against the discounted return sum_k gamma^k r_{t+k} to the end of the episode.
+struct ValueCalibration {
+  int64_t steps = 0;                                              // steps compared
+  double estimate = 0;                                            // mean Q(s_t, a_t)
+  double actual = 0;                                              // mean discounted return from s_t
+  double correlation = std::numeric_limits<double>::quiet_NaN();  // Pearson, across the steps;
+                                                                  // NaN when either is constant
+};
+
 /// Undiscounted returns of the evaluation episodes and their summary.
 struct EvalScore {
   int episodes = 0;
@@ -31,6 +51,9 @@ struct EvalScore {
   double min = 0;
   double max = 0;
   std::vector<double> returns;  // one per episode, in episode order
+  /// Set when the policy gave value estimates (ScoreActionValues, ScorePolicy) and some steps
+  /// could be compared.
+  std::optional<ValueCalibration> values;
 };
 
 /// Summarizes returns (population std). An empty vector gives an all-zero score.
@@ -38,6 +61,14 @@ EvalScore Summarize(std::vector<double> returns);
 
 /// Maps an observation to the greedy action (in [0, num_actions)).
 using GreedyPolicy = std::function<int(std::span<const float> observation)>;
+
+/// Maps an observation to the value estimate of every action (num_actions values, valid until
+/// the next call).
+using ActionValues = std::function<std::span<const float>(std::span<const float> observation)>;
+
+/// Pearson correlation of two equally long series; NaN when they are shorter than 2 or either
+/// is constant.
+double Correlation(std::span<const double> x, std::span<const double> y);
 
 /// Runs `episodes` episodes of a fresh `env_id` env: episode i is reset with seed first_seed + i
 /// and runs until terminated or truncated. In every step the action is uniform at random with
@@ -51,13 +82,22 @@ EvalScore ScoreGreedyPolicy(const GreedyPolicy& greedy, const std::string& env_i
                             double epsilon, uint64_t first_seed = kDefaultEvalSeedBase,
                             const std::function<void()>& after_episode = {});
 
-/// ScoreGreedyPolicy with the network's argmax as the greedy action. Throws
+/// ScoreGreedyPolicy with the first largest of the action values as the greedy action; also
+/// compares the value of every action taken with the discounted return (discount `gamma`) that
+/// followed it (EvalScore::values). Throws std::invalid_argument as ScoreGreedyPolicy, for
+/// gamma outside [0, 1] and for a number of values other than the env's number of actions.
+EvalScore ScoreActionValues(const ActionValues& values, const std::string& env_id, int episodes,
+                            double epsilon, double gamma,
+                            uint64_t first_seed = kDefaultEvalSeedBase,
+                            const std::function<void()>& after_episode = {});
+
+/// ScoreActionValues with the network's outputs as the action values. Throws
 /// std::invalid_argument when the network's input or output size does not match the env's
 /// observation size or number of actions. The network is used (its scratch buffers) but not
 /// changed.
 EvalScore ScorePolicy(nn::Sequential* net, const std::string& env_id, int episodes,
                       double epsilon = kDefaultEvalEpsilon,
-                      uint64_t first_seed = kDefaultEvalSeedBase,
+                      uint64_t first_seed = kDefaultEvalSeedBase, double gamma = kDefaultGamma,
                       const std::function<void()>& after_episode = {});
 
 /// Empty when a network with these input and output sizes fits the env (input size =

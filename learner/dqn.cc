@@ -26,6 +26,7 @@ void DqnConfig::Validate() const {
   if (target_update_period < 1) throw std::invalid_argument("target-update-period must be >= 1");
   if (!(tau > 0 && tau <= 1)) throw std::invalid_argument("tau must be in (0, 1]");
   if (!(max_grad_norm >= 0)) throw std::invalid_argument("max-grad-norm must be >= 0");
+  if (augment_shift < 0) throw std::invalid_argument("augment-shift must be >= 0");
 }
 
 std::string QNetworkArchitecture(const DqnConfig& config, int obs_size, int num_actions) {
@@ -74,6 +75,7 @@ Dqn::Dqn(int obs_size, int num_actions, DqnConfig config)
   config_.Validate();
   std::mt19937 rng(static_cast<std::mt19937::result_type>(config_.seed));
   online_ = nn::BuildFromArchitecture(QNetworkArchitecture(config_, obs_size, num_actions), &rng);
+  shift_rng_.seed(config_.seed + 1);
   if (online_.InputSize() != obs_size || online_.OutputSize() != num_actions) {
     throw std::invalid_argument("network '" + config_.network + "' takes " +
                                 std::to_string(online_.InputSize()) + " inputs and gives " +
@@ -93,13 +95,36 @@ Dqn::Dqn(int obs_size, int num_actions, DqnConfig config)
   }
 }
 
+void Dqn::ShiftedPixels(const uint8_t* pixels, int planes, int height, int width, int n,
+                        nn::Matrix* out) {
+  std::uniform_int_distribution<int> offset(-config_.augment_shift, config_.augment_shift);
+  shift_y_.resize(static_cast<size_t>(n));
+  shift_x_.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    shift_y_[static_cast<size_t>(i)] = offset(shift_rng_);
+    shift_x_[static_cast<size_t>(i)] = offset(shift_rng_);
+  }
+  nn::ShiftedPixelsToMatrix(pixels, planes, height, width, n, shift_y_.data(), shift_x_.data(),
+                            out);
+}
+
 UpdateResult Dqn::Update(const BatchView& b) {
   if (b.obs_size != obs_size_) throw std::invalid_argument("batch observation size mismatch");
   if (b.count < 1) throw std::invalid_argument("empty batch");
   const int n = b.count;
-  if (b.obs_pixels != nullptr && b.next_obs_pixels != nullptr) {
+  if (b.obs_pixels != nullptr && b.next_obs_pixels != nullptr && config_.augment_shift > 0) {
+    const int64_t frame = int64_t{b.frame_height} * b.frame_width;
+    if (frame < 1 || obs_size_ % frame != 0) {
+      throw std::invalid_argument("augment-shift needs the frame size of a pixel batch");
+    }
+    const int planes = static_cast<int>(obs_size_ / frame);
+    ShiftedPixels(b.obs_pixels, planes, b.frame_height, b.frame_width, n, &obs_);
+    ShiftedPixels(b.next_obs_pixels, planes, b.frame_height, b.frame_width, n, &next_obs_);
+  } else if (b.obs_pixels != nullptr && b.next_obs_pixels != nullptr) {
     nn::PixelsToMatrix(b.obs_pixels, obs_size_, n, &obs_);
     nn::PixelsToMatrix(b.next_obs_pixels, obs_size_, n, &next_obs_);
+  } else if (config_.augment_shift > 0) {
+    throw std::invalid_argument("augment-shift applies to pixel observations only");
   } else if (b.obs != nullptr && b.next_obs != nullptr) {
     obs_ = Eigen::Map<const nn::Matrix>(b.obs, obs_size_, n);
     next_obs_ = Eigen::Map<const nn::Matrix>(b.next_obs, obs_size_, n);

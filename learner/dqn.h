@@ -35,7 +35,11 @@ struct DqnConfig {
   int target_update_period = 500;  // updates between target refreshes
   float tau = 1.0f;                // weight of the online network in a refresh
   float max_grad_norm = 10.0f;     // global gradient-norm clip (0: none)
-  uint64_t seed = 0;               // initialisation seed
+  // Pixel batches: shift each observation and each next observation by its own random offset
+  // of up to this many pixels in y and x, edges repeated (DrQ's random shift, Kostrikov et al.
+  // 2020; they use 4 on 84 x 84 frames). 0: no augmentation.
+  int augment_shift = 0;
+  uint64_t seed = 0;  // initialisation seed (and the seed of the shifts)
 
   // Throws std::invalid_argument naming the bad field.
   void Validate() const;
@@ -47,10 +51,13 @@ std::string QNetworkArchitecture(const DqnConfig& config, int obs_size, int num_
 
 // A batch of transitions laid out as in the messages: transition i's observation is
 // obs[i*obs_size .. (i+1)*obs_size). Pixel batches give bytes instead (obs_pixels and
-// next_obs_pixels, divided by 255 on the way into the network) and leave obs and next_obs null.
+// next_obs_pixels, divided by 255 on the way into the network) and leave obs and next_obs null;
+// their frames are frame_height x frame_width (needed for augment_shift).
 struct BatchView {
   int obs_size = 0;
   int count = 0;
+  int frame_height = 0;
+  int frame_width = 0;
   const float* obs = nullptr;
   const float* next_obs = nullptr;
   const uint8_t* obs_pixels = nullptr;
@@ -86,6 +93,10 @@ class Dqn {
   const DqnConfig& config() const { return config_; }
 
  private:
+  // Pixels to network inputs, each observation shifted at random by up to augment_shift.
+  void ShiftedPixels(const uint8_t* pixels, int planes, int height, int width, int n,
+                     nn::Matrix* out);
+
   DqnConfig config_;
   int obs_size_;
   int num_actions_;
@@ -94,11 +105,13 @@ class Dqn {
   std::unique_ptr<nn::Optimizer> optimizer_;
   std::vector<nn::Param> params_;
   int64_t updates_ = 0;
+  std::mt19937_64 shift_rng_;  // augment_shift's offsets
 
   // Buffers reused by every update.
   nn::Matrix obs_, next_obs_, grad_q_;
   nn::Vector pred_, target_values_, loss_grad_, weights_;
   std::vector<int> next_actions_;
+  std::vector<int> shift_y_, shift_x_;
   std::vector<float> td_abs_;
 };
 

@@ -18,7 +18,14 @@
 namespace rl::learner {
 namespace {
 
-int ObsSize(const std::string& env_id) { return envs::MakeEnv(env_id)->spec().observation_size; }
+int ObsSize(const std::string& env_id, int augment_shift) {
+  const envs::EnvSpec spec = envs::MakeEnv(env_id)->spec();
+  if (augment_shift > 0 && spec.frame_height <= 0) {
+    throw std::invalid_argument("augment-shift applies to pixel envs, and " + env_id +
+                                " is not one");
+  }
+  return spec.observation_size;
+}
 int NumActions(const std::string& env_id) { return envs::MakeEnv(env_id)->spec().num_actions; }
 
 }  // namespace
@@ -38,7 +45,7 @@ void LearnerConfig::Validate() const {
 Learner::Learner(LearnerConfig config, Bus* bus)
     : config_((config.Validate(), std::move(config))),
       bus_(bus),
-      obs_size_(ObsSize(config_.env_id)),
+      obs_size_(ObsSize(config_.env_id, config_.dqn.augment_shift)),
       dqn_(obs_size_, NumActions(config_.env_id), config_.dqn),
       weights_(bus),
       sender_(bus->config().sender) {
@@ -128,6 +135,8 @@ void Learner::TrainOn(const Batch& batch) {
         } else {
           b.obs_pixels = m.obs.data();
           b.next_obs_pixels = m.next_obs.data();
+          b.frame_height = m.height;
+          b.frame_width = m.width;
         }
         b.action = m.action.data();
         b.reward = m.reward.data();

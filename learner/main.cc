@@ -68,7 +68,10 @@ int Main(int argc, char** argv) {
       ("tau", rl::po::value(&d.tau)->default_value(d.tau),
        "refresh weight of the online network (1: hard copy)")  //
       ("max-grad-norm", rl::po::value(&d.max_grad_norm)->default_value(d.max_grad_norm),
-       "gradient norm clip (0: none)")                                                //
+       "gradient norm clip (0: none)")  //
+      ("augment-shift", rl::po::value(&d.augment_shift)->default_value(d.augment_shift),
+       "pixel envs: shift every sampled observation by a random offset of up to this many "
+       "pixels, edges repeated (DrQ, Kostrikov et al. 2020); 0: none")                //
       ("seed", rl::po::value(&d.seed)->default_value(d.seed), "initialisation seed")  //
       ("requests-in-flight",
        rl::po::value(&c.requests_in_flight)->default_value(c.requests_in_flight),
@@ -100,7 +103,12 @@ int Main(int argc, char** argv) {
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("learner"));
   rl::learner::Learner learner(c, &bus);
-  std::printf("learner: ready (%s)\n", learner.dqn().online().Architecture().c_str());
+  std::string shifts;
+  if (const int k = learner.dqn().config().augment_shift; k > 0) {
+    shifts = ", random shifts of up to " + std::to_string(k) + " pixels";
+  }
+  std::printf("learner: ready (%s)%s\n", learner.dqn().online().Architecture().c_str(),
+              shifts.c_str());
   std::fflush(stdout);
   learner.Run();
   std::printf("learner: stopped after %lld updates\n", static_cast<long long>(learner.updates()));

@@ -17,4 +17,13 @@ void PixelsToFloats(const uint8_t* pixels, int64_t count, float* out);
 /// see ImageShape), as a stack of frames naturally is.
 void PixelsToMatrix(const uint8_t* pixels, int features, int batch, Matrix* out);
 
+/// PixelsToMatrix with every observation shifted, the random-shift augmentation of DrQ
+/// (Kostrikov et al. 2020: pad by the edge pixels, crop at a random offset). Observation j is
+/// `planes` planes of height x width bytes; its output pixel (y, x) in every plane is its input
+/// pixel (clamp(y + dy[j]), clamp(x + dx[j])), so the edge rows and columns repeat beyond the
+/// border. All planes (the frames of a stack) move together. dy = dx = 0 gives PixelsToMatrix.
+/// No allocation when `out` already has the size.
+void ShiftedPixelsToMatrix(const uint8_t* pixels, int planes, int height, int width, int batch,
+                           const int* dy, const int* dx, Matrix* out);
+
 }  // namespace rl::nn

@@ -185,9 +185,13 @@ done
 echo "launch: $actors actors, replay, learner and evaluator running; logs in $out/logs"
 echo "launch: watch it with scripts/spy.sh --run $out"
 
-# The monitor prints the progress line and decides when the run is over.
-"$bin/monitor" --lcm-url "$url" --lcm-bulk-url "$bulk_url" --run-id "$run_id" --goal "$goal" \
-  --time-budget "$time_budget" | tee "$out/logs/monitor.log" &
+# The monitor prints the progress line and decides when the run is over. It writes its own pid
+# (exec keeps the subshell's) so that the pids file names every process of the run.
+{
+  echo "monitor $BASHPID" >> "$out/pids"
+  exec "$bin/monitor" --lcm-url "$url" --lcm-bulk-url "$bulk_url" --run-id "$run_id" \
+    --goal "$goal" --time-budget "$time_budget"
+} | tee "$out/logs/monitor.log" &
 monitor_pid=$!
 set +e
 wait "$monitor_pid"
@@ -195,7 +199,7 @@ set -e
 status=$(grep -q 'goal reached' "$out/logs/monitor.log" && echo 0 || echo 1)
 stop_all
 
-best=$(awk -F'"mean":' 'NF>1{split($2,a,","); if(a[1]+0>b||n==0){b=a[1]+0}; n++} END{if(n) printf "%.1f over %d evaluations", b, n}' "$out/eval.jsonl" 2>/dev/null || true)
+best=$(awk -F'"mean":' 'NF>1{split($2,a,","); if(a[1]+0>b||n==0){b=a[1]+0}; n++} END{if(n) printf (b > -10 && b < 10 ? "%.2f" : "%.1f") " over %d evaluations", b, n}' "$out/eval.jsonl" 2>/dev/null || true)
 echo "launch: run folder $out"
 echo "launch: report $out/report/index.html"
 [ -z "$best" ] || echo "launch: best evaluation mean $best"

@@ -5,6 +5,7 @@
 // out, 3 when the replay, the learner or the evaluator went silent, 130 on SIGINT/SIGTERM.
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <string>
@@ -34,11 +35,23 @@ struct View {
   bool goal_reached = false;
 };
 
+// 1234567 -> "1,234,567" (appending: GCC 12 warns falsely about string::insert here).
 std::string Thousands(int64_t v) {
-  std::string s = std::to_string(v);
-  for (int i = static_cast<int>(s.size()) - 3; i > (v < 0 ? 1 : 0); i -= 3)
-    s.insert(static_cast<size_t>(i), ",");
-  return s;
+  const std::string digits = std::to_string(v);
+  const std::size_t first = v < 0 ? 1 : 0;  // after the sign
+  std::string out = digits.substr(0, first);
+  for (std::size_t i = first; i < digits.size(); ++i) {
+    if (i > first && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return out;
+}
+
+// A return: two decimals below 10 (grasp success rates such as 0.36), else one.
+std::string Score(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), std::abs(v) < 10 ? "%.2f" : "%.1f", v);
+  return buf;
 }
 
 std::string ProgressLine(const View& v, double elapsed, double now) {
@@ -61,19 +74,19 @@ std::string ProgressLine(const View& v, double elapsed, double now) {
              v.learner.dropped_malformed + v.learner.dropped_foreign + v.learner.dropped_invalid +
              v.evaluator.dropped_malformed + v.evaluator.dropped_foreign +
              v.evaluator.dropped_invalid;
-  char eval[96] = "eval -";
+  std::string eval = "eval -";
   if (v.have_eval) {
-    std::snprintf(eval, sizeof(eval), "eval %.1f (best %.1f)", v.last_eval.mean, v.best_eval);
+    eval = "eval " + Score(v.last_eval.mean) + " (best " + Score(v.best_eval) + ")";
   }
   char line[512];
   std::snprintf(line, sizeof(line),
-                "[%6.1fs] steps %s  episodes %s  return %.1f  %s  learner %.0f upd/s (%s)  "
+                "[%6.1fs] steps %s  episodes %s  return %s  %s  learner %.0f upd/s (%s)  "
                 "replay %s  actors %d%s  lost %lld  dropped %lld",
                 elapsed, Thousands(steps).c_str(), Thousands(episodes).c_str(),
-                live > 0 ? ret / live : 0.0, eval, v.learner.updates_per_second,
-                Thousands(v.learner.updates).c_str(), Thousands(v.replay.size).c_str(), live,
-                paused > 0 ? " (paused)" : "", static_cast<long long>(lost),
-                static_cast<long long>(dropped));
+                Score(live > 0 ? ret / live : 0.0).c_str(), eval.c_str(),
+                v.learner.updates_per_second, Thousands(v.learner.updates).c_str(),
+                Thousands(v.replay.size).c_str(), live, paused > 0 ? " (paused)" : "",
+                static_cast<long long>(lost), static_cast<long long>(dropped));
   return line;
 }
 
@@ -128,9 +141,10 @@ int Main(int argc, char** argv) {
     v.have_eval = true;
     v.last_eval = e;
     v.best_eval = std::max(v.best_eval, e.mean);
-    std::printf("evaluation: update %lld, env steps %lld: mean %.1f +- %.1f over %d episodes%s\n",
-                static_cast<long long>(e.update), static_cast<long long>(e.env_steps), e.mean,
-                e.std, e.episodes, e.mean >= goal ? " -- goal reached" : "");
+    std::printf("evaluation: update %lld, env steps %lld: mean %s +- %s over %d episodes%s\n",
+                static_cast<long long>(e.update), static_cast<long long>(e.env_steps),
+                Score(e.mean).c_str(), Score(e.std).c_str(), e.episodes,
+                e.mean >= goal ? " -- goal reached" : "");
     std::fflush(stdout);
     if (e.mean >= goal) v.goal_reached = true;
   });

@@ -333,6 +333,9 @@ TEST(EvaluatorConfigTest, RejectsBadSettings) {
   c = EvaluatorConfig();
   c.epsilon = 2;
   EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = EvaluatorConfig();
+  c.gamma = 1.01;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
 }
 
 TEST(ScoreCheckpointFileTest, ReadsTheMetadataAndRefusesATruncatedFile) {
@@ -344,6 +347,10 @@ TEST(ScoreCheckpointFileTest, ReadsTheMetadataAndRefusesATruncatedFile) {
   EXPECT_EQ(r.update, 9);
   EXPECT_EQ(r.env_steps, 36);
   EXPECT_EQ(r.episodes, 3);
+  // The network's values of the actions taken, against the returns of the (short) episodes.
+  EXPECT_GT(r.value_steps, 3);
+  EXPECT_DOUBLE_EQ(r.value_estimate, 1.0);
+  EXPECT_GT(r.value_return, 1.0);
   std::filesystem::resize_file(path, std::filesystem::file_size(path) - 7);
   EXPECT_THROW(ScoreCheckpointFile(path, "CartPole-v1", 3, 0.0, 1000), std::runtime_error);
 }

@@ -48,17 +48,27 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   a.wall_seconds = 0.1;
   EvalRecord b = Record("odd \"name\" \\ tab\t\xC3\xA9.bin", 2000, 475.25);
   b.min = -1e-300;
-  AppendJsonLine(path, a);
-  AppendJsonLine(path, b);
+  // With value estimates, one of them without a correlation (written as null).
+  EvalRecord c = Record("c.bin", 3000, 0.36);
+  c.value_steps = 1234;
+  c.value_estimate = 0.291;
+  c.value_return = 0.2705;
+  c.value_correlation = -0.125;
+  EvalRecord d = c;
+  d.value_correlation.reset();
+  for (const EvalRecord& r : {a, b, c, d}) AppendJsonLine(path, r);
 
   const std::string text = ReadFile(path);
-  EXPECT_EQ(CountOccurrences(text, "\n"), 2);
+  EXPECT_EQ(CountOccurrences(text, "\n"), 4);
+  EXPECT_EQ(CountOccurrences(text, "\"value_correlation\": null"), 1);
   int skipped = -1;
   const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
   EXPECT_EQ(skipped, 0);
-  ASSERT_EQ(back.size(), 2U);
+  ASSERT_EQ(back.size(), 4U);
   EXPECT_EQ(back[0], a);
   EXPECT_EQ(back[1], b);
+  EXPECT_EQ(back[2], c);
+  EXPECT_EQ(back[3], d);
 }
 
 TEST(JsonLinesTest, ALineHasTheDocumentedFields) {
@@ -162,6 +172,26 @@ TEST(ReportTest, WritesIndexWithOneRowPerCheckpointNewestFirstAndBothCurves) {
   for (const auto& entry : std::filesystem::directory_iterator(report)) {
     EXPECT_NE(entry.path().extension(), ".tmp") << entry.path();
   }
+}
+
+TEST(ReportTest, ShowsValueEstimatesOnlyWhenMeasuredAndSmallScoresWithTwoDecimals) {
+  TempDir dir;
+  const std::string report = dir / "report";
+  WriteReport(report, {Record("a.bin", 1000, 0.36)}, Info(0.6));
+  std::string html = ReadFile(report + "/index.html");
+  EXPECT_NE(html.find(">0.36<"), std::string::npos);  // not rounded to 0.4
+  EXPECT_EQ(html.find("<th>Q</th>"), std::string::npos);
+
+  EvalRecord r = Record("b.bin", 2000, 0.46);
+  r.value_steps = 700;
+  r.value_estimate = 0.412;
+  r.value_return = 0.305;
+  r.value_correlation = 0.2349;
+  WriteReport(report, {Record("a.bin", 1000, 0.36), r}, Info(0.6));
+  html = ReadFile(report + "/index.html");
+  EXPECT_NE(html.find("<th>Q</th><th>G</th><th>r</th>"), std::string::npos);
+  EXPECT_NE(html.find("<td>0.41</td><td>0.30</td><td>0.23</td>"), std::string::npos);
+  EXPECT_NE(html.find("van Hasselt"), std::string::npos);
 }
 
 TEST(ReportTest, SaysWhenAndWhereTheGoalWasFirstReached) {

@@ -149,6 +149,75 @@ TEST(ScorerTest, RefusesBadArgumentsAndANetworkThatDoesNotFitTheEnv) {
   EXPECT_THROW(ScoreGreedyPolicy(out_of_range, kEnv, 1, 0.0, 1), std::invalid_argument);
 }
 
+TEST(ScorerTest, CorrelationIsPearsonsAndUndefinedForAConstantSeries) {
+  const std::vector<double> x = {1, 2, 3, 4};
+  EXPECT_NEAR(Correlation(x, std::vector<double>{3, 5, 7, 9}), 1.0, 1e-12);
+  EXPECT_NEAR(Correlation(x, std::vector<double>{8, 6, 4, 2}), -1.0, 1e-12);
+  EXPECT_NEAR(Correlation(x, std::vector<double>{1, 3, 2, 4}), 0.8, 1e-12);
+  EXPECT_TRUE(std::isnan(Correlation(x, std::vector<double>{5, 5, 5, 5})));
+  EXPECT_TRUE(std::isnan(Correlation(std::vector<double>{1}, std::vector<double>{2})));
+}
+
+TEST(ScorerTest, ComparesTheValueOfEveryActionTakenWithTheDiscountedReturnThatFollowed) {
+  // Q = (0, 1) everywhere: action 1 is taken, valued 1, and the pole falls within a few steps
+  // (terminated episodes: every step counts).
+  nn::Sequential net = AlwaysChooses(1);
+  constexpr double kGamma = 0.9;
+  const EvalScore score = ScorePolicy(&net, kEnv, 6, /*epsilon=*/0.0, 77, kGamma);
+  ASSERT_TRUE(score.values.has_value());
+  // CartPole rewards 1 per step: an episode of T steps has the returns (1 - gamma^(T-t)) /
+  // (1 - gamma) from its steps t = 0 .. T-1.
+  int64_t steps = 0;
+  double sum = 0;
+  for (double length : PlayByHand(1, 6, 77)) {
+    for (int t = 0; t < static_cast<int>(length); ++t) {
+      sum += (1 - std::pow(kGamma, length - t)) / (1 - kGamma);
+      ++steps;
+    }
+  }
+  EXPECT_EQ(score.values->steps, steps);
+  EXPECT_DOUBLE_EQ(score.values->estimate, 1.0);
+  EXPECT_NEAR(score.values->actual, sum / static_cast<double>(steps), 1e-9);
+  EXPECT_TRUE(std::isnan(score.values->correlation));  // the estimates are constant
+  // A policy without values has no calibration.
+  const GreedyPolicy greedy = [](std::span<const float>) { return 1; };
+  EXPECT_FALSE(ScoreGreedyPolicy(greedy, kEnv, 2, 0.0, 77).values.has_value());
+}
+
+TEST(ScorerTest, OfAnEpisodeCutByItsTimeLimitOnlyStepsFarFromTheCutCount) {
+  // A balancing controller keeps the pole up for all 500 steps, so every episode is truncated.
+  // With gamma 0.99 the unseen rest weighs 0.99^(500 - t): at most 0.01 for t <= 41 (0.99^459 =
+  // 0.00995, 0.99^458 = 0.01005), so 42 steps of each episode count. The values are the pole
+  // angle's cosine, which tracks nothing of the return here but is not constant.
+  std::vector<float> q(2);
+  const ActionValues balance = [&q](std::span<const float> obs) {
+    const float push = obs[2] + 0.5f * obs[3] + 0.01f * obs[0] + 0.1f * obs[1];
+    q[0] = push > 0 ? 0.0f : std::cos(obs[2]);
+    q[1] = push > 0 ? std::cos(obs[2]) : 0.0f;
+    return std::span<const float>(q);
+  };
+  const EvalScore score = ScoreActionValues(balance, kEnv, 3, 0.0, 0.99, 5);
+  ASSERT_EQ(score.returns, (std::vector<double>{500, 500, 500}));
+  ASSERT_TRUE(score.values.has_value());
+  EXPECT_EQ(score.values->steps, 3 * 42);
+  // Those steps' returns: (1 - 0.99^(500 - t)) / 0.01 for t = 0 .. 41, between 99.0 and 99.4.
+  EXPECT_GT(score.values->actual, 99.0);
+  EXPECT_LT(score.values->actual, 99.4);
+  EXPECT_GT(score.values->estimate, 0.9);
+  EXPECT_LE(score.values->estimate, 1.0);
+}
+
+TEST(ScorerTest, RefusesAGammaOutsideTheUnitIntervalAndValuesOfTheWrongLength) {
+  nn::Sequential net = AlwaysChooses(0);
+  EXPECT_THROW(ScorePolicy(&net, kEnv, 1, 0.0, 1, 1.5), std::invalid_argument);
+  EXPECT_THROW(ScorePolicy(&net, kEnv, 1, 0.0, 1, -0.1), std::invalid_argument);
+  std::vector<float> three(3, 0.0f);
+  const ActionValues wrong = [&three](std::span<const float>) {
+    return std::span<const float>(three);
+  };
+  EXPECT_THROW(ScoreActionValues(wrong, kEnv, 1, 0.0, 0.99, 1), std::invalid_argument);
+}
+
 TEST(ScorerTest, TheDefaultSeedBaseIsFarFromTrainingSeeds) {
   EXPECT_EQ(kDefaultEvalSeedBase, 1'000'000'000U);
   EXPECT_DOUBLE_EQ(kDefaultEvalEpsilon, 0.05);

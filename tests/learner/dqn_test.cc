@@ -211,12 +211,96 @@ TEST(DqnTest, APixelBatchTrainsLikeTheSameBatchOfFloats) {
   EXPECT_THROW(from_bytes.Update(b), std::invalid_argument);  // no observations at all
 }
 
+// A pixel batch of n observations: 2 frames of 3 x 3 bytes each.
+struct PixelBatch {
+  std::vector<uint8_t> obs, next_obs;
+  std::vector<int32_t> action;
+  std::vector<float> reward, discount;
+  BatchView view() const {
+    BatchView b;
+    b.obs_size = 18;
+    b.count = static_cast<int>(action.size());
+    b.frame_height = 3;
+    b.frame_width = 3;
+    b.obs_pixels = obs.data();
+    b.next_obs_pixels = next_obs.data();
+    b.action = action.data();
+    b.reward = reward.data();
+    b.discount = discount.data();
+    return b;
+  }
+};
+
+// Flat frames (every pixel of an observation alike) when `flat`, else random bytes.
+PixelBatch MakePixelBatch(bool flat, std::mt19937* rng) {
+  constexpr int n = 8;
+  std::uniform_int_distribution<int> byte(0, 255);
+  PixelBatch p;
+  for (int i = 0; i < n; ++i) {
+    for (std::vector<uint8_t>* v : {&p.obs, &p.next_obs}) {
+      const int level = byte(*rng);
+      for (int k = 0; k < 18; ++k) v->push_back(static_cast<uint8_t>(flat ? level : byte(*rng)));
+    }
+    p.action.push_back(i % 3);
+    p.reward.push_back(0.5f);
+    p.discount.push_back(0.9f);
+  }
+  return p;
+}
+
+std::vector<float> TrainThree(const DqnConfig& c, const PixelBatch& p) {
+  Dqn dqn(18, 3, c);
+  for (int i = 0; i < 3; ++i) dqn.Update(p.view());
+  std::vector<float> flat;
+  dqn.online().GetFlat(&flat);
+  return flat;
+}
+
+TEST(DqnTest, RandomShiftsMoveThePixelsAndNothingElse) {
+  DqnConfig plain;
+  plain.network = "conv2d(2,4,3,1,1,3,3),relu,flatten,linear(36,3)";
+  plain.seed = 5;
+  DqnConfig shifted = plain;
+  shifted.augment_shift = 1;
+  std::mt19937 rng(9);
+  // A shift leaves a flat frame as it is (the edges repeat), so training is the same.
+  const PixelBatch flat = MakePixelBatch(true, &rng);
+  EXPECT_EQ(TrainThree(shifted, flat), TrainThree(plain, flat));
+  // On random frames the shifts change what the network sees, the same way for the same seed.
+  const PixelBatch noise = MakePixelBatch(false, &rng);
+  EXPECT_NE(TrainThree(shifted, noise), TrainThree(plain, noise));
+  EXPECT_EQ(TrainThree(shifted, noise), TrainThree(shifted, noise));
+}
+
+TEST(DqnTest, RandomShiftsNeedPixelBatchesWithTheirFrameSize) {
+  DqnConfig c;
+  c.network = "conv2d(2,4,3,1,1,3,3),relu,flatten,linear(36,3)";
+  c.augment_shift = 2;
+  Dqn dqn(18, 3, c);
+  std::mt19937 rng(1);
+  const PixelBatch p = MakePixelBatch(false, &rng);
+  BatchView no_size = p.view();
+  no_size.frame_height = 0;
+  EXPECT_THROW(dqn.Update(no_size), std::invalid_argument);
+  std::vector<float> floats(18 * 8, 0.5f);
+  BatchView of_floats = p.view();
+  of_floats.obs_pixels = nullptr;
+  of_floats.next_obs_pixels = nullptr;
+  of_floats.obs = floats.data();
+  of_floats.next_obs = floats.data();
+  EXPECT_THROW(dqn.Update(of_floats), std::invalid_argument);
+  EXPECT_NO_THROW(dqn.Update(p.view()));
+}
+
 TEST(DqnConfigTest, RefusesBadSettings) {
   DqnConfig c;
   c.optimizer = "sgd";
   EXPECT_THROW(c.Validate(), std::invalid_argument);
   c = DqnConfig();
   c.tau = 0;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = DqnConfig();
+  c.augment_shift = -1;
   EXPECT_THROW(c.Validate(), std::invalid_argument);
 }
 

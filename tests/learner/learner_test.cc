@@ -171,6 +171,8 @@ TEST_F(LearnerTest, TrainsOnPixelBatchesAndSendsTheirTdErrorsAsPriorities) {
   LearnerConfig c;
   c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)";
   c.dqn.network = "conv2d(2,4,3,1,1,10,5),relu,flatten,linear(200,3)";
+  // Random shifts need the frame size, which comes with each message (Dqn throws without it).
+  c.dqn.augment_shift = 2;
   c.batch_size = 16;
   c.max_updates = 20;
   c.checkpoint_every = 100;
@@ -220,6 +222,13 @@ TEST(LearnerConfigTest, RefusesBadSettings) {
   LearnerConfig c;
   c.requests_in_flight = 0;
   EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
+TEST_F(LearnerTest, RefusesRandomShiftsForAnEnvWithoutPixels) {
+  LearnerConfig c;
+  c.dqn.augment_shift = 4;
+  c.out_dir = dir_.string();
+  EXPECT_THROW(Learner(c, bus_.get()), std::invalid_argument);
 }
 
 }  // namespace

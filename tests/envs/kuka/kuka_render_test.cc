@@ -19,8 +19,10 @@ bool IsWhite(const std::vector<uint8_t>& rgb, int i) {
   return rgb[3 * i] == 255 && rgb[3 * i + 1] == 255 && rgb[3 * i + 2] == 255;
 }
 
-double Luma(const std::vector<uint8_t>& rgb, int i) {
-  return 0.299 * rgb[3 * i] + 0.587 * rgb[3 * i + 1] + 0.114 * rgb[3 * i + 2];
+// Luma of pixel i in grey levels (0..255); Luma is linear, so the colour's weights apply as is.
+double PixelLuma(const std::vector<uint8_t>& rgb, int i) {
+  return Luma({static_cast<float>(rgb[3 * i]), static_cast<float>(rgb[3 * i + 1]),
+               static_cast<float>(rgb[3 * i + 2])});
 }
 
 int CountDifferentPixels(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
@@ -152,7 +154,7 @@ TEST(KukaRenderTest, GripperStandsOutFromTheTrayInGrayscale) {
       int covered = 0;
       for (int i = 0; i < kSize * kSize; ++i) {
         if (IsWhite(alone, i) || IsWhite(hidden, i)) continue;
-        sum += std::abs(Luma(full, i) - Luma(hidden, i));
+        sum += std::abs(PixelLuma(full, i) - PixelLuma(hidden, i));
         ++covered;
       }
       ASSERT_GT(covered, 5) << "seed " << seed << " step " << step;
