@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <numeric>
 #include <stdexcept>
+#include <type_traits>
+#include <utility>
 
 #include "common/channels.h"
 #include "common/clock.h"
@@ -34,44 +36,37 @@ uint64_t TrainingSeed(uint64_t run_seed, int actor_id, int env_index) {
          static_cast<uint64_t>(env_index);
 }
 
-Actor::Actor(ActorConfig config, Bus* bus)
-    : config_(std::move(config)),
-      bus_(bus),
-      rng_(TrainingSeed(config_.seed, config_.actor_id, 99)) {
+Actor::Actor(ActorConfig config, Bus* bus) : config_(std::move(config)), bus_(bus) {
   config_.Validate();
   for (int j = 0; j < config_.envs_per_actor; ++j) {
     auto env = envs::MakeEnv(config_.env_id);
-    if (env->spec().action_dim > 0 || env->spec().num_actions < 1) {
-      throw std::invalid_argument(config_.env_id +
-                                  " has continuous actions; the DQN actor needs discrete ones");
-    }
-    const envs::EnvSpec& spec = env->spec();
-    obs_size_ = spec.observation_size;
-    num_actions_ = spec.num_actions;
-    pixels_ = spec.frame_stack > 0;
+    spec_ = env->spec();
+    pixels_ = spec_.frame_stack > 0;
     env->Reset(TrainingSeed(config_.seed, config_.actor_id, j));
     auto o = env->observation();
     // A pixel env's transitions are frame ids: the float accumulator only needs a token size.
-    const int nstep_size = pixels_ ? 1 : obs_size_;
-    const int stack = std::max(1, spec.frame_stack);
+    const int nstep_size = pixels_ ? 1 : spec_.observation_size;
+    const int stack = std::max(1, spec_.frame_stack);
+    const int width = spec_.action_width();
     slots_.push_back(EnvSlot{std::move(env), std::vector<float>(o.begin(), o.end()),
-                             NStepAccumulator(config_.n_step, config_.gamma, nstep_size), 0.0, 0,
+                             std::vector<float>(static_cast<size_t>(width)),
+                             NStepAccumulator(config_.n_step, config_.gamma, nstep_size, width),
+                             0.0, 0, std::vector<int64_t>(static_cast<size_t>(stack)),
                              std::vector<int64_t>(static_cast<size_t>(stack)),
-                             std::vector<int64_t>(static_cast<size_t>(stack)),
-                             FrameNStepAccumulator(config_.n_step, config_.gamma, stack)});
-    if (pixels_) {
-      pixel_batch_.height = spec.frame_height;
-      pixel_batch_.width = spec.frame_width;
-      pixel_batch_.stack = spec.frame_stack;
-      StartStack(&slots_.back());
-    }
+                             FrameNStepAccumulator(config_.n_step, config_.gamma, stack, width)});
+    if (pixels_) StartStack(&slots_.back());
   }
-  pixel_batch_.actor_id = config_.actor_id;
-  random_action_ = std::uniform_int_distribution<int>(0, num_actions_ - 1);
-  epsilon_ = config_.exploration.Epsilon(config_.actor_id, config_.num_actors, 0);
-  annealed_ = config_.exploration.mode == "linear";
+  policy_ = MakePolicy(spec_, config_.exploration, config_.actor_id, config_.num_actors,
+                       TrainingSeed(config_.seed, config_.actor_id, 99));
   batch_.actor_id = config_.actor_id;
-  batch_.obs_size = obs_size_;
+  batch_.action_width = spec_.action_width();
+  if (pixels_) {
+    batch_.height = spec_.frame_height;
+    batch_.width = spec_.frame_width;
+    batch_.stack = spec_.frame_stack;
+  } else {
+    batch_.obs_size = spec_.observation_size;
+  }
 
   bus_->Subscribe<rlmsg::weights_chunk_t>(
       channels::kWeights, [this](const rlmsg::weights_chunk_t& c) { OnWeights(c); }, Port::kBulk);
@@ -84,56 +79,65 @@ void Actor::OnWeights(const rlmsg::weights_chunk_t& chunk) {
   if (!assembler_.Add(chunk)) return;
   std::optional<Weights> w = assembler_.Take();
   if (!w) return;
-  if (w->architecture != net_.Architecture()) {
-    std::mt19937 init_rng(0);
-    nn::Sequential net = nn::BuildFromArchitecture(w->architecture, &init_rng);
-    if (net.InputSize() != obs_size_ || net.OutputSize() != num_actions_) {
+  if (!policy_->has_network() || w->architecture != policy_->network().Architecture()) {
+    std::string why;
+    try {
+      std::mt19937 init_rng(0);
+      nn::Sequential net = nn::BuildFromArchitecture(w->architecture, &init_rng);
+      why = policy_->CheckNetwork(net);
+      if (why.empty()) policy_->SetNetwork(std::move(net));
+    } catch (const std::invalid_argument& e) {
+      why = e.what();
+    }
+    if (!why.empty()) {
       ++weights_refused_;
-      std::fprintf(stderr, "[actor-%d] refused weights '%s': the env has %d inputs, %d actions\n",
-                   config_.actor_id, w->architecture.c_str(), obs_size_, num_actions_);
+      std::fprintf(stderr, "[actor-%d] refused weights '%s': %s\n", config_.actor_id,
+                   w->architecture.c_str(), why.c_str());
       return;
     }
-    net_ = std::move(net);
   }
-  net_.SetFlat(w->params.data(), w->params.size());
+  policy_->network().SetFlat(w->params.data(), w->params.size());
   weights_version_ = w->version;
 }
 
-int Actor::SelectAction(const std::vector<float>& obs) {
-  if (weights_version_ < 0 || unit_(rng_) < epsilon_) return random_action_(rng_);
-  return net_.Argmax(obs.data(), obs_size_);
-}
-
-void Actor::Append(const Transition& t, int64_t episode_id) {
-  batch_.obs.insert(batch_.obs.end(), t.obs.begin(), t.obs.end());
-  batch_.next_obs.insert(batch_.next_obs.end(), t.next_obs.begin(), t.next_obs.end());
-  batch_.action.push_back(t.action);
+template <class T>
+void Actor::Append(const BasicTransition<T>& t, int64_t episode_id) {
+  if constexpr (std::is_same_v<T, int64_t>) {
+    batch_.obs_frames.insert(batch_.obs_frames.end(), t.obs.begin(), t.obs.end());
+    batch_.next_obs_frames.insert(batch_.next_obs_frames.end(), t.next_obs.begin(),
+                                  t.next_obs.end());
+  } else {
+    batch_.obs.insert(batch_.obs.end(), t.obs.begin(), t.obs.end());
+    batch_.next_obs.insert(batch_.next_obs.end(), t.next_obs.begin(), t.next_obs.end());
+  }
+  batch_.action.insert(batch_.action.end(), t.action.begin(), t.action.end());
   batch_.reward.push_back(t.reward);
   batch_.discount.push_back(t.discount);
   batch_.episode_id.push_back(episode_id);
   batch_.priority.push_back(0.0f);
-  if (static_cast<int>(batch_.action.size()) >= config_.batch_size) PublishBatch();
+  if (static_cast<int>(batch_.reward.size()) >= config_.batch_size) PublishBatch();
 }
 
 void Actor::PublishBatch() {
-  batch_.count = static_cast<int32_t>(batch_.action.size());
-  if (batch_.count == 0) return;
-  batch_.num_values = batch_.count * obs_size_;
-  bus_->Publish(channels::kTransitions, &batch_);
-  published_ += batch_.count;
-  batch_.obs.clear();
-  batch_.next_obs.clear();
-  batch_.action.clear();
-  batch_.reward.clear();
-  batch_.discount.clear();
-  batch_.episode_id.clear();
-  batch_.priority.clear();
+  rlmsg::transition_batch_t& b = batch_;
+  b.count = static_cast<int32_t>(b.reward.size());
+  b.num_values = static_cast<int32_t>(b.obs.size());
+  b.num_frames = static_cast<int32_t>(b.frame_id.size());
+  b.num_bytes = static_cast<int32_t>(b.frames.size());
+  b.num_refs = static_cast<int32_t>(b.obs_frames.size());
+  b.num_action_values = static_cast<int32_t>(b.action.size());
+  if (b.count == 0 && b.num_frames == 0) return;
+  bus_->Publish(channels::kTransitions, &b);
+  published_ += b.count;
+  for (auto* v : {&b.obs, &b.next_obs, &b.action, &b.reward, &b.discount, &b.priority}) v->clear();
+  for (auto* v : {&b.frame_id, &b.obs_frames, &b.next_obs_frames, &b.episode_id}) v->clear();
+  b.frames.clear();
 }
 
 int64_t Actor::AddFrame(const envs::Env& env) {
   const std::span<const uint8_t> f = env.frame();
-  pixel_batch_.frames.insert(pixel_batch_.frames.end(), f.begin(), f.end());
-  pixel_batch_.frame_id.push_back(next_frame_id_);
+  batch_.frames.insert(batch_.frames.end(), f.begin(), f.end());
+  batch_.frame_id.push_back(next_frame_id_);
   return next_frame_id_++;
 }
 
@@ -143,42 +147,10 @@ void Actor::StartStack(EnvSlot* s) {
   std::fill(s->stack_ids.begin(), s->stack_ids.end(), id);
 }
 
-void Actor::AppendPixels(const FrameTransition& t, int64_t episode_id) {
-  pixel_batch_.obs_frames.insert(pixel_batch_.obs_frames.end(), t.obs.begin(), t.obs.end());
-  pixel_batch_.next_obs_frames.insert(pixel_batch_.next_obs_frames.end(), t.next_obs.begin(),
-                                      t.next_obs.end());
-  pixel_batch_.action.push_back(t.action);
-  pixel_batch_.reward.push_back(t.reward);
-  pixel_batch_.discount.push_back(t.discount);
-  pixel_batch_.episode_id.push_back(episode_id);
-  pixel_batch_.priority.push_back(0.0f);
-  if (static_cast<int>(pixel_batch_.action.size()) >= config_.batch_size) PublishPixelBatch();
-}
-
-void Actor::PublishPixelBatch() {
-  rlmsg::pixel_batch_t& b = pixel_batch_;
-  b.num_frames = static_cast<int32_t>(b.frame_id.size());
-  b.num_bytes = static_cast<int32_t>(b.frames.size());
-  b.count = static_cast<int32_t>(b.action.size());
-  b.num_refs = static_cast<int32_t>(b.obs_frames.size());
-  if (b.count == 0 && b.num_frames == 0) return;
-  bus_->Publish(channels::kPixelTransitions, &b);
-  published_ += b.count;
-  b.frame_id.clear();
-  b.frames.clear();
-  b.obs_frames.clear();
-  b.next_obs_frames.clear();
-  b.action.clear();
-  b.reward.clear();
-  b.discount.clear();
-  b.episode_id.clear();
-  b.priority.clear();
-}
-
 int Actor::StepEnvs() {
   for (EnvSlot& s : slots_) {
-    const int action = SelectAction(s.obs);
-    const envs::StepResult r = s.env->Step(action);
+    policy_->Act(s.obs, env_steps_, s.action);
+    const envs::StepResult r = s.env->Act(s.action);
     const std::span<const float> next = s.env->observation();
     s.episode_return += r.reward;
     const double reward = config_.clip_rewards ? std::clamp(r.reward, -1.0, 1.0) : r.reward;
@@ -187,12 +159,11 @@ int Actor::StepEnvs() {
       // The new stack: the old one shifted by one, then the new frame.
       std::copy(s.stack_ids.begin() + 1, s.stack_ids.end(), s.next_stack_ids.begin());
       s.next_stack_ids.back() = AddFrame(*s.env);
-      s.frame_nstep.Add(
-          s.stack_ids, action, reward, s.next_stack_ids, r.terminated, r.truncated,
-          [this, episode_id](const FrameTransition& t) { AppendPixels(t, episode_id); });
+      s.frame_nstep.Add(s.stack_ids, s.action, reward, s.next_stack_ids, r.terminated, r.truncated,
+                        [this, episode_id](const FrameTransition& t) { Append(t, episode_id); });
       s.stack_ids.swap(s.next_stack_ids);
     } else {
-      s.nstep.Add(s.obs, action, reward, next, r.terminated, r.truncated,
+      s.nstep.Add(s.obs, s.action, reward, next, r.terminated, r.truncated,
                   [this, episode_id](const Transition& t) { Append(t, episode_id); });
     }
     if (r.terminated || r.truncated) {
@@ -210,9 +181,6 @@ int Actor::StepEnvs() {
     }
   }
   env_steps_ += static_cast<int64_t>(slots_.size());
-  if (annealed_) {
-    epsilon_ = config_.exploration.Epsilon(config_.actor_id, config_.num_actors, env_steps_);
-  }
   return static_cast<int>(slots_.size());
 }
 
@@ -235,7 +203,7 @@ void Actor::PublishStats() {
   stats_last_time_ = now;
   stats_last_steps_ = env_steps_;
   s.mean_return = mean_return();
-  s.epsilon = epsilon_;
+  s.epsilon = exploration();
   s.weights_version = weights_version_;
   s.paused = insert_allowed_ ? 0 : 1;
   s.transitions_published = published_;
@@ -263,20 +231,16 @@ void Actor::Run() {
       next_stats = now + stats_period;
     }
     if (now >= next_log) {
-      std::printf(
-          "actor-%d: steps %lld episodes %lld mean return %.1f epsilon %.4f weights %lld%s\n",
-          config_.actor_id, static_cast<long long>(env_steps_), static_cast<long long>(episodes_),
-          mean_return(), epsilon_, static_cast<long long>(weights_version_),
-          insert_allowed_ ? "" : " (paused)");
+      std::printf("actor-%d: steps %lld episodes %lld mean return %.1f %s %.4f weights %lld%s\n",
+                  config_.actor_id, static_cast<long long>(env_steps_),
+                  static_cast<long long>(episodes_), mean_return(),
+                  spec_.continuous() ? "sigma" : "epsilon", exploration(),
+                  static_cast<long long>(weights_version_), insert_allowed_ ? "" : " (paused)");
       std::fflush(stdout);
       next_log = now + 5.0;
     }
   }
-  if (pixels_) {
-    PublishPixelBatch();
-  } else {
-    PublishBatch();
-  }
+  PublishBatch();
   PublishStats();
 }
 

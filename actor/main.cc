@@ -28,7 +28,9 @@ int Main(int argc, char** argv) {
       ("n-step", rl::po::value(&c.n_step)->default_value(c.n_step), "n of the n-step returns")  //
       ("gamma", rl::po::value(&c.gamma)->default_value(c.gamma), "discount factor")             //
       ("exploration", rl::po::value(&e.mode)->default_value(e.mode),
-       "apex (constant epsilon_i = base^(1 + alpha i/(N-1))), linear (annealed), constant")  //
+       "discrete actions (epsilon-greedy): apex (constant epsilon_i = base^(1 + alpha "
+       "i/(N-1))), linear (annealed), constant; continuous actions: gaussian (noise on the "
+       "actor network's action, clipped to the bounds)")  //
       ("apex-base", rl::po::value(&e.apex_base)->default_value(e.apex_base),
        "Ape-X base epsilon")  //
       ("apex-alpha", rl::po::value(&e.apex_alpha)->default_value(e.apex_alpha),
@@ -39,6 +41,18 @@ int Main(int argc, char** argv) {
        "linear: final epsilon; constant: the epsilon")  //
       ("epsilon-anneal-steps", rl::po::value(&e.anneal_steps)->default_value(e.anneal_steps),
        "linear: steps from start to end")  //
+      ("sigma", rl::po::value(&e.sigma)->default_value(e.sigma),
+       "gaussian: noise standard deviation, relative to each dimension's half-range (TD3: "
+       "0.1)")  //
+      ("sigma-end", rl::po::value(&e.sigma_end)->default_value(e.sigma_end),
+       "gaussian: final noise scale when annealed")  //
+      ("sigma-anneal-steps",
+       rl::po::value(&e.sigma_anneal_steps)->default_value(e.sigma_anneal_steps),
+       "gaussian: steps of this actor from sigma to sigma-end (0: sigma throughout)")  //
+      ("noise-spread", rl::po::value(&e.noise_spread)->default_value(e.noise_spread),
+       "gaussian: actor i of N uses sigma * spread^(i/(N-1)) (1: every actor alike)")  //
+      ("start-steps", rl::po::value(&e.start_steps)->default_value(e.start_steps),
+       "gaussian: uniform random actions for this actor's first steps")  //
       ("stats-hz", rl::po::value(&c.stats_hz)->default_value(c.stats_hz),
        "stats messages per second")  //
       ("clip-rewards", rl::po::value(&c.clip_rewards)->default_value(c.clip_rewards),
@@ -49,15 +63,25 @@ int Main(int argc, char** argv) {
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "actor",
                         "Usage: actor [options]\n"
-                        "Runs environments with an epsilon-greedy policy and publishes their "
+                        "Runs environments with an exploring policy (epsilon-greedy for discrete "
+                        "actions, Gaussian noise for continuous ones) and publishes their "
                         "transitions to the replay daemon over LCM.",
                         desc, &vm)) {
     return 0;
   }
+  if (e.gaussian()) {
+    rl::RefuseGiven(
+        vm, {"apex-base", "apex-alpha", "epsilon-start", "epsilon-end", "epsilon-anneal-steps"},
+        "exploration is gaussian, and it is an epsilon-greedy option");
+  } else {
+    rl::RefuseGiven(vm, {"sigma", "sigma-end", "sigma-anneal-steps", "noise-spread", "start-steps"},
+                    "exploration is " + e.mode + " (epsilon-greedy), and it is a gaussian option");
+  }
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("actor-" + std::to_string(c.actor_id)));
   rl::actor::Actor actor(c, &bus);
-  std::printf("actor-%d: ready (epsilon %.5f)\n", c.actor_id, actor.epsilon());
+  std::printf("actor-%d: ready (%s %.5f)\n", c.actor_id, e.gaussian() ? "sigma" : "epsilon",
+              actor.exploration());
   std::fflush(stdout);
   actor.Run();
   std::printf("actor-%d: stopped after %lld steps, %lld episodes, weights %lld\n", c.actor_id,

@@ -20,9 +20,9 @@ namespace rl::actor {
 template <class T>
 struct BasicTransition {
   std::span<const T> obs;
-  int action = 0;
-  float reward = 0;    // n-step discounted return
-  float discount = 0;  // gamma^k, or 0 after a termination
+  std::span<const float> action;  // action_width floats (a discrete action: its index)
+  float reward = 0;               // n-step discounted return
+  float discount = 0;             // gamma^k, or 0 after a termination
   std::span<const T> next_obs;
 };
 
@@ -31,12 +31,12 @@ class BasicNStepAccumulator {
  public:
   using Sink = std::function<void(const BasicTransition<T>&)>;
 
-  BasicNStepAccumulator(int n, double gamma, int obs_size);
+  BasicNStepAccumulator(int n, double gamma, int obs_size, int action_width = 1);
 
   // Records the step taken from `obs` with `action`, which gave `reward` and `next_obs`, and
   // emits every transition that is now complete.
-  void Add(std::span<const T> obs, int action, double reward, std::span<const T> next_obs,
-           bool terminated, bool truncated, const Sink& sink);
+  void Add(std::span<const T> obs, std::span<const float> action, double reward,
+           std::span<const T> next_obs, bool terminated, bool truncated, const Sink& sink);
 
   // Steps waiting for their n-step return.
   int pending() const { return count_; }
@@ -45,7 +45,7 @@ class BasicNStepAccumulator {
   // A ring of n preallocated steps, so that stepping allocates nothing.
   struct Pending {
     std::vector<T> obs;
-    int action = 0;
+    std::vector<float> action;
     double reward = 0;
   };
   Pending& At(int k) { return steps_[static_cast<size_t>((head_ + k) % n_)]; }
@@ -56,6 +56,7 @@ class BasicNStepAccumulator {
   int n_;
   double gamma_;
   int obs_size_;
+  int action_width_;
   std::vector<Pending> steps_;
   int head_ = 0;   // oldest pending step
   int count_ = 0;  // pending steps

@@ -1,13 +1,123 @@
-// DQN updates per second for the CartPole MLP (4-120-84-2) at batch 32, 64 and 128, one thread:
-// forward of the target network on s', forward and backward of the online network on s, Adam
-// step. The same update as the PyTorch peer's "updates" (MSE loss, lr 2.5e-4, 8 batches cycled,
-// max over the target network, no target refresh during the measurement).
+// Learner updates per second, one thread, on random data (eight batches cycled), beside the
+// PyTorch peer's "updates" rows (bench/peer/micro.py in the shared folder):
+//   learner_updates_mlp  DQN on the CartPole MLP (4-120-84-2) at batch 32, 64 and 128: forward of
+//                        the target network on s', forward and backward of the online network on
+//                        s, Adam step (MSE loss, lr 2.5e-4, max over the target network, no target
+//                        refresh during the measurement).
+//   learner_updates_td3  TD3 (learner/td3.h) on the peer's two cases: "td3_mlp" (8-d observation,
+//                        2-d action, actor and twin critics 256-256, batch 256) and "td3_car" (the
+//                        TD3 CarRacing article's networks on 4 x 84 x 84 stacks, 3-d action, batch
+//                        128). One call is one critic update; every 2nd also updates the actor and
+//                        the targets (policy delay 2), as the peer's. Also the GFLOP/s this
+//                        reaches, from the forward multiply-adds of the networks (see Td3Flops).
 #include <random>
 #include <string>
 #include <vector>
 
 #include "bench/bench_util.h"
+#include "envs/specs.h"
 #include "learner/dqn.h"
+#include "learner/td3.h"
+#include "nn/conv2d.h"
+#include "nn/linear.h"
+#include "nn/pixels.h"
+
+namespace {
+
+struct Data {
+  rl::nn::Matrix obs, next_obs;
+  std::vector<float> action, reward, discount;
+};
+
+// Eight batches: observations normal (flat) or uniform bytes / 255 (pixels), actions in the box.
+std::vector<Data> MakeData(const rl::envs::EnvSpec& spec, int batch, bool pixels) {
+  std::mt19937 rng(1);
+  std::normal_distribution<float> normal;
+  std::bernoulli_distribution done(0.05);
+  std::uniform_int_distribution<int> byte(0, 255);
+  std::vector<Data> data(8);
+  const int width = spec.action_width();
+  for (Data& d : data) {
+    for (rl::nn::Matrix* m : {&d.obs, &d.next_obs}) {
+      if (pixels) {
+        std::vector<uint8_t> bytes(static_cast<size_t>(spec.observation_size) * batch);
+        for (uint8_t& b : bytes) b = static_cast<uint8_t>(byte(rng));
+        rl::nn::PixelsToMatrix(bytes.data(), spec.observation_size, batch, m);
+      } else {
+        m->resize(spec.observation_size, batch);
+        for (Eigen::Index i = 0; i < m->size(); ++i) m->data()[i] = normal(rng);
+      }
+    }
+    for (int i = 0; i < batch; ++i) {
+      for (int k = 0; k < width; ++k) {
+        if (spec.continuous()) {
+          const auto u = static_cast<size_t>(k);
+          d.action.push_back(
+              std::uniform_real_distribution<float>(spec.action_low[u], spec.action_high[u])(rng));
+        } else {
+          d.action.push_back(static_cast<float>(rng() % static_cast<unsigned>(spec.num_actions)));
+        }
+      }
+      d.reward.push_back(normal(rng));
+      d.discount.push_back(done(rng) ? 0.0f : 0.99f);
+    }
+  }
+  return data;
+}
+
+// Multiply-adds of one forward pass of one observation through the products of `arch`
+// (convolutions and linear layers).
+double ForwardMacs(const std::string& arch) {
+  if (arch.empty()) return 0;
+  std::mt19937 rng(0);
+  const rl::nn::Sequential net = rl::nn::BuildFromArchitecture(arch, &rng);
+  double macs = 0;
+  for (int i = 0; i < net.num_layers(); ++i) {
+    const rl::nn::Layer& layer = net.layer(i);
+    if (const auto* conv = dynamic_cast<const rl::nn::Conv2d*>(&layer)) {
+      const rl::nn::ImageShape in = conv->input_shape();
+      const rl::nn::ImageShape out = conv->output_shape();
+      macs += static_cast<double>(out.height) * out.width * out.channels * in.channels *
+              conv->kernel() * conv->kernel();
+    } else if (dynamic_cast<const rl::nn::Linear*>(&layer) != nullptr) {
+      macs += static_cast<double>(layer.input_size()) * layer.output_size();
+    }
+  }
+  return macs;
+}
+
+// FLOPs (2 x multiply-adds) of one TD3 update at `batch`, averaged over the policy-delay cycle of
+// 2, counting a backward pass as twice its forward: the target actor and both target critics
+// forward (A + 2C), both critics forward and backward (6C), and every 2nd update the actor
+// forward, Q1 forward and backward, the actor backward ((3A + 3C) / 2): 2.5 A + 9.5 C per
+// transition. For the 256-256 networks at batch 256 this is 0.42 GFLOP.
+double Td3UpdateFlops(rl::learner::Td3& td3, int batch) {
+  const double actor = ForwardMacs(td3.actor().Architecture());
+  double critic = 0;
+  std::string arch = td3.critic(0).Architecture();
+  size_t start = 0;
+  for (;;) {
+    const size_t bar = arch.find('|', start);
+    critic += ForwardMacs(arch.substr(start, bar == std::string::npos ? bar : bar - start));
+    if (bar == std::string::npos) break;
+    start = bar + 1;
+  }
+  return 2.0 * batch * (2.5 * actor + 9.5 * critic);
+}
+
+rl::learner::Batch View(const Data& d, int batch, int width) {
+  rl::learner::Batch b;
+  b.count = batch;
+  b.action_width = width;
+  b.obs = &d.obs;
+  b.next_obs = &d.next_obs;
+  b.action = d.action;
+  b.reward = d.reward;
+  b.discount = d.discount;
+  return b;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
@@ -21,45 +131,54 @@ int main(int argc, char** argv) {
     c.max_grad_norm = 0;
     c.target_update_period = 1 << 30;
     rl::learner::Dqn dqn(4, 2, c);
-    // Eight batches of random data, cycled.
-    std::mt19937 rng(1);
-    std::normal_distribution<float> normal;
-    std::bernoulli_distribution done(0.05);
-    struct Data {
-      std::vector<float> obs, next_obs, reward, discount;
-      std::vector<int32_t> action;
-    };
-    std::vector<Data> data(8);
-    for (Data& d : data) {
-      for (int i = 0; i < 4 * batch; ++i) {
-        d.obs.push_back(normal(rng));
-        d.next_obs.push_back(normal(rng));
-      }
-      for (int i = 0; i < batch; ++i) {
-        d.action.push_back(static_cast<int32_t>(rng() & 1U));
-        d.reward.push_back(1.0f);
-        d.discount.push_back(done(rng) ? 0.0f : 0.99f);
-      }
-    }
+    const std::vector<Data> data = MakeData(rl::envs::CartPoleSpec(), batch, false);
     size_t k = 0;
     const auto s = rl::bench::Repeat(repeats, [&] {
-      return rl::bench::Rate(
-          [&] {
-            const Data& d = data[k++ % data.size()];
-            rl::learner::BatchView b;
-            b.obs_size = 4;
-            b.count = batch;
-            b.obs = d.obs.data();
-            b.next_obs = d.next_obs.data();
-            b.action = d.action.data();
-            b.reward = d.reward.data();
-            b.discount = d.discount.data();
-            dqn.Update(b);
-          },
-          1, seconds, 20);
+      return rl::bench::Rate([&] { dqn.Update(View(data[k++ % data.size()], batch, 1)); }, 1,
+                             seconds, 20);
     });
     rl::bench::Emit("learner_updates_mlp", "updates/s", s, repeats,
                     "\"batch\": " + std::to_string(batch) + ", \"threads\": 1");
+  }
+
+  struct Td3Case {
+    const char* name;
+    rl::envs::EnvSpec spec;
+    std::string network;
+    int batch;
+    float actor_lr, critic_lr, tau;
+    bool pixels;
+  };
+  rl::envs::EnvSpec mlp_spec = rl::envs::LunarLanderSpec(true);  // 8-d observation, 2-d action
+  rl::envs::EnvSpec car_spec = rl::envs::CarRacingSpec(true);    // 3-d action
+  car_spec.observation_size = 4 * 84 * 84;
+  car_spec.frame_stack = 4;
+  car_spec.frame_height = car_spec.frame_width = 84;
+  const Td3Case cases[] = {
+      {"td3_mlp", mlp_spec, "mlp", 256, 3e-4f, 3e-4f, 0.005f, false},
+      {"td3_car", car_spec, "car", 128, 2.5e-4f, 1e-3f, 0.05f, true},
+  };
+  for (const Td3Case& t : cases) {
+    rl::learner::Td3Config c;
+    c.network = t.network;
+    c.hidden = {256, 256};
+    c.actor_learning_rate = t.actor_lr;
+    c.critic_learning_rate = t.critic_lr;
+    c.tau = t.tau;
+    rl::learner::Td3 td3(t.spec, c);
+    const std::vector<Data> data = MakeData(t.spec, t.batch, t.pixels);
+    const int width = t.spec.action_width();
+    size_t k = 0;
+    const auto s = rl::bench::Repeat(repeats, [&] {
+      return rl::bench::Rate([&] { td3.Update(View(data[k++ % data.size()], t.batch, width)); }, 1,
+                             seconds, 4);
+    });
+    const double gflop = Td3UpdateFlops(td3, t.batch) / 1e9;
+    rl::bench::Emit("learner_updates_td3", "updates/s", s, repeats,
+                    "\"net\": \"" + std::string(t.name) +
+                        "\", \"batch\": " + std::to_string(t.batch) +
+                        ", \"threads\": 1, \"gflop_per_update\": " + std::to_string(gflop) +
+                        ", \"gflops\": " + std::to_string(gflop * s.median));
   }
   return 0;
 }

@@ -53,8 +53,6 @@
 #include "replay/replay_service.h"
 #include "replay/uniform_sampler.h"
 #include "rlmsg/flow_control_t.hpp"
-#include "rlmsg/pixel_batch_t.hpp"
-#include "rlmsg/pixel_sample_batch_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
 #include "rlmsg/stats_replay_t.hpp"
 
@@ -76,7 +74,9 @@ rlmsg::transition_batch_t Batch() {
   m.num_values = 128;
   m.obs.assign(128, 0.1f);
   m.next_obs.assign(128, 0.2f);
-  m.action.assign(32, 1);
+  m.action_width = 1;
+  m.num_action_values = 32;
+  m.action.assign(32, 1.0f);
   m.reward.assign(32, 1.0f);
   m.discount.assign(32, 0.99f);
   m.episode_id.assign(32, 0);
@@ -226,7 +226,7 @@ class PixelActorSim {
   }
 
   /// The next batch of kBatch transitions with the frames new in it (valid until the next call).
-  rlmsg::pixel_batch_t* Next() {
+  rlmsg::transition_batch_t* Next() {
     m_.frame_id.clear();
     m_.obs_frames.clear();
     m_.next_obs_frames.clear();
@@ -243,7 +243,7 @@ class PixelActorSim {
       const bool terminal = ++step_ >= episode_steps_;
       m_.obs_frames.insert(m_.obs_frames.end(), stack_.begin(), stack_.end());
       m_.next_obs_frames.insert(m_.next_obs_frames.end(), next.begin(), next.end());
-      m_.action.push_back(static_cast<int32_t>(rng_() % 18));
+      m_.action.push_back(static_cast<float>(rng_() % 18));
       m_.reward.push_back(rng_() % 64 == 0 ? 1.0f : 0.0f);
       m_.discount.push_back(terminal ? 0.0f : 0.99f);
       m_.episode_id.push_back(episode_);
@@ -261,6 +261,8 @@ class PixelActorSim {
     m_.frames.assign(pattern_.begin(), pattern_.begin() + m_.num_bytes);
     m_.count = kBatch;
     m_.num_refs = kBatch * kStack;
+    m_.action_width = 1;
+    m_.num_action_values = kBatch;
     return &m_;
   }
 
@@ -275,7 +277,7 @@ class PixelActorSim {
 
   std::mt19937_64 rng_;
   std::vector<uint8_t> pattern_;
-  rlmsg::pixel_batch_t m_{};
+  rlmsg::transition_batch_t m_{};
   std::array<int64_t, kStack> stack_{};
   int64_t next_frame_id_ = 0;
   int64_t episode_ = 0;
@@ -283,11 +285,19 @@ class PixelActorSim {
   int episode_steps_ = 0;
 };
 
-rl::replay::PixelBatchView View(const rlmsg::pixel_batch_t& m) {
-  return rl::replay::PixelBatchView{m.actor_id,   m.height,          m.width,   m.stack,
-                                    m.num_frames, m.frame_id,        m.frames,  m.count,
-                                    m.obs_frames, m.next_obs_frames, m.action,  m.reward,
-                                    m.discount,   m.episode_id,      m.priority};
+rl::replay::PixelBatchView View(const rlmsg::transition_batch_t& m) {
+  return rl::replay::PixelBatchView{m.actor_id,
+                                    m.height,
+                                    m.width,
+                                    m.stack,
+                                    m.num_frames,
+                                    m.frame_id,
+                                    m.frames,
+                                    m.count,
+                                    m.obs_frames,
+                                    m.next_obs_frames,
+                                    rl::replay::ColumnsView{m.action_width, m.action, m.reward,
+                                                            m.discount, m.episode_id, m.priority}};
 }
 
 // What the pixel replay service's thread exposes to the main thread.
@@ -345,7 +355,7 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
   double first_sent = 0;
   while (probe.inserts.load() == 0 && rl::MonoSeconds() - first_start < 10) {
     if (rl::MonoSeconds() - first_sent > 2) {
-      bus->Publish(rl::channels::kPixelTransitions, sim.Next());
+      bus->Publish(rl::channels::kTransitions, sim.Next());
       first_sent = rl::MonoSeconds();
     }
     bus->Handle(5);
@@ -368,8 +378,8 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
     double bytes = 0;
     const double start = rl::MonoSeconds();
     while (rl::MonoSeconds() - start < seconds) {
-      rlmsg::pixel_batch_t* m = sim.Next();
-      bus->Publish(rl::channels::kPixelTransitions, m);
+      rlmsg::transition_batch_t* m = sim.Next();
+      bus->Publish(rl::channels::kTransitions, m);
       sent += m->count;
       bytes += m->getEncodedSize();
       bus->Handle(0);
@@ -420,9 +430,9 @@ void PixelSample(rl::Bus* bus, int repeats, double seconds) {
   auto state = std::make_shared<State>();
   State& st = *state;
   const std::string me = bus->config().sender;
-  bus->Subscribe<rlmsg::pixel_sample_batch_t>(
-      rl::channels::kPixelSamples,
-      [state, me](const rlmsg::pixel_sample_batch_t& m) {
+  bus->Subscribe<rlmsg::sample_batch_t>(
+      rl::channels::kSamples,
+      [state, me](const rlmsg::sample_batch_t& m) {
         if (m.requester != me || state->outstanding.erase(m.request_id) == 0) return;
         state->received += m.count;
         ++state->batches;
@@ -508,10 +518,10 @@ void PixelActors(rl::Bus* bus, const ServiceProbe& probe, int port, int multipli
       for (int64_t j = 0;; ++j) {
         const double due = t0 + phase + static_cast<double>(j) * period;
         if (due >= t_end) break;
-        rlmsg::pixel_batch_t* m = sim.Next();  // the actor's work happens before the due time
+        rlmsg::transition_batch_t* m = sim.Next();  // the actor's work happens before the due time
         const double wait = due - rl::MonoSeconds();
         if (wait > 0) std::this_thread::sleep_for(std::chrono::duration<double>(wait));
-        if (!actor_bus.Publish(rl::channels::kPixelTransitions, m)) ++publish_failures;
+        if (!actor_bus.Publish(rl::channels::kTransitions, m)) ++publish_failures;
         sent += m->count;
         sent_bytes += m->getEncodedSize();
         actor_bus.Handle(0);
@@ -622,7 +632,7 @@ int64_t RssBytes() {
 void PixelMemory(bool prioritized) {
   // Actors first (their message buffers are not the table's), then a clean baseline.
   std::vector<PixelActorSim> sims;
-  std::vector<rlmsg::pixel_batch_t*> next;
+  std::vector<rlmsg::transition_batch_t*> next;
   sims.reserve(kActors);
   for (int a = 0; a < kActors; ++a) {
     sims.emplace_back(a, 500 + static_cast<uint64_t>(a));

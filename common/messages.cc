@@ -77,16 +77,26 @@ const char* Prescan(const rlmsg::transition_batch_t*, const uint8_t* data, size_
   r.Skip(8);  // fingerprint
   r.Header();
   r.Skip(4);  // actor_id
-  r.Skip(4);  // obs_size
   const int64_t count = r.ReadInt(4);
+  r.Skip(4);  // obs_size
   const int64_t num_values = r.ReadInt(4);
   r.Array(num_values, 4);  // obs
   r.Array(num_values, 4);  // next_obs
-  r.Array(count, 4);       // action
-  r.Array(count, 4);       // reward
-  r.Array(count, 4);       // discount
-  r.Array(count, 8);       // episode_id
-  r.Array(count, 4);       // priority
+  r.Skip(12);              // height, width, stack
+  const int64_t num_frames = r.ReadInt(4);
+  r.Array(num_frames, 8);  // frame_id
+  const int64_t num_bytes = r.ReadInt(4);
+  r.Array(num_bytes, 1);  // frames
+  const int64_t num_refs = r.ReadInt(4);
+  r.Array(num_refs, 8);  // obs_frames
+  r.Array(num_refs, 8);  // next_obs_frames
+  r.Skip(4);             // action_width
+  const int64_t num_action_values = r.ReadInt(4);
+  r.Array(num_action_values, 4);  // action
+  r.Array(count, 4);              // reward
+  r.Array(count, 4);              // discount
+  r.Array(count, 8);              // episode_id
+  r.Array(count, 4);              // priority
   return Finish(r);
 }
 
@@ -96,58 +106,23 @@ const char* Prescan(const rlmsg::sample_batch_t*, const uint8_t* data, size_t si
   r.Header();
   r.String();  // requester
   r.Skip(8);   // request_id
-  r.Skip(4);   // obs_size
   const int64_t count = r.ReadInt(4);
+  r.Skip(4);  // obs_size
   const int64_t num_values = r.ReadInt(4);
   r.Array(num_values, 4);  // obs
   r.Array(num_values, 4);  // next_obs
-  r.Array(count, 4);       // action
-  r.Array(count, 4);       // reward
-  r.Array(count, 4);       // discount
-  r.Array(count, 8);       // index
-  r.Array(count, 4);       // weight
-  r.Skip(16);              // replay_size, total_inserts
-  return Finish(r);
-}
-
-const char* Prescan(const rlmsg::pixel_batch_t*, const uint8_t* data, size_t size) {
-  Reader r(data, size);
-  r.Skip(8);
-  r.Header();
-  r.Skip(16);  // actor_id, height, width, stack
-  const int64_t num_frames = r.ReadInt(4);
-  r.Array(num_frames, 8);  // frame_id
+  r.Skip(12);              // height, width, stack
   const int64_t num_bytes = r.ReadInt(4);
-  r.Array(num_bytes, 1);  // frames
-  const int64_t count = r.ReadInt(4);
-  const int64_t num_refs = r.ReadInt(4);
-  r.Array(num_refs, 8);  // obs_frames
-  r.Array(num_refs, 8);  // next_obs_frames
-  r.Array(count, 4);     // action
-  r.Array(count, 4);     // reward
-  r.Array(count, 4);     // discount
-  r.Array(count, 8);     // episode_id
-  r.Array(count, 4);     // priority
-  return Finish(r);
-}
-
-const char* Prescan(const rlmsg::pixel_sample_batch_t*, const uint8_t* data, size_t size) {
-  Reader r(data, size);
-  r.Skip(8);
-  r.Header();
-  r.String();  // requester
-  r.Skip(8);   // request_id
-  r.Skip(12);  // height, width, stack
-  const int64_t count = r.ReadInt(4);
-  const int64_t num_bytes = r.ReadInt(4);
-  r.Array(num_bytes, 1);  // obs
-  r.Array(num_bytes, 1);  // next_obs
-  r.Array(count, 4);      // action
-  r.Array(count, 4);      // reward
-  r.Array(count, 4);      // discount
-  r.Array(count, 8);      // index
-  r.Array(count, 4);      // weight
-  r.Skip(16);             // replay_size, total_inserts
+  r.Array(num_bytes, 1);  // obs_pixels
+  r.Array(num_bytes, 1);  // next_obs_pixels
+  r.Skip(4);              // action_width
+  const int64_t num_action_values = r.ReadInt(4);
+  r.Array(num_action_values, 4);  // action
+  r.Array(count, 4);              // reward
+  r.Array(count, 4);              // discount
+  r.Array(count, 8);              // index
+  r.Array(count, 4);              // weight
+  r.Skip(16);                     // replay_size, total_inserts
   return Finish(r);
 }
 
@@ -174,24 +149,6 @@ const char* Prescan(const rlmsg::weights_chunk_t*, const uint8_t* data, size_t s
   return Finish(r);
 }
 
-const char* Validate(const rlmsg::transition_batch_t& m) {
-  if (!HeaderOk(m.header)) return "bad header";
-  if (m.obs_size <= 0 || m.count <= 0) return "empty batch";
-  if (static_cast<int64_t>(m.obs_size) * m.count != m.num_values) return "num_values mismatch";
-  if (m.actor_id < 0) return "negative actor_id";
-  if (!AllFinite(m.obs) || !AllFinite(m.next_obs) || !AllFinite(m.reward) ||
-      !AllFinite(m.discount) || !AllFinite(m.priority)) {
-    return "non-finite value";
-  }
-  for (int i = 0; i < m.count; ++i) {
-    if (m.action[static_cast<size_t>(i)] < 0) return "negative action";
-    const float d = m.discount[static_cast<size_t>(i)];
-    if (d < 0.0f || d > 1.0f) return "discount outside [0, 1]";
-    if (m.priority[static_cast<size_t>(i)] < 0.0f) return "negative priority";
-  }
-  return nullptr;
-}
-
 namespace {
 
 // Frame geometry of pixel messages: positive and small enough that products cannot overflow.
@@ -199,49 +156,89 @@ bool GeometryOk(int32_t height, int32_t width, int32_t stack) {
   return height > 0 && width > 0 && stack > 0 && height <= 4096 && width <= 4096 && stack <= 64;
 }
 
-// Actions, discounts and priorities of `count` transitions.
-const char* CheckTransitions(const std::vector<int32_t>& action, const std::vector<float>& discount,
-                             const std::vector<float>& priority) {
-  for (int32_t a : action) {
-    if (a < 0) return "negative action";
-  }
+// The per-transition columns both transition and sample messages carry: count transitions,
+// action_width floats each (finite), discounts in [0, 1], and every other float finite.
+const char* CheckColumns(int32_t count, int32_t action_width, int32_t num_action_values,
+                         const std::vector<float>& action, const std::vector<float>& reward,
+                         const std::vector<float>& discount) {
+  if (action_width < 1 || action_width > kMaxActionWidth) return "action_width outside [1, 64]";
+  if (int64_t{count} * action_width != num_action_values) return "num_action_values mismatch";
+  if (!AllFinite(action)) return "non-finite action";
+  if (!AllFinite(reward) || !AllFinite(discount)) return "non-finite value";
   for (float d : discount) {
     if (d < 0.0f || d > 1.0f) return "discount outside [0, 1]";
   }
-  for (float p : priority) {
-    if (p < 0.0f) return "negative priority";
+  return nullptr;
+}
+
+// Flat or pixel observations of `count` transitions, exactly one kind; `has_pixels` says whether
+// any pixel array is non-empty.
+const char* CheckObservationKind(int32_t count, int32_t obs_size, int32_t num_values,
+                                 int32_t height, int32_t width, int32_t stack, bool has_pixels) {
+  const bool flat = obs_size > 0;
+  const bool pixels = stack > 0 || height > 0 || width > 0;
+  if (flat == pixels) return "neither or both of flat and pixel observations";
+  if (flat) {
+    if (int64_t{obs_size} * count != num_values) return "num_values mismatch";
+    if (has_pixels) return "pixel arrays in a flat batch";
+    return nullptr;
   }
+  if (!GeometryOk(height, width, stack)) return "bad frame geometry";
+  if (num_values != 0) return "flat observations in a pixel batch";
   return nullptr;
 }
 
 }  // namespace
 
-const char* Validate(const rlmsg::pixel_batch_t& m) {
+const char* Validate(const rlmsg::transition_batch_t& m) {
   if (!HeaderOk(m.header)) return "bad header";
   if (m.actor_id < 0) return "negative actor_id";
-  if (!GeometryOk(m.height, m.width, m.stack)) return "bad frame geometry";
-  if (m.num_frames < 0 || m.count < 0 || m.num_frames + m.count == 0) return "empty batch";
-  if (int64_t{m.num_frames} * m.height * m.width != m.num_bytes) return "num_bytes mismatch";
-  if (int64_t{m.count} * m.stack != m.num_refs) return "num_refs mismatch";
-  for (size_t i = 1; i < m.frame_id.size(); ++i) {
-    if (m.frame_id[i] <= m.frame_id[i - 1]) return "frame ids not increasing";
+  if (m.count < 0) return "negative count";
+  if (const char* why = CheckObservationKind(m.count, m.obs_size, m.num_values, m.height, m.width,
+                                             m.stack, m.num_frames != 0 || m.num_refs != 0)) {
+    return why;
   }
-  if (!m.frame_id.empty() && m.frame_id.front() < 0) return "negative frame id";
-  if (!AllFinite(m.reward) || !AllFinite(m.discount) || !AllFinite(m.priority)) {
-    return "non-finite value";
+  if (m.obs_size > 0) {
+    if (m.count == 0) return "empty batch";
+    if (!AllFinite(m.obs) || !AllFinite(m.next_obs)) return "non-finite value";
+  } else {
+    if (m.num_frames < 0 || m.num_frames + m.count == 0) return "empty batch";
+    if (int64_t{m.num_frames} * m.height * m.width != m.num_bytes) return "num_bytes mismatch";
+    if (int64_t{m.count} * m.stack != m.num_refs) return "num_refs mismatch";
+    for (size_t i = 1; i < m.frame_id.size(); ++i) {
+      if (m.frame_id[i] <= m.frame_id[i - 1]) return "frame ids not increasing";
+    }
+    if (!m.frame_id.empty() && m.frame_id.front() < 0) return "negative frame id";
   }
-  return CheckTransitions(m.action, m.discount, m.priority);
+  if (const char* why = CheckColumns(m.count, m.action_width, m.num_action_values, m.action,
+                                     m.reward, m.discount)) {
+    return why;
+  }
+  if (!AllFinite(m.priority)) return "non-finite value";
+  for (float p : m.priority) {
+    if (p < 0.0f) return "negative priority";
+  }
+  return nullptr;
 }
 
-const char* Validate(const rlmsg::pixel_sample_batch_t& m) {
+const char* Validate(const rlmsg::sample_batch_t& m) {
   if (!HeaderOk(m.header)) return "bad header";
-  if (!GeometryOk(m.height, m.width, m.stack)) return "bad frame geometry";
   if (m.count <= 0) return "empty batch";
-  if (int64_t{m.count} * m.stack * m.height * m.width != m.num_bytes) return "num_bytes mismatch";
-  if (!AllFinite(m.reward) || !AllFinite(m.discount) || !AllFinite(m.weight)) {
-    return "non-finite value";
+  if (const char* why = CheckObservationKind(m.count, m.obs_size, m.num_values, m.height, m.width,
+                                             m.stack, m.num_bytes != 0)) {
+    return why;
   }
-  return CheckTransitions(m.action, m.discount, {});
+  if (m.obs_size > 0) {
+    if (!AllFinite(m.obs) || !AllFinite(m.next_obs)) return "non-finite value";
+  } else if (int64_t{m.count} * m.stack * m.height * m.width != m.num_bytes) {
+    return "num_bytes mismatch";
+  }
+  if (const char* why = CheckColumns(m.count, m.action_width, m.num_action_values, m.action,
+                                     m.reward, m.discount)) {
+    return why;
+  }
+  if (!AllFinite(m.weight)) return "non-finite value";
+  return nullptr;
 }
 
 const char* Validate(const rlmsg::priority_update_t& m) {
@@ -257,20 +254,6 @@ const char* Validate(const rlmsg::priority_update_t& m) {
 const char* Validate(const rlmsg::sample_request_t& m) {
   if (!HeaderOk(m.header)) return "bad header";
   if (m.batch_size <= 0 || m.batch_size > 65536) return "batch_size outside [1, 65536]";
-  return nullptr;
-}
-
-const char* Validate(const rlmsg::sample_batch_t& m) {
-  if (!HeaderOk(m.header)) return "bad header";
-  if (m.obs_size <= 0 || m.count <= 0) return "empty batch";
-  if (static_cast<int64_t>(m.obs_size) * m.count != m.num_values) return "num_values mismatch";
-  if (!AllFinite(m.obs) || !AllFinite(m.next_obs) || !AllFinite(m.reward) ||
-      !AllFinite(m.discount) || !AllFinite(m.weight)) {
-    return "non-finite value";
-  }
-  for (int32_t a : m.action) {
-    if (a < 0) return "negative action";
-  }
   return nullptr;
 }
 

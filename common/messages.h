@@ -13,8 +13,6 @@
 #include "rlmsg/checkpoint_t.hpp"
 #include "rlmsg/eval_result_t.hpp"
 #include "rlmsg/flow_control_t.hpp"
-#include "rlmsg/pixel_batch_t.hpp"
-#include "rlmsg/pixel_sample_batch_t.hpp"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
@@ -29,12 +27,12 @@ namespace rl {
 
 // Largest array a message may carry (elements), far above any real message.
 inline constexpr int64_t kMaxArrayElements = 64 * 1024 * 1024;
+// Widest action a message may carry (floats per transition).
+inline constexpr int32_t kMaxActionWidth = 64;
 
 const char* Prescan(const rlmsg::transition_batch_t*, const uint8_t* data, size_t size);
 const char* Prescan(const rlmsg::sample_batch_t*, const uint8_t* data, size_t size);
 const char* Prescan(const rlmsg::weights_chunk_t*, const uint8_t* data, size_t size);
-const char* Prescan(const rlmsg::pixel_batch_t*, const uint8_t* data, size_t size);
-const char* Prescan(const rlmsg::pixel_sample_batch_t*, const uint8_t* data, size_t size);
 const char* Prescan(const rlmsg::priority_update_t*, const uint8_t* data, size_t size);
 // Messages whose only variable part is strings: lcm-gen's decoder checks string lengths, but a
 // zero or negative length makes it throw; the bus catches that, so no prescan is needed.
@@ -47,8 +45,6 @@ const char* Validate(const rlmsg::transition_batch_t& m);
 const char* Validate(const rlmsg::sample_request_t& m);
 const char* Validate(const rlmsg::sample_batch_t& m);
 const char* Validate(const rlmsg::weights_chunk_t& m);
-const char* Validate(const rlmsg::pixel_batch_t& m);
-const char* Validate(const rlmsg::pixel_sample_batch_t& m);
 const char* Validate(const rlmsg::priority_update_t& m);
 const char* Validate(const rlmsg::checkpoint_t& m);
 const char* Validate(const rlmsg::flow_control_t& m);

@@ -65,6 +65,16 @@ bool ParseOptions(int argc, char** argv, const std::string& role, const std::str
   return true;
 }
 
+void RefuseGiven(const po::variables_map& vm, std::initializer_list<const char*> names,
+                 const std::string& why) {
+  for (const char* name : names) {
+    auto it = vm.find(name);
+    if (it != vm.end() && !it->second.defaulted()) {
+      throw std::runtime_error(std::string("option --") + name + " does not apply: " + why);
+    }
+  }
+}
+
 int RunMain(const char* program, int (*body)(int, char**), int argc, char** argv) {
   try {
     return body(argc, argv);

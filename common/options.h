@@ -9,6 +9,7 @@
 #include <boost/program_options.hpp>
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 
 #include "common/lcm_bus.h"
@@ -34,6 +35,12 @@ void AddCommonOptions(po::options_description* desc, CommonOptions* common);
 // message that names the option.
 bool ParseOptions(int argc, char** argv, const std::string& role, const std::string& usage,
                   const po::options_description& desc, po::variables_map* vm);
+
+/// Throws std::runtime_error("option --NAME does not apply: <why>") for the first of `names`
+/// that was given (on the command line or in the config file) rather than left at its default:
+/// options of the algorithm or exploration a run did not choose are refused, not ignored.
+void RefuseGiven(const po::variables_map& vm, std::initializer_list<const char*> names,
+                 const std::string& why);
 
 // Runs body() and turns an exception into "<program>: error: <what>" on stderr and exit code 2.
 int RunMain(const char* program, int (*body)(int, char**), int argc, char** argv);

@@ -10,6 +10,7 @@
 #include "common/check.h"
 #include "envs/raster.h"
 #include "envs/rng.h"
+#include "envs/specs.h"
 
 namespace rl::envs {
 namespace {
@@ -40,13 +41,7 @@ void CartPoleConfig::Validate() const {
   }
 }
 
-CartPole::CartPole(const CartPoleConfig& config)
-    : spec_{.id = "CartPole-v1",
-            .observation_size = 4,
-            .num_actions = 2,
-            .max_episode_steps = 500,
-            .reward_threshold = 475.0},
-      config_(config) {
+CartPole::CartPole(const CartPoleConfig& config) : spec_(CartPoleSpec()), config_(config) {
   config_.Validate();
 }
 

@@ -8,6 +8,7 @@
 #include "common/check.h"
 #include "envs/raster.h"
 #include "envs/rng.h"
+#include "envs/specs.h"
 
 namespace rl::envs {
 namespace {
@@ -30,12 +31,11 @@ void PaintCell(Canvas& canvas, int row, int column) {
 
 }  // namespace
 
-Catch::Catch()
-    : spec_{.id = "Catch-v0",
-            .observation_size = kRows * kColumns,
-            .num_actions = 3,
-            .max_episode_steps = kRows - 1,
-            .reward_threshold = 0.9} {}
+Catch::Catch() : spec_(CatchSpec()) {
+  RL_CHECK(spec_.observation_size == kRows * kColumns && spec_.max_episode_steps == kRows - 1 &&
+           spec_.render_width == kScreenWidth && spec_.render_height == kScreenHeight)
+      << "CatchSpec() disagrees with the Catch constants";
+}
 
 void Catch::Reset(uint64_t seed) {
   SeedRng(seed, rng_);

@@ -1,5 +1,6 @@
 #include "envs/env.h"
 
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -10,6 +11,16 @@ namespace rl::envs {
 
 StepResult Env::StepContinuous(std::span<const float> /*action*/) {
   throw std::logic_error("discrete env");
+}
+
+StepResult Env::Act(std::span<const float> action) {
+  const EnvSpec& s = spec();
+  // Bounds are the env's to clip; everything else about the action must be right.
+  if (const char* why = CheckAction(s, action, std::numeric_limits<float>::infinity())) {
+    throw std::invalid_argument(s.id + ": " + why);
+  }
+  if (s.continuous()) return StepContinuous(action);
+  return Step(static_cast<int>(action[0]));
 }
 
 std::span<const uint8_t> Env::frame() const { throw std::logic_error("not a pixel env"); }

@@ -18,18 +18,22 @@ struct StepResult {
   bool truncated = false;
 };
 
-/// Static description of an environment (shapes and registration data). An env is either
-/// discrete (num_actions > 0, action_dim == 0; use Step) or continuous (num_actions == 0,
-/// action_dim > 0; use StepContinuous).
+/// Static description of an environment (shapes and registration data), known without building
+/// the env (LookupSpec in envs/specs.h). An env is either discrete (num_actions > 0, action_dim
+/// == 0; use Step) or continuous (num_actions == 0, action_dim > 0; use StepContinuous). Either
+/// way an action travels and is stored as action_width() floats: a discrete action is one value
+/// holding the index (Act() and CheckAction() accept only an integer in range).
 struct EnvSpec {
-  std::string id;           // Registered id, e.g. "CartPole-v1".
-  int observation_size;     // Number of float32 values in observation().
-  int num_actions;          // Discrete actions are 0 .. num_actions - 1; 0 for continuous envs.
-  int max_episode_steps;    // Time limit applied by the registry (TimeLimit).
-  double reward_threshold;  // Average return at which the task counts as solved.
-  int action_dim = 0;       // Size of a continuous action vector; 0 for discrete envs.
-  float action_low = 0;     // Bounds of every component of a continuous action (a box); the env
-  float action_high = 0;    // clips values outside them. Both 0 for discrete envs.
+  std::string id;               // Registered id, e.g. "CartPole-v1".
+  int observation_size = 0;     // Number of float32 values in observation().
+  int num_actions = 0;          // Discrete actions are 0 .. num_actions - 1; 0 for continuous envs.
+  int max_episode_steps = 0;    // Time limit applied by the registry (TimeLimit).
+  double reward_threshold = 0;  // Average return at which the task counts as solved.
+  int action_dim = 0;           // Size of a continuous action vector; 0 for discrete envs.
+  // Bounds of each component of a continuous action (action_dim values each, a box); the env
+  // clips values outside them. Empty for discrete envs.
+  std::vector<float> action_low = {};
+  std::vector<float> action_high = {};
   // Pixel envs (frame_stack > 0): observation() is the stack of the last frame_stack grayscale
   // frames of frame_height x frame_width pixels, oldest first, each pixel divided by 255, so
   // observation_size == frame_stack * frame_height * frame_width; frame() is the newest frame as
@@ -38,7 +42,21 @@ struct EnvSpec {
   int frame_height = 0;
   int frame_width = 0;
   int frame_stack = 0;
+  // Size of Render()'s image (the native size), so that a pixel pipeline's frame size is known
+  // without rendering.
+  int render_width = 0;
+  int render_height = 0;
+
+  bool continuous() const { return num_actions == 0; }
+  /// Floats per action: action_dim for a continuous env, 1 (the index) for a discrete one.
+  int action_width() const { return continuous() ? action_dim : 1; }
 };
+
+/// Why `action` is not a valid action of `spec`, or nullptr: a width other than action_width(),
+/// a value that is not finite, a discrete value that is not an integer in [0, num_actions), or a
+/// continuous value outside [action_low, action_high] widened by `tolerance` on each side.
+/// O(width); no allocation.
+const char* CheckAction(const EnvSpec& spec, std::span<const float> action, float tolerance = 0);
 
 /// One environment instance. Not thread-safe: an instance is used by one thread at a time. Each
 /// instance owns its RNG, so instances never share random state.
@@ -64,6 +82,12 @@ class Env {
   /// std::invalid_argument for an action of the wrong size, std::logic_error if Reset was never
   /// called. The default (for discrete envs) throws std::logic_error("discrete env").
   virtual StepResult StepContinuous(std::span<const float> action);
+
+  /// Steps with an action in the one representation (EnvSpec::action_width() floats): Step() with
+  /// the index for a discrete env, StepContinuous() for a continuous one. Throws
+  /// std::invalid_argument with CheckAction()'s reason for a bad action (bounds are not checked
+  /// here: a continuous env clips).
+  StepResult Act(std::span<const float> action);
 
   /// Current observation (observation_size float32 values). Valid until the next Reset or Step.
   virtual std::span<const float> observation() const = 0;

@@ -10,7 +10,7 @@
 
 #include <string>
 
-#include "envs/image/pixel_env.h"
+#include "envs/image/image_config.h"
 
 namespace rl::envs {
 

@@ -8,7 +8,9 @@
 #include "envs/box2d/lunar_lander.h"
 #include "envs/cartpole.h"
 #include "envs/catch.h"
+#include "envs/image/pixel_env.h"
 #include "envs/kuka/kuka_diverse_object_env.h"
+#include "envs/pendulum.h"
 #include "envs/pixel_spec.h"
 #include "envs/time_limit.h"
 
@@ -34,6 +36,10 @@ constexpr std::array kRegistrations = {
                  []() -> std::unique_ptr<Env> {
                    return std::make_unique<TimeLimit>(
                        std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true}), 1000);
+                 }},
+    Registration{"Pendulum-v1",
+                 []() -> std::unique_ptr<Env> {
+                   return std::make_unique<TimeLimit>(std::make_unique<Pendulum>(), 200);
                  }},
     // Every Catch episode ends after 9 steps, so the limit never cuts one short: it only marks
     // the terminating step truncated as well (terminated still means no bootstrapping).

@@ -1,5 +1,6 @@
 #include "evaluator/evaluator_service.h"
 
+#include "envs/specs.h"
 #include "evaluator/frame_grid.h"
 #include "evaluator/video.h"
 
@@ -15,6 +16,7 @@
 #include "common/clock.h"
 #include "common/shutdown.h"
 #include "envs/registry.h"
+#include "envs/specs.h"
 #include "nn/checkpoint.h"
 #include "nn/sequential.h"
 #include "rlmsg/eval_result_t.hpp"
@@ -73,8 +75,7 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
                              std::to_string(net.FlatSize()));
   }
   net.SetFlat(ckpt.params.data(), ckpt.params.size());
-  const std::string misfit =
-      CheckNetworkFitsEnv(net.InputSize(), net.OutputSize(), envs::MakeEnv(env_id)->spec());
+  const std::string misfit = CheckNetworkFitsEnv(net, envs::LookupSpec(env_id));
   if (!misfit.empty()) throw std::runtime_error("checkpoint " + path + ": " + misfit);
   if (meta != nullptr) *meta = ckpt.meta;
   return net;
@@ -113,8 +114,8 @@ EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_i
 EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* progress)
     : config_(std::move(config)), bus_(bus), progress_(progress) {
   config_.Validate();
-  // The goal defaults to the env's reward threshold (MakeEnv throws for an unknown id).
-  const envs::EnvSpec spec = envs::MakeEnv(config_.env_id)->spec();
+  // The goal defaults to the env's reward threshold (LookupSpec throws for an unknown id).
+  const envs::EnvSpec spec = envs::LookupSpec(config_.env_id);
   goal_ = std::isnan(config_.goal) ? spec.reward_threshold : config_.goal;
   has_frames_ = spec.frame_height > 0;
   char epsilon[32], gamma[32];
@@ -123,7 +124,9 @@ EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* 
   const uint64_t last_seed = config_.seed_base + static_cast<uint64_t>(config_.episodes) - 1;
   eval_settings_ = "Each checkpoint is scored on " + std::to_string(config_.episodes) +
                    " episodes (seeds " + std::to_string(config_.seed_base) + " to " +
-                   std::to_string(last_seed) + ") with epsilon " + epsilon +
+                   std::to_string(last_seed) + ")" +
+                   (spec.continuous() ? std::string(" with the actor's action, without noise")
+                                      : std::string(" with epsilon ") + epsilon) +
                    "; returns G are discounted with gamma " + gamma + ".";
 
   // Resume the history of the run folder.

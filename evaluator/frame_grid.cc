@@ -73,8 +73,9 @@ FrameGridResult WriteFrameGrid(nn::Sequential* net, const std::string& env_id, u
   if (env->spec().frame_height <= 0) {
     throw std::invalid_argument(env_id + " has no camera frames (not a pixel env)");
   }
-  const std::string misfit = CheckNetworkFitsEnv(net->InputSize(), net->OutputSize(), env->spec());
-  if (!misfit.empty()) throw std::invalid_argument(misfit);
+  // The greedy policy (epsilon 0; no noise): throws when the network does not fit the env.
+  const std::unique_ptr<actor::Policy> policy = EvaluationPolicy(*net, env->spec(), 0.0, seed);
+  std::vector<float> action(static_cast<size_t>(env->spec().action_width()));
 
   FrameGridResult result;
   std::vector<std::vector<cv::Mat>> rows;
@@ -85,7 +86,8 @@ FrameGridResult WriteFrameGrid(nn::Sequential* net, const std::string& env_id, u
     double episode_return = 0;
     for (int t = 1;; ++t) {
       const auto obs = env->observation();
-      const envs::StepResult r = env->Step(net->Argmax(obs.data(), static_cast<int>(obs.size())));
+      policy->Act(obs, 0, action);
+      const envs::StepResult r = env->Act(action);
       episode_return += r.reward;
       const bool done = r.terminated || r.truncated;
       char label[64];

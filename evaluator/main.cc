@@ -10,6 +10,7 @@
 #include "common/lcm_bus.h"
 #include "common/options.h"
 #include "common/shutdown.h"
+#include "envs/specs.h"
 #include "evaluator/evaluator_service.h"
 #include "evaluator/frame_grid.h"
 #include "evaluator/report.h"
@@ -67,7 +68,8 @@ int Main(int argc, char** argv) {
       ("episodes", rl::po::value(&config.episodes)->default_value(config.episodes),
        "evaluation episodes per checkpoint")  //
       ("epsilon", rl::po::value(&config.epsilon)->default_value(config.epsilon, "0.05"),
-       "exploration rate while scoring (0.05 as in Mnih et al. 2015)")  //
+       "discrete actions: exploration rate while scoring (0.05 as in Mnih et al. 2015); "
+       "continuous actions are scored without noise")  //
       ("gamma", rl::po::value(&config.gamma)->default_value(config.gamma, "0.99"),
        "discount of the returns the network's value estimates are compared with: the actors' "
        "gamma (put gamma at the top of a preset so that both read it)")  //
@@ -98,6 +100,10 @@ int Main(int argc, char** argv) {
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "evaluator", kUsage, desc, &vm)) return 0;
   if (!eval_env.empty()) config.env_id = eval_env;
+  if (rl::envs::LookupSpec(config.env_id).continuous()) {
+    rl::RefuseGiven(vm, {"epsilon"},
+                    config.env_id + " has continuous actions, scored without exploration");
+  }
 
   // Standalone mode: one file, one JSON object.
   if (!checkpoint.empty()) {

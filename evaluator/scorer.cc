@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "envs/registry.h"
+#include "envs/specs.h"
 
 namespace rl::evaluator {
 
@@ -50,12 +51,9 @@ double Correlation(std::span<const double> x, std::span<const double> y) {
 
 namespace {
 
-void CheckArguments(int episodes, double epsilon) {
+void CheckEpisodes(int episodes) {
   if (episodes < 1) {
     throw std::invalid_argument("episodes must be at least 1, got " + std::to_string(episodes));
-  }
-  if (!(epsilon >= 0.0 && epsilon <= 1.0)) {
-    throw std::invalid_argument("epsilon must be in [0, 1], got " + std::to_string(epsilon));
   }
 }
 
@@ -106,18 +104,35 @@ class CalibrationAccumulator {
   std::vector<double> estimates_, returns_;  // the steps that count, all episodes
 };
 
-// Plays the episodes of ScoreGreedyPolicy; with `values`, the greedy action is the first largest
-// value and the values of the actions taken are compared with the returns (discount gamma).
-EvalScore Play(const GreedyPolicy& greedy, const ActionValues& values, double gamma,
-               const std::string& env_id, int episodes, double epsilon, uint64_t first_seed,
-               const std::function<void()>& after_episode) {
-  CheckArguments(episodes, epsilon);
+}  // namespace
+
+std::unique_ptr<actor::Policy> EvaluationPolicy(const nn::Sequential& net,
+                                                const envs::EnvSpec& spec, double epsilon,
+                                                uint64_t seed) {
+  if (!(epsilon >= 0.0 && epsilon <= 1.0)) {
+    throw std::invalid_argument("epsilon must be in [0, 1], got " + std::to_string(epsilon));
+  }
+  std::unique_ptr<actor::Policy> policy =
+      actor::MakePolicy(spec, actor::EvaluationExploration(spec, epsilon), 0, 1, seed);
+  policy->SetNetwork(net);
+  return policy;
+}
+
+std::string CheckNetworkFitsEnv(const nn::Sequential& net, const envs::EnvSpec& spec) {
+  return actor::MakePolicy(spec, actor::EvaluationExploration(spec, 0.0), 0, 1, 0)
+      ->CheckNetwork(net);
+}
+
+EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, uint64_t first_seed,
+                double gamma, const std::function<void()>& after_episode) {
+  CheckEpisodes(episodes);
+  if (!(gamma >= 0.0 && gamma <= 1.0)) {
+    throw std::invalid_argument("gamma must be in [0, 1], got " + std::to_string(gamma));
+  }
   std::unique_ptr<envs::Env> env = envs::MakeEnv(env_id);
-  const int num_actions = env->spec().num_actions;
-  std::mt19937_64 rng(first_seed);
-  std::uniform_real_distribution<double> coin(0.0, 1.0);
-  std::uniform_int_distribution<int> random_action(0, num_actions - 1);
+  std::vector<float> action(static_cast<size_t>(env->spec().action_width()));
   CalibrationAccumulator calibration(gamma);
+  bool has_values = false;
 
   std::vector<double> returns;
   returns.reserve(static_cast<size_t>(episodes));
@@ -126,34 +141,17 @@ EvalScore Play(const GreedyPolicy& greedy, const ActionValues& values, double ga
     double episode_return = 0;
     // Act until the env terminates or its time limit truncates the episode.
     for (;;) {
-      const bool explore = epsilon > 0.0 && coin(rng) < epsilon;
-      // The values are asked for on random steps too: the random action's value is compared.
-      std::span<const float> q;
-      if (values) {
-        q = values(env->observation());
-        if (static_cast<int>(q.size()) != num_actions) {
-          throw std::invalid_argument(std::to_string(q.size()) + " action values for " +
-                                      std::to_string(num_actions) + " actions");
-        }
-      }
-      int action;
-      if (explore) {
-        action = random_action(rng);
-      } else if (values) {
-        action = static_cast<int>(std::max_element(q.begin(), q.end()) - q.begin());
-      } else {
-        action = greedy(env->observation());
-        if (action < 0 || action >= num_actions) {
-          throw std::invalid_argument("greedy action " + std::to_string(action) + " outside [0, " +
-                                      std::to_string(num_actions) + ")");
-        }
-      }
-      const double value = values ? static_cast<double>(q[static_cast<size_t>(action)]) : 0.0;
-      const envs::StepResult step = env->Step(action);
+      policy->Act(env->observation(), 0, action);
+      // The value of the action taken, random ones included (a Q-network's estimate).
+      const std::optional<double> value = policy->last_value();
+      const envs::StepResult step = env->Act(action);
       episode_return += step.reward;
-      if (values) calibration.Step(value, step.reward);
+      if (value) {
+        has_values = true;
+        calibration.Step(*value, step.reward);
+      }
       if (step.terminated || step.truncated) {
-        if (values) calibration.EndEpisode(step.terminated);
+        if (has_values) calibration.EndEpisode(step.terminated);
         break;
       }
     }
@@ -161,56 +159,16 @@ EvalScore Play(const GreedyPolicy& greedy, const ActionValues& values, double ga
     if (after_episode) after_episode();
   }
   EvalScore score = Summarize(std::move(returns));
-  if (values) score.values = calibration.Result();
+  if (has_values) score.values = calibration.Result();
   return score;
-}
-
-}  // namespace
-
-EvalScore ScoreGreedyPolicy(const GreedyPolicy& greedy, const std::string& env_id, int episodes,
-                            double epsilon, uint64_t first_seed,
-                            const std::function<void()>& after_episode) {
-  return Play(greedy, ActionValues(), kDefaultGamma, env_id, episodes, epsilon, first_seed,
-              after_episode);
-}
-
-EvalScore ScoreActionValues(const ActionValues& values, const std::string& env_id, int episodes,
-                            double epsilon, double gamma, uint64_t first_seed,
-                            const std::function<void()>& after_episode) {
-  if (!(gamma >= 0.0 && gamma <= 1.0)) {
-    throw std::invalid_argument("gamma must be in [0, 1], got " + std::to_string(gamma));
-  }
-  return Play(GreedyPolicy(), values, gamma, env_id, episodes, epsilon, first_seed, after_episode);
-}
-
-std::string CheckNetworkFitsEnv(int input_size, int output_size, const envs::EnvSpec& spec) {
-  if (spec.action_dim > 0) {
-    return spec.id + " has continuous actions; a Q-network scores discrete ones only";
-  }
-  std::string why;
-  if (input_size != spec.observation_size) {
-    why = "network input size " + std::to_string(input_size) + " does not match " + spec.id +
-          "'s observation size " + std::to_string(spec.observation_size);
-  }
-  if (output_size != spec.num_actions) {
-    if (!why.empty()) why += "; ";
-    why += "network output size " + std::to_string(output_size) + " does not match " + spec.id +
-           "'s " + std::to_string(spec.num_actions) + " actions";
-  }
-  return why;
 }
 
 EvalScore ScorePolicy(nn::Sequential* net, const std::string& env_id, int episodes, double epsilon,
                       uint64_t first_seed, double gamma,
                       const std::function<void()>& after_episode) {
-  const std::string why =
-      CheckNetworkFitsEnv(net->InputSize(), net->OutputSize(), envs::MakeEnv(env_id)->spec());
-  if (!why.empty()) throw std::invalid_argument(why);
-  const ActionValues values = [net](std::span<const float> obs) {
-    const nn::Matrix& q = net->Predict(obs.data(), static_cast<int>(obs.size()));
-    return std::span<const float>(q.data(), static_cast<size_t>(q.size()));
-  };
-  return ScoreActionValues(values, env_id, episodes, epsilon, gamma, first_seed, after_episode);
+  std::unique_ptr<actor::Policy> policy =
+      EvaluationPolicy(*net, envs::LookupSpec(env_id), epsilon, first_seed);
+  return Score(policy.get(), env_id, episodes, first_seed, gamma, after_episode);
 }
 
 }  // namespace rl::evaluator

@@ -1,15 +1,18 @@
-// Scores a policy by running evaluation episodes, as in Mnih et al. 2015: the greedy action of the
-// network with a small exploration rate (epsilon = 0.05), from seeded initial states.
+// Scores a policy by running evaluation episodes from seeded initial states: for a Q-network, as
+// in Mnih et al. 2015, the greedy action with a small exploration rate (epsilon = 0.05); for a
+// TD3 actor, its deterministic action (Fujimoto et al. 2018 evaluate without noise).
 #pragma once
 
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "actor/policy.h"
 #include "envs/env.h"
 #include "nn/sequential.h"
 
@@ -59,49 +62,38 @@ struct EvalScore {
 /// Summarizes returns (population std). An empty vector gives an all-zero score.
 EvalScore Summarize(std::vector<double> returns);
 
-/// Maps an observation to the greedy action (in [0, num_actions)).
-using GreedyPolicy = std::function<int(std::span<const float> observation)>;
-
-/// Maps an observation to the value estimate of every action (num_actions values, valid until
-/// the next call).
-using ActionValues = std::function<std::span<const float>(std::span<const float> observation)>;
-
 /// Pearson correlation of two equally long series; NaN when they are shorter than 2 or either
 /// is constant.
 double Correlation(std::span<const double> x, std::span<const double> y);
 
-/// Runs `episodes` episodes of a fresh `env_id` env: episode i is reset with seed first_seed + i
-/// and runs until terminated or truncated. In every step the action is uniform at random with
-/// probability `epsilon`, else greedy(observation); the random draws come from a
-/// std::mt19937_64 seeded with first_seed, so the same arguments give the same score.
-/// Throws std::invalid_argument for episodes < 1, epsilon outside [0, 1], an unknown env id or
-/// a greedy action outside the env's action range.
+/// The evaluation policy of `net` for `spec` (actor/policy.h): the greedy action of a Q-network
+/// with a uniform random action with probability `epsilon` (discrete envs), or the actor
+/// network's action without noise (continuous envs); random draws seeded with `seed`. Throws
+/// std::invalid_argument when the network does not fit the env or epsilon is outside [0, 1].
+std::unique_ptr<actor::Policy> EvaluationPolicy(const nn::Sequential& net,
+                                                const envs::EnvSpec& spec, double epsilon,
+                                                uint64_t seed);
+
+/// Runs `episodes` episodes of a fresh `env_id` env with `policy` (step 0 of its schedule): episode
+/// i is reset with seed first_seed + i and runs until terminated or truncated. When the policy
+/// gives value estimates (a Q-network), the value of every action taken is compared with the
+/// discounted return (discount `gamma`) that followed it (EvalScore::values). Throws
+/// std::invalid_argument for episodes < 1, gamma outside [0, 1] or an unknown env id.
 /// `after_episode`, when set, is called after every episode (the evaluator publishes its stats
 /// from there, so that a long evaluation does not look like a silent process).
-EvalScore ScoreGreedyPolicy(const GreedyPolicy& greedy, const std::string& env_id, int episodes,
-                            double epsilon, uint64_t first_seed = kDefaultEvalSeedBase,
-                            const std::function<void()>& after_episode = {});
+EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes,
+                uint64_t first_seed = kDefaultEvalSeedBase, double gamma = kDefaultGamma,
+                const std::function<void()>& after_episode = {});
 
-/// ScoreGreedyPolicy with the first largest of the action values as the greedy action; also
-/// compares the value of every action taken with the discounted return (discount `gamma`) that
-/// followed it (EvalScore::values). Throws std::invalid_argument as ScoreGreedyPolicy, for
-/// gamma outside [0, 1] and for a number of values other than the env's number of actions.
-EvalScore ScoreActionValues(const ActionValues& values, const std::string& env_id, int episodes,
-                            double epsilon, double gamma,
-                            uint64_t first_seed = kDefaultEvalSeedBase,
-                            const std::function<void()>& after_episode = {});
-
-/// ScoreActionValues with the network's outputs as the action values. Throws
-/// std::invalid_argument when the network's input or output size does not match the env's
-/// observation size or number of actions. The network is used (its scratch buffers) but not
-/// changed.
+/// Score() with EvaluationPolicy(*net, env's spec, epsilon, first_seed). The network is copied,
+/// not changed.
 EvalScore ScorePolicy(nn::Sequential* net, const std::string& env_id, int episodes,
                       double epsilon = kDefaultEvalEpsilon,
                       uint64_t first_seed = kDefaultEvalSeedBase, double gamma = kDefaultGamma,
                       const std::function<void()>& after_episode = {});
 
-/// Empty when a network with these input and output sizes fits the env (input size =
-/// observation size, output size = number of actions), else a sentence saying what differs.
-std::string CheckNetworkFitsEnv(int input_size, int output_size, const envs::EnvSpec& spec);
+/// Empty when `net` can drive a policy of `spec` (input size = observation size, output size =
+/// number of actions or action dimension), else a sentence saying what differs.
+std::string CheckNetworkFitsEnv(const nn::Sequential& net, const envs::EnvSpec& spec);
 
 }  // namespace rl::evaluator

@@ -17,8 +17,9 @@ namespace rl::evaluator {
 VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, uint64_t seed,
                               int width, int height, double fps, const std::string& path) {
   auto env = envs::MakeEnv(env_id);
-  const std::string misfit = CheckNetworkFitsEnv(net->InputSize(), net->OutputSize(), env->spec());
-  if (!misfit.empty()) throw std::invalid_argument(misfit);
+  // The greedy policy (epsilon 0; no noise): throws when the network does not fit the env.
+  const std::unique_ptr<actor::Policy> policy = EvaluationPolicy(*net, env->spec(), 0.0, seed);
+  std::vector<float> action(static_cast<size_t>(env->spec().action_width()));
   // The encoder wants even frame sizes.
   width += width % 2;
   height += height % 2;
@@ -45,7 +46,8 @@ VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, ui
   write_frame();
   while (true) {
     const auto obs = env->observation();
-    const envs::StepResult r = env->Step(net->Argmax(obs.data(), static_cast<int>(obs.size())));
+    policy->Act(obs, 0, action);
+    const envs::StepResult r = env->Act(action);
     result.episode_return += r.reward;
     write_frame();
     if (r.terminated || r.truncated) break;

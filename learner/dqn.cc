@@ -26,7 +26,6 @@ void DqnConfig::Validate() const {
   if (target_update_period < 1) throw std::invalid_argument("target-update-period must be >= 1");
   if (!(tau > 0 && tau <= 1)) throw std::invalid_argument("tau must be in (0, 1]");
   if (!(max_grad_norm >= 0)) throw std::invalid_argument("max-grad-norm must be >= 0");
-  if (augment_shift < 0) throw std::invalid_argument("augment-shift must be >= 0");
 }
 
 std::string QNetworkArchitecture(const DqnConfig& config, int obs_size, int num_actions) {
@@ -75,7 +74,6 @@ Dqn::Dqn(int obs_size, int num_actions, DqnConfig config)
   config_.Validate();
   std::mt19937 rng(static_cast<std::mt19937::result_type>(config_.seed));
   online_ = nn::BuildFromArchitecture(QNetworkArchitecture(config_, obs_size, num_actions), &rng);
-  shift_rng_.seed(config_.seed + 1);
   if (online_.InputSize() != obs_size || online_.OutputSize() != num_actions) {
     throw std::invalid_argument("network '" + config_.network + "' takes " +
                                 std::to_string(online_.InputSize()) + " inputs and gives " +
@@ -95,53 +93,44 @@ Dqn::Dqn(int obs_size, int num_actions, DqnConfig config)
   }
 }
 
-void Dqn::ShiftedPixels(const uint8_t* pixels, int planes, int height, int width, int n,
-                        nn::Matrix* out) {
-  std::uniform_int_distribution<int> offset(-config_.augment_shift, config_.augment_shift);
-  shift_y_.resize(static_cast<size_t>(n));
-  shift_x_.resize(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    shift_y_[static_cast<size_t>(i)] = offset(shift_rng_);
-    shift_x_[static_cast<size_t>(i)] = offset(shift_rng_);
-  }
-  nn::ShiftedPixelsToMatrix(pixels, planes, height, width, n, shift_y_.data(), shift_x_.data(),
-                            out);
+std::string Dqn::Describe() const {
+  return std::string(config_.double_dqn ? "Double DQN" : "DQN") + ", " + online_.Architecture();
 }
 
-UpdateResult Dqn::Update(const BatchView& b) {
-  if (b.obs_size != obs_size_) throw std::invalid_argument("batch observation size mismatch");
-  if (b.count < 1) throw std::invalid_argument("empty batch");
-  const int n = b.count;
-  if (b.obs_pixels != nullptr && b.next_obs_pixels != nullptr && config_.augment_shift > 0) {
-    const int64_t frame = int64_t{b.frame_height} * b.frame_width;
-    if (frame < 1 || obs_size_ % frame != 0) {
-      throw std::invalid_argument("augment-shift needs the frame size of a pixel batch");
-    }
-    const int planes = static_cast<int>(obs_size_ / frame);
-    ShiftedPixels(b.obs_pixels, planes, b.frame_height, b.frame_width, n, &obs_);
-    ShiftedPixels(b.next_obs_pixels, planes, b.frame_height, b.frame_width, n, &next_obs_);
-  } else if (b.obs_pixels != nullptr && b.next_obs_pixels != nullptr) {
-    nn::PixelsToMatrix(b.obs_pixels, obs_size_, n, &obs_);
-    nn::PixelsToMatrix(b.next_obs_pixels, obs_size_, n, &next_obs_);
-  } else if (config_.augment_shift > 0) {
-    throw std::invalid_argument("augment-shift applies to pixel observations only");
-  } else if (b.obs != nullptr && b.next_obs != nullptr) {
-    obs_ = Eigen::Map<const nn::Matrix>(b.obs, obs_size_, n);
-    next_obs_ = Eigen::Map<const nn::Matrix>(b.next_obs, obs_size_, n);
-  } else {
-    throw std::invalid_argument("batch without observations");
+UpdateResult Dqn::Update(const Batch& b) {
+  if (b.obs == nullptr || b.next_obs == nullptr || b.obs->rows() != obs_size_ ||
+      b.next_obs->rows() != obs_size_ || b.obs->cols() != b.count ||
+      b.next_obs->cols() != b.count) {
+    throw std::invalid_argument("batch observation size mismatch");
   }
+  if (b.count < 1) throw std::invalid_argument("empty batch");
+  if (b.action_width != 1 || static_cast<int>(b.action.size()) != b.count) {
+    throw std::invalid_argument("DQN takes one action value (the index) per transition");
+  }
+  const int n = b.count;
+  // Actions are indices; check them all before anything changes.
+  actions_.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const float a = b.action[static_cast<size_t>(i)];
+    if (!(a >= 0 && a < static_cast<float>(num_actions_)) ||
+        a != static_cast<float>(static_cast<int>(a))) {
+      throw std::invalid_argument("action outside the network's");
+    }
+    actions_[static_cast<size_t>(i)] = static_cast<int>(a);
+  }
+  const nn::Matrix& obs = *b.obs;
+  const nn::Matrix& next_obs = *b.next_obs;
 
   // Targets y = r + discount * Q_target(s', a*), a* = argmax of the online (Double DQN) or
   // target network. The online network's forward on s' comes first, because the forward on s
   // below must stay cached for the backward pass.
   next_actions_.resize(static_cast<size_t>(n));
   if (config_.double_dqn) {
-    const nn::Matrix& q_online_next = online_.Forward(next_obs_);
+    const nn::Matrix& q_online_next = online_.Forward(next_obs);
     for (int i = 0; i < n; ++i)
       q_online_next.col(i).maxCoeff(&next_actions_[static_cast<size_t>(i)]);
   }
-  const nn::Matrix& q_next = target_.Forward(next_obs_);
+  const nn::Matrix& q_next = target_.Forward(next_obs);
   target_values_.resize(n);
   for (int i = 0; i < n; ++i) {
     int a = 0;
@@ -150,20 +139,19 @@ UpdateResult Dqn::Update(const BatchView& b) {
     } else {
       q_next.col(i).maxCoeff(&a);
     }
-    target_values_[i] = b.reward[i] + b.discount[i] * q_next(a, i);
+    const auto k = static_cast<size_t>(i);
+    target_values_[i] = b.reward[k] + b.discount[k] * q_next(a, i);
   }
 
   // Q(s, a) of the taken actions.
-  const nn::Matrix& q = online_.Forward(obs_);
+  const nn::Matrix& q = online_.Forward(obs);
   pred_.resize(n);
   for (int i = 0; i < n; ++i) {
-    const int a = b.action[i];
-    if (a < 0 || a >= num_actions_) throw std::invalid_argument("action outside the network's");
-    pred_[i] = q(a, i);
+    pred_[i] = q(actions_[static_cast<size_t>(i)], i);
   }
   const nn::Vector* w = nullptr;
-  if (b.weight != nullptr) {
-    weights_ = Eigen::Map<const nn::Vector>(b.weight, n);
+  if (!b.weight.empty()) {
+    weights_ = Eigen::Map<const nn::Vector>(b.weight.data(), n);
     w = &weights_;
   }
   UpdateResult result;
@@ -176,7 +164,7 @@ UpdateResult Dqn::Update(const BatchView& b) {
 
   // Gradient flows only into the chosen actions' outputs.
   grad_q_.setZero(num_actions_, n);
-  for (int i = 0; i < n; ++i) grad_q_(b.action[i], i) = loss_grad_[i];
+  for (int i = 0; i < n; ++i) grad_q_(actions_[static_cast<size_t>(i)], i) = loss_grad_[i];
   online_.ZeroGrad();
   online_.BackwardParams(grad_q_);  // parameter gradients only: no input gradient needed
   if (config_.max_grad_norm > 0) {

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "learner/algorithm.h"
 #include "nn/optimizers.h"
 #include "nn/sequential.h"
 
@@ -35,11 +36,7 @@ struct DqnConfig {
   int target_update_period = 500;  // updates between target refreshes
   float tau = 1.0f;                // weight of the online network in a refresh
   float max_grad_norm = 10.0f;     // global gradient-norm clip (0: none)
-  // Pixel batches: shift each observation and each next observation by its own random offset
-  // of up to this many pixels in y and x, edges repeated (DrQ's random shift, Kostrikov et al.
-  // 2020; they use 4 on 84 x 84 frames). 0: no augmentation.
-  int augment_shift = 0;
-  uint64_t seed = 0;  // initialisation seed (and the seed of the shifts)
+  uint64_t seed = 0;               // initialisation seed
 
   // Throws std::invalid_argument naming the bad field.
   void Validate() const;
@@ -49,54 +46,24 @@ struct DqnConfig {
 // std::invalid_argument when the network cannot take such observations.
 std::string QNetworkArchitecture(const DqnConfig& config, int obs_size, int num_actions);
 
-// A batch of transitions laid out as in the messages: transition i's observation is
-// obs[i*obs_size .. (i+1)*obs_size). Pixel batches give bytes instead (obs_pixels and
-// next_obs_pixels, divided by 255 on the way into the network) and leave obs and next_obs null;
-// their frames are frame_height x frame_width (needed for augment_shift).
-struct BatchView {
-  int obs_size = 0;
-  int count = 0;
-  int frame_height = 0;
-  int frame_width = 0;
-  const float* obs = nullptr;
-  const float* next_obs = nullptr;
-  const uint8_t* obs_pixels = nullptr;
-  const uint8_t* next_obs_pixels = nullptr;
-  const int32_t* action = nullptr;
-  const float* reward = nullptr;
-  const float* discount = nullptr;
-  const float* weight = nullptr;  // importance weights, or nullptr for all ones
-};
-
-struct UpdateResult {
-  float loss = 0;    // mean (weighted) loss of the batch
-  float mean_q = 0;  // mean Q of the chosen actions
-  float grad_norm = 0;
-};
-
-class Dqn {
+class Dqn final : public Algorithm {
  public:
   Dqn(int obs_size, int num_actions, DqnConfig config);
   Dqn(const Dqn&) = delete;
   Dqn& operator=(const Dqn&) = delete;
 
-  // One gradient step on the batch. Throws std::invalid_argument on a batch whose observation
-  // size or actions do not fit the network.
-  UpdateResult Update(const BatchView& batch);
-
-  // |TD error| of each transition of the last Update (for prioritized replay).
-  const std::vector<float>& last_td_errors() const { return td_abs_; }
+  // One gradient step on the batch (Algorithm::Update).
+  UpdateResult Update(const Batch& batch) override;
+  const std::vector<float>& last_td_errors() const override { return td_abs_; }
+  nn::Sequential& policy() override { return online_; }
+  int64_t updates() const override { return updates_; }
+  std::string Describe() const override;
 
   nn::Sequential& online() { return online_; }
   const nn::Sequential& target() const { return target_; }
-  int64_t updates() const { return updates_; }
   const DqnConfig& config() const { return config_; }
 
  private:
-  // Pixels to network inputs, each observation shifted at random by up to augment_shift.
-  void ShiftedPixels(const uint8_t* pixels, int planes, int height, int width, int n,
-                     nn::Matrix* out);
-
   DqnConfig config_;
   int obs_size_;
   int num_actions_;
@@ -105,13 +72,12 @@ class Dqn {
   std::unique_ptr<nn::Optimizer> optimizer_;
   std::vector<nn::Param> params_;
   int64_t updates_ = 0;
-  std::mt19937_64 shift_rng_;  // augment_shift's offsets
 
   // Buffers reused by every update.
-  nn::Matrix obs_, next_obs_, grad_q_;
+  nn::Matrix grad_q_;
   nn::Vector pred_, target_values_, loss_grad_, weights_;
   std::vector<int> next_actions_;
-  std::vector<int> shift_y_, shift_x_;
+  std::vector<int> actions_;
   std::vector<float> td_abs_;
 };
 

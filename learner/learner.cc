@@ -3,12 +3,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
-#include <type_traits>
 
 #include "common/channels.h"
 #include "common/clock.h"
 #include "common/shutdown.h"
-#include "envs/registry.h"
+#include "envs/specs.h"
 #include "nn/checkpoint.h"
 #include "nn/parallel.h"
 #include "rlmsg/checkpoint_t.hpp"
@@ -18,20 +17,25 @@
 namespace rl::learner {
 namespace {
 
-int ObsSize(const std::string& env_id, int augment_shift) {
-  const envs::EnvSpec spec = envs::MakeEnv(env_id)->spec();
-  if (augment_shift > 0 && spec.frame_height <= 0) {
-    throw std::invalid_argument("augment-shift applies to pixel envs, and " + env_id +
-                                " is not one");
+std::unique_ptr<Algorithm> MakeAlgorithm(const LearnerConfig& c, const envs::EnvSpec& spec) {
+  if (c.algorithm == "td3") return std::make_unique<Td3>(spec, c.td3);
+  if (spec.continuous()) {
+    throw std::invalid_argument(spec.id +
+                                " has continuous actions; DQN needs discrete ones (use "
+                                "algorithm = td3)");
   }
-  return spec.observation_size;
+  return std::make_unique<Dqn>(spec.observation_size, spec.num_actions, c.dqn);
 }
-int NumActions(const std::string& env_id) { return envs::MakeEnv(env_id)->spec().num_actions; }
 
 }  // namespace
 
 void LearnerConfig::Validate() const {
-  dqn.Validate();
+  if (algorithm != "dqn" && algorithm != "td3") {
+    throw std::invalid_argument("algorithm must be dqn or td3, not '" + algorithm + "'");
+  }
+  if (algorithm == "dqn") dqn.Validate();
+  if (algorithm == "td3") td3.Validate();
+  if (augment_shift < 0) throw std::invalid_argument("augment-shift must be >= 0");
   if (batch_size < 1 || batch_size > 65536) throw std::invalid_argument("batch-size in [1, 65536]");
   if (requests_in_flight < 1) throw std::invalid_argument("requests-in-flight must be >= 1");
   if (!(request_timeout > 0)) throw std::invalid_argument("request-timeout must be > 0");
@@ -45,17 +49,15 @@ void LearnerConfig::Validate() const {
 Learner::Learner(LearnerConfig config, Bus* bus)
     : config_((config.Validate(), std::move(config))),
       bus_(bus),
-      obs_size_(ObsSize(config_.env_id, config_.dqn.augment_shift)),
-      dqn_(obs_size_, NumActions(config_.env_id), config_.dqn),
+      spec_(envs::LookupSpec(config_.env_id)),
+      algorithm_(MakeAlgorithm(config_, spec_)),
+      decoder_(spec_, config_.augment_shift, config_.seed + 7),
       weights_(bus),
       sender_(bus->config().sender) {
   nn::SetNumThreads(config_.threads);
   std::filesystem::create_directories(std::filesystem::path(config_.out_dir) / "checkpoints");
   bus_->Subscribe<rlmsg::sample_batch_t>(
       channels::kSamples, [this](const rlmsg::sample_batch_t& m) { OnSamples(m); }, Port::kBulk);
-  bus_->Subscribe<rlmsg::pixel_sample_batch_t>(
-      channels::kPixelSamples, [this](const rlmsg::pixel_sample_batch_t& m) { OnPixelSamples(m); },
-      Port::kBulk);
 }
 
 bool Learner::Accept(const std::string& requester, int64_t request_id, int64_t total_inserts) {
@@ -72,26 +74,11 @@ bool Learner::Accept(const std::string& requester, int64_t request_id, int64_t t
 
 void Learner::OnSamples(const rlmsg::sample_batch_t& m) {
   if (!Accept(m.requester, m.request_id, m.total_inserts)) return;
-  if (m.obs_size != obs_size_) {
-    throw std::invalid_argument("sample batch with observation size " + std::to_string(m.obs_size) +
-                                ", expected " + std::to_string(obs_size_));
-  }
-  ready_.emplace_back(m);
-}
-
-void Learner::OnPixelSamples(const rlmsg::pixel_sample_batch_t& m) {
-  if (!Accept(m.requester, m.request_id, m.total_inserts)) return;
-  const int64_t obs_size = int64_t{m.stack} * m.height * m.width;
-  if (obs_size != obs_size_) {
-    throw std::invalid_argument("pixel sample batch of " + std::to_string(m.stack) + " x " +
-                                std::to_string(m.height) + " x " + std::to_string(m.width) +
-                                " bytes per observation, expected " + std::to_string(obs_size_));
-  }
-  ready_.emplace_back(m);
+  ready_.push_back(m);
 }
 
 void Learner::PublishPriorities(const std::vector<int64_t>& index) {
-  const std::vector<float>& td = dqn_.last_td_errors();
+  const std::vector<float>& td = algorithm_->last_td_errors();
   priorities_.count = static_cast<int32_t>(index.size());
   priorities_.index = index;
   priorities_.priority.assign(td.begin(), td.end());
@@ -122,31 +109,27 @@ void Learner::TopUpRequests(double now) {
   }
 }
 
-void Learner::TrainOn(const Batch& batch) {
-  BatchView b;
-  b.obs_size = obs_size_;
-  const std::vector<int64_t>* index = nullptr;
-  std::visit(
-      [&](const auto& m) {
-        b.count = m.count;
-        if constexpr (std::is_same_v<std::decay_t<decltype(m)>, rlmsg::sample_batch_t>) {
-          b.obs = m.obs.data();
-          b.next_obs = m.next_obs.data();
-        } else {
-          b.obs_pixels = m.obs.data();
-          b.next_obs_pixels = m.next_obs.data();
-          b.frame_height = m.height;
-          b.frame_width = m.width;
-        }
-        b.action = m.action.data();
-        b.reward = m.reward.data();
-        b.discount = m.discount.data();
-        b.weight = m.weight.data();
-        index = &m.index;
-      },
-      batch);
-  const UpdateResult r = dqn_.Update(b);
-  if (config_.prioritized) PublishPriorities(*index);
+void Learner::TrainOn(const rlmsg::sample_batch_t& m) {
+  // A reply that does not fit (a foreign run's replay, a replay of another env) is dropped and
+  // counted, never trained on and never fatal.
+  Batch batch;
+  const char* why = decoder_.Decode(m, &batch);
+  UpdateResult r;
+  if (why == nullptr) {
+    try {
+      r = algorithm_->Update(batch);
+    } catch (const std::invalid_argument& e) {
+      why = "the algorithm refused it";
+      if (batches_refused_ < 10) std::fprintf(stderr, "[%s] %s\n", sender_.c_str(), e.what());
+    }
+  }
+  if (why != nullptr) {
+    if (batches_refused_++ < 10 || batches_refused_ % 1000 == 0) {
+      std::fprintf(stderr, "[%s] refused a sample batch: %s\n", sender_.c_str(), why);
+    }
+    return;
+  }
+  if (config_.prioritized) PublishPriorities(m.index);
   loss_sum_ += r.loss;
   q_sum_ += r.mean_q;
   ++stat_updates_;
@@ -154,16 +137,17 @@ void Learner::TrainOn(const Batch& batch) {
 
 std::string Learner::Checkpoint() {
   char name[64];
-  std::snprintf(name, sizeof(name), "ckpt-%09lld.bin", static_cast<long long>(dqn_.updates()));
+  std::snprintf(name, sizeof(name), "ckpt-%09lld.bin",
+                static_cast<long long>(algorithm_->updates()));
   const std::string path = (std::filesystem::path(config_.out_dir) / "checkpoints" / name).string();
   nn::Checkpoint ckpt;
-  ckpt.architecture = dqn_.online().Architecture();
-  ckpt.meta.update = dqn_.updates();
+  ckpt.architecture = algorithm_->policy().Architecture();
+  ckpt.meta.update = algorithm_->updates();
   ckpt.meta.env_steps = env_steps_;
   ckpt.meta.wall_seconds = MonoSeconds() - start_time_;
   ckpt.meta.run_id = static_cast<uint64_t>(bus_->config().run_id);
   ckpt.meta.note = config_.env_id;
-  dqn_.online().GetFlat(&ckpt.params);
+  algorithm_->policy().GetFlat(&ckpt.params);
   nn::SaveCheckpoint(path, ckpt);
   // Keep the newest keep_checkpoints files; older ones have been scored or skipped by now.
   if (written_.empty() || written_.back() != path) written_.push_back(path);
@@ -185,7 +169,7 @@ std::string Learner::Checkpoint() {
 
 void Learner::PublishStats(double now) {
   rlmsg::stats_learner_t s{};
-  s.updates = dqn_.updates();
+  s.updates = algorithm_->updates();
   const double dt = now - stats_last_time_;
   s.updates_per_second = (stats_last_time_ > 0 && dt > 0)
                              ? static_cast<double>(s.updates - stats_last_updates_) / dt
@@ -198,6 +182,7 @@ void Learner::PublishStats(double now) {
   s.request_timeouts = request_timeouts_;
   s.priorities_sent = priorities_sent_;
   bus_->FillCounters(&s);
+  s.dropped_invalid += batches_refused_;
   bus_->Publish(channels::kStatsLearner, &s);
   stats_last_time_ = now;
   stats_last_updates_ = s.updates;
@@ -211,10 +196,10 @@ void Learner::Run() {
   double next_stats = start_time_;
   double next_log = start_time_ + 5.0;
   // The initial (random) network goes out at once, so actors and tools see weights flow.
-  dqn_.online().GetFlat(&flat_);
-  weights_.Start(0, dqn_.online().Architecture(), flat_);
+  algorithm_->policy().GetFlat(&flat_);
+  weights_.Start(0, algorithm_->policy().Architecture(), flat_);
   while (!StopRequested()) {
-    if (config_.max_updates > 0 && dqn_.updates() >= config_.max_updates) break;
+    if (config_.max_updates > 0 && algorithm_->updates() >= config_.max_updates) break;
     bus_->Handle(ready_.empty() && !weights_.busy() ? 2 : 0);
     const double now = MonoSeconds();
     TopUpRequests(now);
@@ -222,10 +207,10 @@ void Learner::Run() {
       TrainOn(ready_.front());
       ready_.pop_front();
       TopUpRequests(now);
-      const int64_t u = dqn_.updates();
+      const int64_t u = algorithm_->updates();
       if (u % config_.weights_every == 0) {
-        dqn_.online().GetFlat(&flat_);
-        weights_.Start(u, dqn_.online().Architecture(), flat_);
+        algorithm_->policy().GetFlat(&flat_);
+        weights_.Start(u, algorithm_->policy().Architecture(), flat_);
       }
       if (u % config_.checkpoint_every == 0) Checkpoint();
     }
@@ -236,13 +221,13 @@ void Learner::Run() {
     }
     if (now >= next_log) {
       std::printf("learner: updates %lld env steps %lld timeouts %lld\n",
-                  static_cast<long long>(dqn_.updates()), static_cast<long long>(env_steps_),
+                  static_cast<long long>(algorithm_->updates()), static_cast<long long>(env_steps_),
                   static_cast<long long>(request_timeouts_));
       std::fflush(stdout);
       next_log = now + 5.0;
     }
   }
-  if (dqn_.updates() > 0) Checkpoint();
+  if (algorithm_->updates() > 0) Checkpoint();
   PublishStats(MonoSeconds());
 }
 

@@ -1,5 +1,7 @@
-// Learner: samples batches from the replay daemon, trains a Dqn on them, broadcasts weights,
-// writes and announces checkpoints, and publishes its stats.
+// Learner: samples batches from the replay daemon, trains an Algorithm (DQN or TD3, algorithm.h)
+// on them, broadcasts the policy network's weights, writes and announces checkpoints, and
+// publishes its stats. It learns the env's sizes from its static spec (envs/specs.h): it builds
+// no env and links no physics or rendering.
 //
 // Sampling is request/reply with requests_in_flight requests outstanding; a request without a
 // reply after request_timeout seconds is sent again with the same id (the replay ignores a
@@ -9,13 +11,16 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <memory>
 #include <string>
-#include <variant>
 
 #include "common/lcm_bus.h"
+#include "envs/env.h"
+#include "learner/algorithm.h"
+#include "learner/batch_decoder.h"
 #include "learner/dqn.h"
+#include "learner/td3.h"
 #include "learner/weights_publisher.h"
-#include "rlmsg/pixel_sample_batch_t.hpp"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
 
@@ -23,18 +28,24 @@ namespace rl::learner {
 
 struct LearnerConfig {
   std::string env_id = "CartPole-v1";  // environment (gives the network's input and output sizes)
-  DqnConfig dqn;                       // the algorithm
-  int batch_size = 128;                // transitions per update
-  int requests_in_flight = 4;          // sample requests outstanding at once
-  double request_timeout = 2.0;        // seconds before a request is sent again
-  int weights_every = 100;             // updates between weight broadcasts
-  int checkpoint_every = 1000;         // updates between checkpoints
-  int keep_checkpoints = 0;            // newest checkpoint files kept on disk (0: all)
-  bool prioritized = false;            // publish |TD errors| as priorities after every update
-  int threads = 1;                     // compute threads of the network library (nn::SetNumThreads)
-  std::string out_dir = ".";           // checkpoints go to <out_dir>/checkpoints/
-  int64_t max_updates = 0;             // stop after this many updates (0: until stopped)
-  double stats_hz = 4.0;               // stats messages per second
+  std::string algorithm = "dqn";       // "dqn" (discrete actions) or "td3" (continuous)
+  DqnConfig dqn;                       // algorithm = dqn
+  Td3Config td3;                       // algorithm = td3
+  // Pixel envs: shift every sampled observation by a random offset of up to this many pixels
+  // (DrQ's random shift, Kostrikov et al. 2020; they use 4 on 84 x 84 frames). 0: none.
+  int augment_shift = 0;
+  uint64_t seed = 0;             // seed of the shifts (the algorithms have their own)
+  int batch_size = 128;          // transitions per update
+  int requests_in_flight = 4;    // sample requests outstanding at once
+  double request_timeout = 2.0;  // seconds before a request is sent again
+  int weights_every = 100;       // updates between weight broadcasts
+  int checkpoint_every = 1000;   // updates between checkpoints
+  int keep_checkpoints = 0;      // newest checkpoint files kept on disk (0: all)
+  bool prioritized = false;      // publish |TD errors| as priorities after every update
+  int threads = 1;               // compute threads of the network library (nn::SetNumThreads)
+  std::string out_dir = ".";     // checkpoints go to <out_dir>/checkpoints/
+  int64_t max_updates = 0;       // stop after this many updates (0: until stopped)
+  double stats_hz = 4.0;         // stats messages per second
 
   void Validate() const;
 };
@@ -49,8 +60,11 @@ class Learner {
   // Trains until StopRequested() or max_updates, then writes a last checkpoint.
   void Run();
 
-  int64_t updates() const { return dqn_.updates(); }
-  Dqn& dqn() { return dqn_; }
+  int64_t updates() const { return algorithm_->updates(); }
+  Algorithm& algorithm() { return *algorithm_; }
+  const envs::EnvSpec& spec() const { return spec_; }
+  // Sample replies that did not fit the networks (counted, dropped, logged).
+  int64_t batches_refused() const { return batches_refused_; }
   // Writes a checkpoint of the current parameters, announces it and returns its path.
   std::string Checkpoint();
 
@@ -59,31 +73,29 @@ class Learner {
     double sent = 0;
   };
 
-  // A reply received and not yet trained on: flat or pixel observations.
-  using Batch = std::variant<rlmsg::sample_batch_t, rlmsg::pixel_sample_batch_t>;
-
   // Takes a reply if it answers one of our requests in flight; false for another learner's or a
   // duplicate.
   bool Accept(const std::string& requester, int64_t request_id, int64_t total_inserts);
   void OnSamples(const rlmsg::sample_batch_t& m);
-  void OnPixelSamples(const rlmsg::pixel_sample_batch_t& m);
   void PublishPriorities(const std::vector<int64_t>& index);
   void TopUpRequests(double now);
   void SendRequest(int64_t id);
-  void TrainOn(const Batch& batch);
+  void TrainOn(const rlmsg::sample_batch_t& batch);
   void PublishStats(double now);
 
   LearnerConfig config_;
   Bus* bus_;
-  int obs_size_ = 0;
-  Dqn dqn_;
+  envs::EnvSpec spec_;
+  std::unique_ptr<Algorithm> algorithm_;
+  BatchDecoder decoder_;
   WeightsPublisher weights_;
   std::string sender_;
   double start_time_ = 0;
 
   std::map<int64_t, Request> in_flight_;  // by request id
   int64_t next_request_id_ = 0;
-  std::deque<Batch> ready_;
+  std::deque<rlmsg::sample_batch_t> ready_;
+  int64_t batches_refused_ = 0;
   rlmsg::priority_update_t priorities_{};
   int64_t priorities_sent_ = 0;
   int64_t env_steps_ = 0;

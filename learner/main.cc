@@ -31,48 +31,74 @@ int Main(int argc, char** argv) {
   rl::CommonOptions common;
   rl::learner::LearnerConfig c;
   rl::learner::DqnConfig& d = c.dqn;
-  std::string hidden = "120,84";
+  rl::learner::Td3Config& t = c.td3;
+  // Options both algorithms have but with different defaults are left without one here and set
+  // on the chosen algorithm's config only when given.
+  std::string network, hidden;
+  float tau = 0, adam_eps = 0, max_grad_norm = 0;
+  uint64_t seed = 0;
   rl::po::options_description desc("Options");
   rl::AddCommonOptions(&desc, &common);
   desc.add_options()                                                                //
       ("env", rl::po::value(&c.env_id)->default_value(c.env_id), "environment id")  //
       ("out", rl::po::value(&c.out_dir)->default_value(c.out_dir),
        "run folder; checkpoints go to <out>/checkpoints")  //
-      ("network", rl::po::value(&d.network)->default_value(d.network),
-       "Q network: mlp, nature (Mnih et al. 2015, 4x84x84 frames), grasp (stacks of 40x40 "
-       "frames), grasp48 (stacks of 48x48 frames, a 6x6 map) or an architecture string")  //
-      ("hidden", rl::po::value(&hidden)->default_value(hidden),
-       "hidden layer widths of the MLP")  //
-      ("dueling", rl::po::value(&d.dueling)->default_value(d.dueling),
-       "dueling value and advantage streams (1/0; mlp, nature, grasp, grasp48)")  //
+      ("algorithm", rl::po::value(&c.algorithm)->default_value(c.algorithm),
+       "dqn (discrete actions: Double DQN, dueling, n-step, prioritized) or td3 (continuous "
+       "actions: Fujimoto et al. 2018)")  //
+      ("network", rl::po::value(&network),
+       "dqn: the Q network, mlp (default), nature (Mnih et al. 2015, 4x84x84 frames), grasp "
+       "(stacks of 40x40 frames), grasp48 (stacks of 48x48 frames) or an architecture string; "
+       "td3: mlp (default) or car (the TD3 CarRacing article's CNNs, 4x84x84 frames)")  //
+      ("hidden", rl::po::value(&hidden),
+       "hidden layer widths of the MLPs (dqn default 120,84; td3 default 256,256)")  //
+      ("tau", rl::po::value(&tau),
+       "target update weight of the online network (dqn default 1: hard copy every "
+       "target-update-period; td3 default 0.005: Polyak, every policy-delay updates)")  //
+      ("adam-eps", rl::po::value(&adam_eps), "Adam epsilon (default 1e-8)")             //
+      ("max-grad-norm", rl::po::value(&max_grad_norm),
+       "gradient norm clip, 0: none (dqn default 10, td3 default 0)")          //
+      ("seed", rl::po::value(&seed)->default_value(0), "initialisation seed")  //
+      ("batch-size", rl::po::value(&c.batch_size)->default_value(c.batch_size),
+       "transitions per update")  //
       ("prioritized", rl::po::value(&c.prioritized)->default_value(c.prioritized),
        "send |TD errors| to the replay as priorities after every update (1/0)")  //
-      ("batch-size", rl::po::value(&c.batch_size)->default_value(c.batch_size),
-       "transitions per update")                                                                 //
-      ("optimizer", rl::po::value(&d.optimizer)->default_value(d.optimizer), "adam or rmsprop")  //
+      ("augment-shift", rl::po::value(&c.augment_shift)->default_value(c.augment_shift),
+       "pixel envs: shift every sampled observation by a random offset of up to this many "
+       "pixels, edges repeated (DrQ, Kostrikov et al. 2020); 0: none")  //
+      // DQN only.
+      ("dueling", rl::po::value(&d.dueling)->default_value(d.dueling),
+       "dqn: dueling value and advantage streams (1/0; mlp, nature, grasp, grasp48)")  //
+      ("optimizer", rl::po::value(&d.optimizer)->default_value(d.optimizer),
+       "dqn: adam or rmsprop")  //
       ("learning-rate", rl::po::value(&d.learning_rate)->default_value(d.learning_rate),
-       "step size")                                                                        //
-      ("adam-eps", rl::po::value(&d.adam_eps)->default_value(d.adam_eps), "Adam epsilon")  //
+       "dqn: step size")  //
       ("rmsprop-alpha", rl::po::value(&d.rmsprop_alpha)->default_value(d.rmsprop_alpha),
-       "RMSProp smoothing constant (DeepMind: 0.95)")  //
+       "dqn: RMSProp smoothing constant (DeepMind: 0.95)")  //
       ("rmsprop-eps", rl::po::value(&d.rmsprop_eps)->default_value(d.rmsprop_eps),
-       "RMSProp epsilon (DeepMind: 0.01)")  //
+       "dqn: RMSProp epsilon (DeepMind: 0.01)")  //
       ("rmsprop-centered", rl::po::value(&d.rmsprop_centered)->default_value(d.rmsprop_centered),
-       "centered RMSProp, as DeepMind's (1/0)")                                //
-      ("loss", rl::po::value(&d.loss)->default_value(d.loss), "huber or mse")  //
+       "dqn: centered RMSProp, as DeepMind's (1/0)")                                //
+      ("loss", rl::po::value(&d.loss)->default_value(d.loss), "dqn: huber or mse")  //
       ("double-dqn", rl::po::value(&d.double_dqn)->default_value(d.double_dqn),
-       "Double DQN targets (1/0)")  //
+       "dqn: Double DQN targets (1/0)")  //
       ("target-update-period",
        rl::po::value(&d.target_update_period)->default_value(d.target_update_period),
-       "updates between target network refreshes")  //
-      ("tau", rl::po::value(&d.tau)->default_value(d.tau),
-       "refresh weight of the online network (1: hard copy)")  //
-      ("max-grad-norm", rl::po::value(&d.max_grad_norm)->default_value(d.max_grad_norm),
-       "gradient norm clip (0: none)")  //
-      ("augment-shift", rl::po::value(&d.augment_shift)->default_value(d.augment_shift),
-       "pixel envs: shift every sampled observation by a random offset of up to this many "
-       "pixels, edges repeated (DrQ, Kostrikov et al. 2020); 0: none")                //
-      ("seed", rl::po::value(&d.seed)->default_value(d.seed), "initialisation seed")  //
+       "dqn: updates between target network refreshes")  //
+      // TD3 only.
+      ("actor-learning-rate",
+       rl::po::value(&t.actor_learning_rate)->default_value(t.actor_learning_rate),
+       "td3: the actor's Adam step size")  //
+      ("critic-learning-rate",
+       rl::po::value(&t.critic_learning_rate)->default_value(t.critic_learning_rate),
+       "td3: the critics' Adam step size")  //
+      ("policy-delay", rl::po::value(&t.policy_delay)->default_value(t.policy_delay),
+       "td3: critic updates per actor and target update")  //
+      ("target-noise", rl::po::value(&t.target_noise)->default_value(t.target_noise),
+       "td3: target policy smoothing noise, relative to each action dimension's half-range")  //
+      ("target-noise-clip", rl::po::value(&t.target_noise_clip)->default_value(t.target_noise_clip),
+       "td3: clip of that noise, relative to the half-range")  //
+      // Both.
       ("requests-in-flight",
        rl::po::value(&c.requests_in_flight)->default_value(c.requests_in_flight),
        "sample requests outstanding at once")  //
@@ -94,21 +120,43 @@ int Main(int argc, char** argv) {
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "learner",
                         "Usage: learner [options]\n"
-                        "Trains a DQN on batches sampled from the replay daemon, broadcasts its "
-                        "weights and writes checkpoints.",
+                        "Trains a DQN or a TD3 on batches sampled from the replay daemon, "
+                        "broadcasts its policy network's weights and writes checkpoints.",
                         desc, &vm)) {
     return 0;
   }
-  d.hidden = ParseWidths(hidden);
+  if (c.algorithm == "td3") {
+    rl::RefuseGiven(vm,
+                    {"dueling", "optimizer", "learning-rate", "rmsprop-alpha", "rmsprop-eps",
+                     "rmsprop-centered", "loss", "double-dqn", "target-update-period"},
+                    "algorithm is td3, and it is a dqn option");
+    if (vm.count("network")) t.network = network;
+    if (vm.count("hidden")) t.hidden = ParseWidths(hidden);
+    if (vm.count("tau")) t.tau = tau;
+    if (vm.count("adam-eps")) t.adam_eps = adam_eps;
+    if (vm.count("max-grad-norm")) t.max_grad_norm = max_grad_norm;
+    t.seed = seed;
+  } else {
+    rl::RefuseGiven(vm,
+                    {"actor-learning-rate", "critic-learning-rate", "policy-delay", "target-noise",
+                     "target-noise-clip"},
+                    "algorithm is " + c.algorithm + ", and it is a td3 option");
+    if (vm.count("network")) d.network = network;
+    if (vm.count("hidden")) d.hidden = ParseWidths(hidden);
+    if (vm.count("tau")) d.tau = tau;
+    if (vm.count("adam-eps")) d.adam_eps = adam_eps;
+    if (vm.count("max-grad-norm")) d.max_grad_norm = max_grad_norm;
+    d.seed = seed;
+  }
+  c.seed = seed;
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("learner"));
   rl::learner::Learner learner(c, &bus);
   std::string shifts;
-  if (const int k = learner.dqn().config().augment_shift; k > 0) {
+  if (const int k = c.augment_shift; k > 0) {
     shifts = ", random shifts of up to " + std::to_string(k) + " pixels";
   }
-  std::printf("learner: ready (%s)%s\n", learner.dqn().online().Architecture().c_str(),
-              shifts.c_str());
+  std::printf("learner: ready (%s)%s\n", learner.algorithm().Describe().c_str(), shifts.c_str());
   std::fflush(stdout);
   learner.Run();
   std::printf("learner: stopped after %lld updates\n", static_cast<long long>(learner.updates()));

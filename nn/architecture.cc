@@ -15,6 +15,7 @@
 #include "nn/flatten.h"
 #include "nn/layer_norm.h"
 #include "nn/linear.h"
+#include "nn/pool2d.h"
 #include "nn/sequential.h"
 
 namespace rl::nn {
@@ -97,6 +98,16 @@ int ParseInt(const std::string& arch, const std::string& layer, const std::strin
   return value;
 }
 
+float ParseFloat(const std::string& arch, const std::string& layer, const std::string& s) {
+  try {
+    size_t used = 0;
+    const float v = std::stof(s, &used);
+    if (used == s.size()) return v;
+  } catch (const std::exception&) {
+  }
+  ArchError(arch, "layer '" + layer + "': '" + s + "' is not a number");
+}
+
 // The known layers: name, argument names (empty: takes no arguments) and a factory.
 struct LayerKind {
   const char* name;
@@ -130,6 +141,16 @@ const std::vector<LayerKind>& LayerKinds() {
        {"in", "hidden", "actions"},
        [](const std::vector<int>& a, std::mt19937* rng) -> std::unique_ptr<Layer> {
          return std::make_unique<Dueling>(a[0], a[1], a[2], rng);
+       }},
+      {"maxpool2d",
+       {"channels", "kernel", "height", "width"},
+       [](const std::vector<int>& a, std::mt19937* /*rng*/) -> std::unique_ptr<Layer> {
+         return std::make_unique<Pool2d>(Pool2d::Mode::kMax, a[0], a[1], a[2], a[3]);
+       }},
+      {"avgpool2d",
+       {"channels", "kernel", "height", "width"},
+       [](const std::vector<int>& a, std::mt19937* /*rng*/) -> std::unique_ptr<Layer> {
+         return std::make_unique<Pool2d>(Pool2d::Mode::kAverage, a[0], a[1], a[2], a[3]);
        }},
       {"relu",
        {},
@@ -171,6 +192,25 @@ Sequential BuildFromArchitecture(const std::string& arch, std::mt19937* rng) {
   for (size_t i = 0; i < specs.size(); ++i) {
     const LayerSpec& spec = specs[i];
     const std::string where = "layer " + std::to_string(i) + " '" + spec.name + "'";
+    if (spec.name == "bounded") {
+      // bounded(n,low_1,high_1,...): an integer, then 2n floats.
+      if (spec.args.empty()) ArchError(arch, where + " needs bounded(n,low_1,high_1,...)");
+      const int n = ParseInt(arch, spec.name, spec.args[0], false);
+      if (spec.args.size() != 1 + 2 * static_cast<size_t>(n)) {
+        ArchError(arch, where + " needs " + std::to_string(2 * n) + " bounds after n");
+      }
+      std::vector<float> low, high;
+      for (int k = 0; k < n; ++k) {
+        low.push_back(ParseFloat(arch, spec.name, spec.args[1 + 2 * static_cast<size_t>(k)]));
+        high.push_back(ParseFloat(arch, spec.name, spec.args[2 + 2 * static_cast<size_t>(k)]));
+      }
+      try {
+        net.Add(std::make_unique<Bounded>(std::move(low), std::move(high)));
+      } catch (const std::invalid_argument& e) {
+        ArchError(arch, where + ": " + e.what());
+      }
+      continue;
+    }
     const auto& kinds = LayerKinds();
     const auto kind = std::find_if(kinds.begin(), kinds.end(),
                                    [&](const LayerKind& k) { return spec.name == k.name; });

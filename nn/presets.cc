@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "nn/activations.h"
+
 namespace rl::nn {
 namespace {
 
@@ -59,6 +61,60 @@ std::string Grasp48CnnArchitecture(int num_actions, int in_channels, bool duelin
 
 Sequential MakeGrasp48Cnn(int num_actions, std::mt19937* rng, int in_channels, bool dueling) {
   return BuildFromArchitecture(Grasp48CnnArchitecture(num_actions, in_channels, dueling), rng);
+}
+
+namespace {
+
+// linear(in,h1),relu,...,linear(hk,out): the layers of an MLP as an architecture string.
+std::string MlpLayers(int in, const std::vector<int>& hidden, int out) {
+  RequirePositive(in, "Td3Mlp: input size");
+  RequirePositive(out, "Td3Mlp: output size");
+  std::string arch;
+  for (int h : hidden) {
+    RequirePositive(h, "Td3Mlp: hidden width");
+    arch += "linear(" + std::to_string(in) + "," + std::to_string(h) + "),relu,";
+    in = h;
+  }
+  return arch + "linear(" + std::to_string(in) + "," + std::to_string(out) + ")";
+}
+
+}  // namespace
+
+std::string Td3MlpActorArchitecture(int obs_size, const std::vector<int>& hidden,
+                                    const std::vector<float>& low, const std::vector<float>& high) {
+  const int actions = static_cast<int>(low.size());
+  if (actions < 1 || high.size() != low.size()) {
+    throw std::invalid_argument("Td3MlpActor: needs one low and one high bound per action");
+  }
+  const Bounded bounds(low, high);  // checks the bounds and writes them exactly
+  return MlpLayers(obs_size, hidden, actions) + "," + bounds.Describe();
+}
+
+std::string Td3MlpCriticArchitecture(int obs_size, int action_size,
+                                     const std::vector<int>& hidden) {
+  RequirePositive(action_size, "Td3MlpCritic: action size");
+  return "||" + MlpLayers(obs_size + action_size, hidden, 1);
+}
+
+std::string CarEncoderArchitecture() {
+  return "conv2d(4,16,4,2,0,84,84),relu,maxpool2d(16,2,41,41),conv2d(16,32,4,2,0,20,20),relu,"
+         "avgpool2d(32,2,9,9),flatten";
+}
+
+std::string Td3CarActorArchitecture(const std::vector<float>& low, const std::vector<float>& high) {
+  const int actions = static_cast<int>(low.size());
+  if (actions < 1 || high.size() != low.size()) {
+    throw std::invalid_argument("Td3CarActor: needs one low and one high bound per action");
+  }
+  const Bounded bounds(low, high);
+  const std::string a = std::to_string(actions);
+  return CarEncoderArchitecture() + ",layernorm(512),linear(512,128),relu,linear(128," + a +
+         "),layernorm(" + a + ")," + bounds.Describe();
+}
+
+std::string Td3CarCriticArchitecture() {
+  return CarEncoderArchitecture() + ",linear(512,128),relu,linear(128,3),relu|linear(3,3),relu|" +
+         "linear(6,3),relu,linear(3,1)";
 }
 
 }  // namespace rl::nn

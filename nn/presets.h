@@ -3,6 +3,7 @@
 
 #include <random>
 #include <string>
+#include <vector>
 
 #include "nn/sequential.h"
 
@@ -43,5 +44,24 @@ std::string Grasp48CnnArchitecture(int num_actions, int in_channels = 4, bool du
 /// BuildFromArchitecture(Grasp48CnnArchitecture(num_actions, in_channels, dueling), rng).
 Sequential MakeGrasp48Cnn(int num_actions, std::mt19937* rng, int in_channels = 4,
                           bool dueling = false);
+
+/// TD3 (Fujimoto et al. 2018), the author's networks for flat observations: the actor
+///   linear(obs,h1),relu,...,linear(hk,actions),bounded(actions,low_1,high_1,...)
+/// (a tanh scaled to the action box) and a critic (an ActionValueNet string, both branches empty)
+///   ||linear(obs+actions,h1),relu,...,linear(hk,1)
+/// Throws std::invalid_argument for non-positive sizes or bounds of another size than the action.
+std::string Td3MlpActorArchitecture(int obs_size, const std::vector<int>& hidden,
+                                    const std::vector<float>& low, const std::vector<float>& high);
+std::string Td3MlpCriticArchitecture(int obs_size, int action_size, const std::vector<int>& hidden);
+
+/// The TD3 CarRacing article's networks on 4 x 84 x 84 stacks (td3-carracing.md 1.2). Encoder:
+///   conv2d(4,16,4,2,0,84,84),relu,maxpool2d(16,2,41,41),conv2d(16,32,4,2,0,20,20),relu,
+///   avgpool2d(32,2,9,9),flatten  -> 512 features
+/// Actor: encoder,layernorm(512),linear(512,128),relu,linear(128,a),layernorm(a),bounded(a,...).
+/// Critic (ActionValueNet string): encoder,linear(512,128),relu,linear(128,3),relu | linear(3,3),
+/// relu | linear(6,3),relu,linear(3,1), for 3-d actions (the article's).
+std::string CarEncoderArchitecture();
+std::string Td3CarActorArchitecture(const std::vector<float>& low, const std::vector<float>& high);
+std::string Td3CarCriticArchitecture();
 
 }  // namespace rl::nn

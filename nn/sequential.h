@@ -140,6 +140,8 @@ class Sequential {
 ///   batchnorm2d(channels,h,w)                        BatchNorm2d
 ///   layernorm(features)                              LayerNorm
 ///   dueling(in,hidden,actions)                       Dueling
+///   maxpool2d(channels,k,h,w), avgpool2d(channels,k,h,w)  Pool2d (k x k windows, stride k)
+///   bounded(n,low_1,high_1,...,low_n,high_n)         Bounded (tanh scaled to per-feature bounds)
 ///   relu, tanh, flatten
 /// e.g. "conv2d(4,32,8,4,0,84,84),relu,conv2d(32,64,4,2,0,20,20),relu,flatten,linear(6400,7)".
 /// Parameters are drawn from `rng` as in PyTorch's defaults, layer by layer. Throws

@@ -2,11 +2,13 @@
 // holding both to a samples-per-insert ratio. See README.md.
 #include <cstdint>
 #include <cstdio>
+#include <span>
 #include <string>
 
 #include "common/lcm_bus.h"
 #include "common/options.h"
 #include "common/shutdown.h"
+#include "envs/specs.h"
 #include "replay/replay_service.h"
 
 namespace {
@@ -14,19 +16,25 @@ namespace {
 constexpr char kUsage[] =
     "Usage: replay [options]\n"
     "The replay daemon: stores transitions from RL_TRANSITIONS in a ring buffer and answers\n"
-    "RL_SAMPLE_REQUEST with batches on RL_SAMPLES (uniform or prioritized; pixel transitions\n"
-    "from RL_PIXEL_TRANSITIONS are answered on RL_PIXEL_SAMPLES), holding the ratio of\n"
-    "samples to inserts near --samples-per-insert (actors are paused through RL_FLOW).";
+    "RL_SAMPLE_REQUEST with batches on RL_SAMPLES (uniform or prioritized; flat observations,\n"
+    "or pixel frames stored once and stacks rebuilt), holding the ratio of samples to inserts\n"
+    "near --samples-per-insert (actors are paused through RL_FLOW). With --env, every action is\n"
+    "checked against the env's action space (width, integer indices, bounds) and a batch with a\n"
+    "bad one is refused and counted.";
 
 int Main(int argc, char** argv) {
   namespace po = rl::po;
   rl::CommonOptions common;
   rl::replay::ReplayServiceOptions options;
   options.progress_seconds = 5.0;
+  std::string env_id;
 
   po::options_description desc("Options");
   rl::AddCommonOptions(&desc, &common);
   desc.add_options()  //
+      ("env", po::value(&env_id),
+       "environment of the run: actions are checked against its action space (none: any "
+       "action of the first batch's width)")  //
       ("capacity", po::value(&options.table.capacity)->default_value(options.table.capacity),
        "transitions kept; the oldest are overwritten")  //
       ("obs-size", po::value(&options.table.obs_size)->default_value(options.table.obs_size),
@@ -69,6 +77,14 @@ int Main(int argc, char** argv) {
   po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "replay", kUsage, desc, &vm)) return 0;
 
+  if (!env_id.empty()) {
+    // The static spec: the replay builds no env and links no physics.
+    const rl::envs::EnvSpec spec = rl::envs::LookupSpec(env_id);
+    options.table.action_width = spec.action_width();
+    options.check_action = [spec](std::span<const float> action) {
+      return rl::envs::CheckAction(spec, action);
+    };
+  }
   // Refuse bad values before touching the network.
   options.Validate();
   rl::InstallStopHandlers();

@@ -47,6 +47,12 @@ void PixelTableOptions::Validate() const {
                                 std::to_string(kMaxSide) + "] (0: from the first batch), got " +
                                 std::to_string(height) + " x " + std::to_string(width));
   }
+  if (action_width < 0 || action_width > TransitionColumns::kMaxActionWidth) {
+    throw std::invalid_argument(
+        "pixel table: action_width must be in [0, 64] (0: from the first "
+        "batch), got " +
+        std::to_string(action_width));
+  }
   if (stack < 0 || stack > kMaxStack) {
     throw std::invalid_argument("pixel table: stack must be in [0, " + std::to_string(kMaxStack) +
                                 "] (0: from the first batch), got " + std::to_string(stack));
@@ -57,8 +63,10 @@ int64_t PixelTableOptions::frames_kept() const {
   return frame_capacity > 0 ? frame_capacity : capacity + capacity / 32 + 4096;
 }
 
-void PixelSampleBatch::Resize(int new_count, int new_height, int new_width, int new_stack) {
+void PixelSampleBatch::Resize(int new_count, int new_height, int new_width, int new_stack,
+                              int new_action_width) {
   count = new_count;
+  action_width = new_action_width;
   height = new_height;
   width = new_width;
   stack = new_stack;
@@ -67,7 +75,7 @@ void PixelSampleBatch::Resize(int new_count, int new_height, int new_width, int 
                        static_cast<size_t>(new_width);
   obs.resize(bytes);
   next_obs.resize(bytes);
-  action.resize(n);
+  action.resize(n * static_cast<size_t>(new_action_width));
   reward.resize(n);
   discount.resize(n);
   index.resize(n);
@@ -75,7 +83,7 @@ void PixelSampleBatch::Resize(int new_count, int new_height, int new_width, int 
 }
 
 PixelSampleSpans PixelSampleBatch::spans() {
-  return PixelSampleSpans{obs, next_obs, action, reward, discount, index, weight};
+  return PixelSampleSpans{obs, next_obs, {action, reward, discount, index, weight, {}}};
 }
 
 PixelTable::PixelTable(PixelTableOptions options, std::unique_ptr<Sampler> sampler)
@@ -99,11 +107,6 @@ void PixelTable::Allocate(int height, int width, int stack) {
                      static_cast<size_t>(width),
                  0);
   frame_refs_.assign(slots * 2 * static_cast<size_t>(stack), -1);
-  action_.assign(slots, 0);
-  reward_.assign(slots, 0.0f);
-  discount_.assign(slots, 0.0f);
-  episode_id_.assign(slots, -1);
-  insert_number_.assign(slots, -1);
 }
 
 PixelTable::ActorFrames* PixelTable::FindOrAddActor(int32_t actor_id) {
@@ -135,7 +138,7 @@ bool PixelTable::Stale(int64_t slot) const {
 }
 
 void PixelTable::Drop(int64_t slot) {
-  int64_t& number = insert_number_[static_cast<size_t>(slot)];
+  int64_t& number = columns_.insert_numbers()[static_cast<size_t>(slot)];
   if (number < 0) return;
   number = -1;
   sampler_->Remove(slot);
@@ -144,7 +147,7 @@ void PixelTable::Drop(int64_t slot) {
 
 void PixelTable::DropAllStale() {
   for (int64_t slot = 0; slot < options_.capacity; ++slot) {
-    if (insert_number_[static_cast<size_t>(slot)] >= 0 && Stale(slot)) Drop(slot);
+    if (columns_.insert_numbers()[static_cast<size_t>(slot)] >= 0 && Stale(slot)) Drop(slot);
   }
 }
 
@@ -176,14 +179,10 @@ const char* PixelTable::Insert(const PixelBatchView& batch) {
   if (batch.obs_frames.size() != n * stack || batch.next_obs_frames.size() != n * stack) {
     return "obs_frames or next_obs_frames size is not count * stack";
   }
-  if (batch.action.size() != n || batch.reward.size() != n || batch.discount.size() != n) {
-    return "action, reward or discount size is not count";
-  }
-  if (!batch.episode_id.empty() && batch.episode_id.size() != n) {
-    return "episode_id size is neither 0 nor count";
-  }
-  if (!batch.priority.empty() && batch.priority.size() != n) {
-    return "priority size is neither 0 nor count";
+  // A frames-only batch says nothing about actions; one with transitions must fit the width.
+  const int width = columns_.allocated() ? columns_.action_width() : options_.action_width;
+  if (n > 0) {
+    if (const char* why = TransitionColumns::Check(batch.columns, n, width)) return why;
   }
   for (size_t j = 1; j < num_frames; ++j) {
     if (batch.frame_id[j] <= batch.frame_id[j - 1]) return "frame ids not increasing";
@@ -191,6 +190,9 @@ const char* PixelTable::Insert(const PixelBatchView& batch) {
   ActorFrames* actor = FindOrAddActor(batch.actor_id);
   if (actor == nullptr) return "too many actors (1024 distinct actor ids at most)";
   if (height_ == 0) Allocate(batch.height, batch.width, batch.stack);
+  if (n > 0 && !columns_.allocated()) {
+    columns_.Allocate(options_.capacity, batch.columns.action_width);
+  }
 
   // A batch starting at or below the actor's newest id comes from a restarted actor: forget
   // the old ids, so that none of them is taken for a new frame that never arrived.
@@ -221,13 +223,9 @@ const char* PixelTable::Insert(const PixelBatchView& batch) {
     const int64_t slot = total_inserts_ % options_.capacity;
     const auto s = static_cast<size_t>(slot);
     std::copy(global, global + 2 * stack, frame_refs_.data() + s * 2 * stack);
-    action_[s] = batch.action[i];
-    reward_[s] = batch.reward[i];
-    discount_[s] = batch.discount[i];
-    episode_id_[s] = batch.episode_id.empty() ? -1 : batch.episode_id[i];
-    if (insert_number_[s] < 0) ++size_;
-    insert_number_[s] = total_inserts_;
-    sampler_->Insert(slot, batch.priority.empty() ? 0.0 : batch.priority[i]);
+    if (columns_.insert_numbers()[s] < 0) ++size_;
+    columns_.Store(s, batch.columns, i, total_inserts_);
+    sampler_->Insert(slot, batch.columns.priority.empty() ? 0.0 : batch.columns.priority[i]);
     ++total_inserts_;
   }
   return nullptr;
@@ -243,9 +241,10 @@ bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const PixelSampleS
   RL_CHECK(out.obs.size() == n * stack_bytes && out.next_obs.size() == n * stack_bytes)
       << "obs and next_obs must hold batch_size * stack * height * width = " << n * stack_bytes
       << " bytes";
-  RL_CHECK(out.action.size() == n && out.reward.size() == n && out.discount.size() == n &&
-           out.index.size() == n && out.weight.size() == n)
-      << "action, reward, discount, index and weight must hold batch_size = " << n << " values";
+  RL_CHECK(columns_.Fits(out.columns, n))
+      << "action must hold batch_size * action_width floats, reward, discount, index and weight "
+         "batch_size = "
+      << n << " values";
 
   // Let the sampler choose the slots, drawing again for each stale one (removed on the way).
   if (items_.size() < n) items_.resize(n);
@@ -255,7 +254,8 @@ bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const PixelSampleS
   for (size_t i = 0; i < n; ++i) {
     int redraws = 0;
     // A slot is drawn again if it is stale, or was dropped as stale earlier in this batch.
-    while (insert_number_[static_cast<size_t>(items[i].slot)] < 0 || Stale(items[i].slot)) {
+    while (columns_.insert_numbers()[static_cast<size_t>(items[i].slot)] < 0 ||
+           Stale(items[i].slot)) {
       Drop(items[i].slot);
       dropped = true;
       ++stale_draws_;
@@ -282,11 +282,8 @@ bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const PixelSampleS
                               : out.next_obs.data() + i * stack_bytes + (k - stack) * frame_bytes;
       std::memcpy(to, frame, frame_bytes);
     }
-    out.action[i] = action_[s];
-    out.reward[i] = reward_[s];
-    out.discount[i] = discount_[s];
-    out.index[i] = insert_number_[s];
-    out.weight[i] = ImportanceWeight(items[i].probability, min_probability, beta_);
+    columns_.Gather(s, i, out.columns);
+    out.columns.weight[i] = ImportanceWeight(items[i].probability, min_probability, beta_);
   }
   total_samples_ += batch_size;
   return true;
@@ -294,7 +291,8 @@ bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const PixelSampleS
 
 int64_t PixelTable::UpdatePriorities(std::span<const int64_t> index,
                                      std::span<const float> priority) {
-  return ApplyPriorities(index, priority, insert_number_, total_inserts_, sampler_.get());
+  return ApplyPriorities(index, priority, columns_.insert_numbers(), total_inserts_,
+                         sampler_.get());
 }
 
 void PixelTable::set_importance_exponent(double beta) {
@@ -307,12 +305,9 @@ void PixelTable::set_importance_exponent(double beta) {
 
 int64_t PixelTable::memory_bytes() const {
   size_t bytes = frames_.capacity() + frame_refs_.capacity() * sizeof(int64_t) +
-                 action_.capacity() * sizeof(int32_t) +
-                 (reward_.capacity() + discount_.capacity()) * sizeof(float) +
-                 (episode_id_.capacity() + insert_number_.capacity()) * sizeof(int64_t) +
                  items_.capacity() * sizeof(SampledItem) + actors_.capacity() * sizeof(ActorFrames);
   for (const ActorFrames& actor : actors_) bytes += actor.window.capacity() * sizeof(FrameRef);
-  return static_cast<int64_t>(bytes) + sampler_->memory_bytes();
+  return static_cast<int64_t>(bytes) + columns_.memory_bytes() + sampler_->memory_bytes();
 }
 
 }  // namespace rl::replay

@@ -16,8 +16,8 @@
 //     keeps its local id, so that an id 4096 older, or one never received, is not mistaken for
 //     it): a transition may name only frames among its actor's last 4096;
 //   - per transition slot (capacity slots, filled in insertion order, the oldest overwritten):
-//     the global numbers of its 2 * stack frames, action, reward, discount, episode id and
-//     insert number.
+//     the global numbers of its 2 * stack frames, and the fields every table stores
+//     (TransitionColumns: action, reward, discount, episode id and insert number).
 //
 // A transition is stored only if every frame it names is known and still stored; otherwise it
 // is skipped (counted in transitions_missing_frames(): typically a lost frame message) and the
@@ -25,7 +25,8 @@
 // its oldest frame (frame_capacity too small for the frames that arrive while it is kept);
 // Sample() then removes it from the sampler and draws again (counted in stale_draws()).
 //
-// Memory: frame_capacity * height * width bytes + capacity * (16 * stack + 28) bytes + 64 KiB
+// Memory: frame_capacity * height * width bytes + capacity * (16 * stack + 4 * action_width + 24)
+// bytes + 64 KiB
 // per actor, allocated when the geometry becomes known (from the options, or the first batch),
 // plus the sampler's (16 bytes per slot for the uniform sampler, 32 to 64 for the prioritized
 // one). With the default frame_capacity (capacity * 1.03125 + 4096) and 84 x 84 stacks of 4, a
@@ -42,6 +43,7 @@
 #include <vector>
 
 #include "replay/sampler.h"
+#include "replay/transition_columns.h"
 
 namespace rl::replay {
 
@@ -58,6 +60,8 @@ struct PixelTableOptions {
   int height = 0;
   int width = 0;
   int stack = 0;
+  // Floats per action; 0: taken from the first batch with transitions.
+  int action_width = 0;
 
   /// Throws std::invalid_argument naming the field when a value is out of range.
   void Validate() const;
@@ -69,8 +73,7 @@ struct PixelTableOptions {
 /// local ids (strictly increasing) and num_frames * height * width bytes; count transitions, each
 /// naming its obs and next_obs stacks by local frame id, oldest first (count * stack ids each;
 /// transition i at [i * stack, (i + 1) * stack)), which may be frames of this batch or of an
-/// earlier batch of the same actor. action, reward and discount hold count values; episode_id
-/// and priority hold count values or are empty (stored as -1, and "priority not known").
+/// earlier batch of the same actor. The other fields as ColumnsView (transition_columns.h).
 struct PixelBatchView {
   int32_t actor_id = 0;
   int height = 0;
@@ -82,25 +85,16 @@ struct PixelBatchView {
   int count = 0;
   std::span<const int64_t> obs_frames;
   std::span<const int64_t> next_obs_frames;
-  std::span<const int32_t> action;
-  std::span<const float> reward;
-  std::span<const float> discount;
-  std::span<const int64_t> episode_id;
-  std::span<const float> priority;
+  ColumnsView columns;
 };
 
 /// Where Sample() writes a batch of `count` transitions: obs and next_obs have room for
 /// count * stack * height * width bytes (transition i's stack at [i * stack * height * width,
-/// ...), its frames oldest first), the others for count values each. index and weight as in
-/// SampleSpans (replay_table.h).
+/// ...), its frames oldest first); the other fields as ColumnSpans (transition_columns.h).
 struct PixelSampleSpans {
   std::span<uint8_t> obs;
   std::span<uint8_t> next_obs;
-  std::span<int32_t> action;
-  std::span<float> reward;
-  std::span<float> discount;
-  std::span<int64_t> index;
-  std::span<float> weight;
+  ColumnSpans columns;
 };
 
 /// A batch that owns its arrays, for callers that have none of their own. Resize() allocates
@@ -110,15 +104,17 @@ struct PixelSampleBatch {
   int height = 0;
   int width = 0;
   int stack = 0;
+  int action_width = 0;
   std::vector<uint8_t> obs;
   std::vector<uint8_t> next_obs;
-  std::vector<int32_t> action;
+  std::vector<float> action;
   std::vector<float> reward;
   std::vector<float> discount;
   std::vector<int64_t> index;
   std::vector<float> weight;
 
-  void Resize(int new_count, int new_height, int new_width, int new_stack);
+  void Resize(int new_count, int new_height, int new_width, int new_stack,
+              int new_action_width = 1);
   PixelSampleSpans spans();
 };
 
@@ -177,6 +173,8 @@ class PixelTable {
   int height() const { return height_; }
   int width() const { return width_; }
   int stack() const { return stack_; }
+  /// Floats per action; 0 until known.
+  int action_width() const { return columns_.action_width(); }
   /// Transitions skipped at Insert() because a frame they name is unknown or overwritten.
   int64_t transitions_missing_frames() const { return missing_frames_; }
   /// Draws made again because the drawn transition's oldest frame had been overwritten.
@@ -230,11 +228,8 @@ class PixelTable {
 
   // Per-slot storage (frame_refs_: 2 * stack_ global frame numbers per slot, obs then next_obs).
   std::vector<int64_t> frame_refs_;
-  std::vector<int32_t> action_;
-  std::vector<float> reward_;
-  std::vector<float> discount_;
-  std::vector<int64_t> episode_id_;
-  std::vector<int64_t> insert_number_;  // -1: the slot holds no transition that can be drawn
+  // Insert numbers of -1 mark slots that hold no transition that can be drawn.
+  TransitionColumns columns_;
 
   std::vector<SampledItem> items_;  // scratch for Sample()
 };

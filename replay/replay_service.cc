@@ -105,9 +105,6 @@ ReplayService::ReplayService(Bus* bus, ReplayServiceOptions options)
   insert_allowed_ = limiter_.CanInsert(options_.insert_unit);
   bus_.Subscribe<rlmsg::transition_batch_t>(
       channels::kTransitions, [this](const rlmsg::transition_batch_t& m) { OnTransitions(m); });
-  bus_.Subscribe<rlmsg::pixel_batch_t>(
-      channels::kPixelTransitions,
-      [this](const rlmsg::pixel_batch_t& m) { OnPixelTransitions(m); });
   bus_.Subscribe<rlmsg::sample_request_t>(
       channels::kSampleRequest, [this](const rlmsg::sample_request_t& m) { OnSampleRequest(m); });
   bus_.Subscribe<rlmsg::priority_update_t>(
@@ -137,47 +134,46 @@ void ReplayService::LogRefusal(const char* what, const char* why) {
 }
 
 void ReplayService::OnTransitions(const rlmsg::transition_batch_t& m) {
-  if (pixels_ != nullptr) {
-    ++counters_.batches_refused;
-    LogRefusal("transition batch", "this run stores pixel transitions");
-    return;
+  // The bus has checked sizes and values; the env's action check comes next, then the table
+  // checks what only it knows (observation size, geometry, action width, frame references).
+  const char* why = nullptr;
+  if (options_.check_action) {
+    const auto width = static_cast<size_t>(m.action_width);
+    for (size_t i = 0; why == nullptr && i < static_cast<size_t>(m.count); ++i) {
+      why = options_.check_action(std::span<const float>(m.action).subspan(i * width, width));
+    }
   }
-  // The bus has checked sizes and values; the table checks what only it knows (obs_size).
-  const TransitionBatchView view{m.obs_size, m.count,    m.obs,        m.next_obs, m.action,
-                                 m.reward,   m.discount, m.episode_id, m.priority};
-  if (const char* why = table_.Insert(view)) {
+  const int64_t before = total_inserts();
+  if (why == nullptr) why = m.obs_size > 0 ? InsertFlat(m) : InsertPixels(m);
+  if (why != nullptr) {
     ++counters_.batches_refused;
     LogRefusal("transition batch", why);
     return;
   }
-  limiter_.Insert(m.count);
+  limiter_.Insert(total_inserts() - before);
   PublishFlow(/*force=*/false);
 }
 
-void ReplayService::OnPixelTransitions(const rlmsg::pixel_batch_t& m) {
-  if (table_.total_inserts() > 0) {
-    ++counters_.batches_refused;
-    LogRefusal("pixel batch", "this run stores flat transitions");
-    return;
-  }
+const char* ReplayService::InsertFlat(const rlmsg::transition_batch_t& m) {
+  if (pixels_ != nullptr) return "this run stores pixel transitions";
+  return table_.Insert(TransitionBatchView{
+      m.obs_size, m.count, m.obs, m.next_obs,
+      ColumnsView{m.action_width, m.action, m.reward, m.discount, m.episode_id, m.priority}});
+}
+
+const char* ReplayService::InsertPixels(const rlmsg::transition_batch_t& m) {
+  if (table_.total_inserts() > 0) return "this run stores flat transitions";
   if (pixels_ == nullptr) {
     PixelTableOptions options;
     options.capacity = options_.table.capacity;
     options.frame_capacity = options_.frame_capacity;
+    options.action_width = options_.table.action_width;
     pixels_ = std::make_unique<PixelTable>(options, MakeSampler());
   }
-  // The bus has checked sizes and values; the table checks geometry and frame references.
-  const PixelBatchView view{m.actor_id, m.height, m.width,    m.stack,      m.num_frames,
-                            m.frame_id, m.frames, m.count,    m.obs_frames, m.next_obs_frames,
-                            m.action,   m.reward, m.discount, m.episode_id, m.priority};
-  const int64_t before = pixels_->total_inserts();
-  if (const char* why = pixels_->Insert(view)) {
-    ++counters_.batches_refused;
-    LogRefusal("pixel batch", why);
-    return;
-  }
-  limiter_.Insert(pixels_->total_inserts() - before);
-  PublishFlow(/*force=*/false);
+  return pixels_->Insert(PixelBatchView{
+      m.actor_id, m.height, m.width, m.stack, m.num_frames, m.frame_id, m.frames, m.count,
+      m.obs_frames, m.next_obs_frames,
+      ColumnsView{m.action_width, m.action, m.reward, m.discount, m.episode_id, m.priority}});
 }
 
 void ReplayService::OnPriorities(const rlmsg::priority_update_t& m) {
@@ -212,26 +208,26 @@ const char* ReplayService::Unanswerable(const PendingRequest& request) {
     return "batch_size above 2 * error_buffer - samples_per_insert (the limiter could never "
            "allow it)";
   }
-  if (pixels_ != nullptr && pixels_->height() > 0) {
-    const int64_t obs_bytes = int64_t{pixels_->stack()} * pixels_->height() * pixels_->width();
-    // Two byte arrays of batch_size stacks, and 36 bytes per transition for the rest.
-    if (int64_t{request.batch_size} * (2 * obs_bytes + 36) + 1024 > options_.max_reply_bytes) {
-      return "reply above max_reply_bytes";
-    }
-    return nullptr;
+  // The reply's size is known once the observation size (or geometry) and action width are.
+  const int width = pixels_ ? pixels_->action_width() : table_.action_width();
+  const bool pixels = pixels_ != nullptr && pixels_->height() > 0;
+  if (width == 0 || (!pixels && table_.obs_size() == 0)) return nullptr;
+  // The observation arrays alone, in 64 bits (also keeps the counts from overflowing).
+  const int64_t obs_bytes = pixels
+                                ? int64_t{pixels_->stack()} * pixels_->height() * pixels_->width()
+                                : int64_t{table_.obs_size()} * 4;
+  if (int64_t{request.batch_size} * 2 * obs_bytes > options_.max_reply_bytes) {
+    return "reply above max_reply_bytes";
   }
-  // The reply's size is known once the observation size is.
-  if (table_.obs_size() > 0) {
-    // Two float arrays of batch_size * obs_size alone (also keeps num_values from overflowing).
-    if (int64_t{request.batch_size} * table_.obs_size() * 8 > options_.max_reply_bytes) {
-      return "reply above max_reply_bytes";
-    }
-    reply_.header.sender = bus_.config().sender;
-    reply_.requester = request.requester;
-    reply_.count = request.batch_size;
-    reply_.num_values = request.batch_size * table_.obs_size();
-    if (reply_.getEncodedSize() > options_.max_reply_bytes) return "reply above max_reply_bytes";
-  }
+  // The exact encoded size: lcm-gen's size depends only on the counts and strings.
+  rlmsg::sample_batch_t& r = reply_;
+  r.header.sender = bus_.config().sender;
+  r.requester = request.requester;
+  r.count = request.batch_size;
+  r.num_values = pixels ? 0 : request.batch_size * table_.obs_size();
+  r.num_bytes = pixels ? static_cast<int32_t>(request.batch_size * obs_bytes) : 0;
+  r.num_action_values = request.batch_size * width;
+  if (r.getEncodedSize() > options_.max_reply_bytes) return "reply above max_reply_bytes";
   return nullptr;
 }
 
@@ -256,73 +252,61 @@ int ReplayService::Serve() {
 }
 
 void ReplayService::Answer(const PendingRequest& request) {
-  if (pixels_ != nullptr) {
-    AnswerPixels(request);
-    return;
-  }
   // Size the reused reply (no allocation once warm) and let the table fill it.
   const int count = request.batch_size;
-  const int obs_size = table_.obs_size();
   const auto n = static_cast<size_t>(count);
-  const size_t values = n * static_cast<size_t>(obs_size);
-  reply_.requester = request.requester;
-  reply_.request_id = request.request_id;
-  reply_.obs_size = obs_size;
-  reply_.count = count;
-  reply_.num_values = count * obs_size;
-  reply_.obs.resize(values);
-  reply_.next_obs.resize(values);
-  reply_.action.resize(n);
-  reply_.reward.resize(n);
-  reply_.discount.resize(n);
-  reply_.index.resize(n);
-  reply_.weight.resize(n);
-  const SampleSpans out{reply_.obs,      reply_.next_obs, reply_.action, reply_.reward,
-                        reply_.discount, reply_.index,    reply_.weight, {}};
-  // CanSample() held, so at least min_size_to_sample >= 1 transitions are stored.
-  table_.set_importance_exponent(beta());
-  const bool sampled = table_.Sample(count, &rng_, out);
-  RL_CHECK(sampled) << "the limiter allowed a sample from an empty table";
-  limiter_.Sample(count);
-  reply_.replay_size = table_.size();
-  reply_.total_inserts = table_.total_inserts();
-  bus_.Publish(channels::kSamples, &reply_, Port::kBulk);
-  ++counters_.requests_answered;
-}
-
-void ReplayService::AnswerPixels(const PendingRequest& request) {
-  const int count = request.batch_size;
-  const auto n = static_cast<size_t>(count);
-  const int64_t obs_bytes = int64_t{pixels_->stack()} * pixels_->height() * pixels_->width();
-  const auto bytes = static_cast<size_t>(obs_bytes * count);
-  rlmsg::pixel_sample_batch_t& r = pixel_reply_;
+  rlmsg::sample_batch_t& r = reply_;
   r.requester = request.requester;
   r.request_id = request.request_id;
-  r.height = pixels_->height();
-  r.width = pixels_->width();
-  r.stack = pixels_->stack();
   r.count = count;
-  r.num_bytes = static_cast<int32_t>(bytes);
-  r.obs.resize(bytes);
-  r.next_obs.resize(bytes);
-  r.action.resize(n);
+  r.action_width = pixels_ ? pixels_->action_width() : table_.action_width();
+  r.num_action_values = count * r.action_width;
+  r.action.resize(static_cast<size_t>(r.num_action_values));
   r.reward.resize(n);
   r.discount.resize(n);
   r.index.resize(n);
   r.weight.resize(n);
-  const PixelSampleSpans out{r.obs, r.next_obs, r.action, r.reward, r.discount, r.index, r.weight};
-  pixels_->set_importance_exponent(beta());
-  if (!pixels_->Sample(count, &rng_, out)) {
-    // Every stored transition names an overwritten frame (a frame ring far too small for the
-    // traffic): nothing can be drawn until new transitions arrive.
-    ++counters_.requests_refused;
-    LogRefusal("sample request", "every stored transition names an overwritten frame");
-    return;
+  const ColumnSpans columns{r.action, r.reward, r.discount, r.index, r.weight, {}};
+  bool sampled = false;
+  if (pixels_ != nullptr) {
+    r.obs_size = r.num_values = 0;
+    r.obs.clear();
+    r.next_obs.clear();
+    r.height = pixels_->height();
+    r.width = pixels_->width();
+    r.stack = pixels_->stack();
+    r.num_bytes = count * r.stack * r.height * r.width;
+    r.obs_pixels.resize(static_cast<size_t>(r.num_bytes));
+    r.next_obs_pixels.resize(static_cast<size_t>(r.num_bytes));
+    pixels_->set_importance_exponent(beta());
+    sampled =
+        pixels_->Sample(count, &rng_, PixelSampleSpans{r.obs_pixels, r.next_obs_pixels, columns});
+    if (!sampled) {
+      // Every stored transition names an overwritten frame (a frame ring far too small for the
+      // traffic): nothing can be drawn until new transitions arrive.
+      ++counters_.requests_refused;
+      LogRefusal("sample request", "every stored transition names an overwritten frame");
+      return;
+    }
+    r.replay_size = pixels_->size();
+    r.total_inserts = pixels_->total_inserts();
+  } else {
+    r.height = r.width = r.stack = r.num_bytes = 0;
+    r.obs_pixels.clear();
+    r.next_obs_pixels.clear();
+    r.obs_size = table_.obs_size();
+    r.num_values = count * r.obs_size;
+    r.obs.resize(static_cast<size_t>(r.num_values));
+    r.next_obs.resize(static_cast<size_t>(r.num_values));
+    table_.set_importance_exponent(beta());
+    // CanSample() held, so at least min_size_to_sample >= 1 transitions are stored.
+    sampled = table_.Sample(count, &rng_, SampleSpans{r.obs, r.next_obs, columns});
+    RL_CHECK(sampled) << "the limiter allowed a sample from an empty table";
+    r.replay_size = table_.size();
+    r.total_inserts = table_.total_inserts();
   }
   limiter_.Sample(count);
-  r.replay_size = pixels_->size();
-  r.total_inserts = pixels_->total_inserts();
-  bus_.Publish(channels::kPixelSamples, &r, Port::kBulk);
+  bus_.Publish(channels::kSamples, &r, Port::kBulk);
   ++counters_.requests_answered;
 }
 

@@ -3,14 +3,15 @@
 //
 // In (main port):
 //   RL_TRANSITIONS     transition_batch_t  every valid batch is stored, whatever the limiter says
-//                                          (the limiter only tells actors to pause)
-//   RL_PIXEL_TRANSITIONS pixel_batch_t     the same for pixel transitions (frames stored once)
+//                                          (the limiter only tells actors to pause); flat ones in
+//                                          the ReplayTable, pixel ones (frames stored once) in
+//                                          the PixelTable
 //   RL_SAMPLE_REQUEST  sample_request_t    queued; several may be in flight
 //   RL_PRIORITIES      priority_update_t   new priorities (prioritized replay)
 // Out:
 //   RL_SAMPLES         sample_batch_t      (bulk port) one reply per request, in request order,
 //                                          as soon as the limiter allows a sample of its size
-//   RL_PIXEL_SAMPLES   pixel_sample_batch_t  (bulk port) the same when the replay holds pixels
+//                                          (flat observations or rebuilt pixel stacks)
 //   RL_FLOW            flow_control_t      at flow_hz, and at once whenever insert_allowed changes
 //   RL_STATS_REPLAY    stats_replay_t      at stats_hz
 //
@@ -19,8 +20,11 @@
 // counted here and reported in stats_replay_t.dropped_invalid together with the bus's count.
 //
 // A run stores either flat or pixel transitions: the kind of the first batch decides, and
-// batches of the other kind are refused. Sampling is uniform, or proportional to priority
-// (Schaul et al. 2016) with importance weights whose exponent beta is annealed to 1.
+// batches of the other kind are refused. Actions are stored as the env's action width of floats
+// and are otherwise opaque to the replay; an optional check (from the env's static spec: width,
+// integer indices, bounds) refuses a whole batch with a bad action. Sampling is uniform, or
+// proportional to priority (Schaul et al. 2016) with importance weights whose exponent beta is
+// annealed to 1.
 //
 // Replies are one message each: a request whose reply would exceed max_reply_bytes is refused.
 // For CartPole a batch of 128 is about 7 KB; a batch of 32 Nature-DQN stacks (4 x 84 x 84) about
@@ -35,6 +39,7 @@
 #include <functional>
 #include <memory>
 #include <random>
+#include <span>
 #include <string>
 
 #include "common/clock.h"
@@ -43,8 +48,6 @@
 #include "replay/rate_limiter.h"
 #include "replay/replay_table.h"
 #include "rlmsg/flow_control_t.hpp"
-#include "rlmsg/pixel_batch_t.hpp"
-#include "rlmsg/pixel_sample_batch_t.hpp"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
@@ -70,6 +73,9 @@ struct ReplayServiceOptions {
   double priority_epsilon = 1e-6;
   // Frames kept for pixel transitions (0: the pixel table's default, a little above capacity).
   int64_t frame_capacity = 0;
+  // Why an action (action width floats) is not one of the run's env, or nullptr; empty: no check
+  // (the width is then fixed by the first batch). A batch with any bad action is refused whole.
+  std::function<const char*(std::span<const float>)> check_action;
   // Transitions an actor asks to insert at a time: insert_allowed is CanInsert(insert_unit).
   int insert_unit = 1;
   // Sample requests waiting for the limiter; when full, the oldest is dropped.
@@ -164,11 +170,12 @@ class ReplayService {
   };
 
   void OnTransitions(const rlmsg::transition_batch_t& m);
-  void OnPixelTransitions(const rlmsg::pixel_batch_t& m);
+  // Stores a flat or a pixel batch; the reason it was refused, or nullptr.
+  const char* InsertFlat(const rlmsg::transition_batch_t& m);
+  const char* InsertPixels(const rlmsg::transition_batch_t& m);
   void OnSampleRequest(const rlmsg::sample_request_t& m);
   void OnPriorities(const rlmsg::priority_update_t& m);
   std::unique_ptr<Sampler> MakeSampler() const;
-  void AnswerPixels(const PendingRequest& request);
   // Draws and publishes the reply to one request.
   void Answer(const PendingRequest& request);
   // Why a request can never be answered, or nullptr.
@@ -201,7 +208,6 @@ class ReplayService {
 
   // Reused messages, so that a warm service does not allocate per reply.
   rlmsg::sample_batch_t reply_{};
-  rlmsg::pixel_sample_batch_t pixel_reply_{};
   rlmsg::flow_control_t flow_{};
   rlmsg::stats_replay_t stats_{};
 };

@@ -29,6 +29,12 @@ void ReplayTableOptions::Validate() const {
     throw std::invalid_argument("replay table: capacity must be at least 1, got " +
                                 std::to_string(capacity));
   }
+  if (action_width < 0 || action_width > TransitionColumns::kMaxActionWidth) {
+    throw std::invalid_argument(
+        "replay table: action_width must be in [0, 64] (0: from the "
+        "first batch), got " +
+        std::to_string(action_width));
+  }
   if (obs_size < 0 || obs_size > kMaxObsSize) {
     throw std::invalid_argument("replay table: obs_size must be in [0, " +
                                 std::to_string(kMaxObsSize) + "] (0: from the first batch), got " +
@@ -36,14 +42,15 @@ void ReplayTableOptions::Validate() const {
   }
 }
 
-void SampleBatch::Resize(int new_count, int new_obs_size) {
+void SampleBatch::Resize(int new_count, int new_obs_size, int new_action_width) {
   count = new_count;
   obs_size = new_obs_size;
+  action_width = new_action_width;
   const auto n = static_cast<size_t>(new_count);
   const size_t values = n * static_cast<size_t>(new_obs_size);
   obs.resize(values);
   next_obs.resize(values);
-  action.resize(n);
+  action.resize(n * static_cast<size_t>(new_action_width));
   reward.resize(n);
   discount.resize(n);
   index.resize(n);
@@ -52,28 +59,27 @@ void SampleBatch::Resize(int new_count, int new_obs_size) {
 }
 
 SampleSpans SampleBatch::spans() {
-  return SampleSpans{obs, next_obs, action, reward, discount, index, weight, episode_id};
+  return SampleSpans{obs, next_obs, {action, reward, discount, index, weight, episode_id}};
 }
 
 ReplayTable::ReplayTable(ReplayTableOptions options, std::unique_ptr<Sampler> sampler)
     : options_(options), sampler_(std::move(sampler)) {
   options_.Validate();
   if (sampler_ == nullptr) sampler_ = std::make_unique<UniformSampler>(options_.capacity);
-  if (options_.obs_size > 0) Allocate(options_.obs_size);
+  obs_size_ = options_.obs_size;
+  if (options_.obs_size > 0 && options_.action_width > 0) {
+    Allocate(options_.obs_size, options_.action_width);
+  }
 }
 
 ReplayTable::~ReplayTable() = default;
 
-void ReplayTable::Allocate(int obs_size) {
+void ReplayTable::Allocate(int obs_size, int action_width) {
   obs_size_ = obs_size;
   const auto slots = static_cast<size_t>(options_.capacity);
   obs_.assign(slots * static_cast<size_t>(obs_size), 0.0f);
   next_obs_.assign(slots * static_cast<size_t>(obs_size), 0.0f);
-  action_.assign(slots, 0);
-  reward_.assign(slots, 0.0f);
-  discount_.assign(slots, 0.0f);
-  episode_id_.assign(slots, -1);
-  insert_number_.assign(slots, -1);
+  columns_.Allocate(options_.capacity, action_width);
 }
 
 const char* ReplayTable::Insert(const TransitionBatchView& batch) {
@@ -86,16 +92,9 @@ const char* ReplayTable::Insert(const TransitionBatchView& batch) {
   if (batch.obs.size() != values || batch.next_obs.size() != values) {
     return "obs or next_obs size is not count * obs_size";
   }
-  if (batch.action.size() != n || batch.reward.size() != n || batch.discount.size() != n) {
-    return "action, reward or discount size is not count";
-  }
-  if (!batch.episode_id.empty() && batch.episode_id.size() != n) {
-    return "episode_id size is neither 0 nor count";
-  }
-  if (!batch.priority.empty() && batch.priority.size() != n) {
-    return "priority size is neither 0 nor count";
-  }
-  if (obs_size_ == 0) Allocate(batch.obs_size);
+  const int width = columns_.allocated() ? columns_.action_width() : options_.action_width;
+  if (const char* why = TransitionColumns::Check(batch.columns, n, width)) return why;
+  if (!columns_.allocated()) Allocate(batch.obs_size, batch.columns.action_width);
 
   // Write each transition into the slot after the newest one, wrapping around.
   const auto obs_size = static_cast<size_t>(obs_size_);
@@ -104,12 +103,8 @@ const char* ReplayTable::Insert(const TransitionBatchView& batch) {
     const auto s = static_cast<size_t>(slot);
     CopyN(batch.obs.data() + i * obs_size, obs_size, obs_.data() + s * obs_size);
     CopyN(batch.next_obs.data() + i * obs_size, obs_size, next_obs_.data() + s * obs_size);
-    action_[s] = batch.action[i];
-    reward_[s] = batch.reward[i];
-    discount_[s] = batch.discount[i];
-    episode_id_[s] = batch.episode_id.empty() ? -1 : batch.episode_id[i];
-    insert_number_[s] = total_inserts_;
-    sampler_->Insert(slot, batch.priority.empty() ? 0.0 : batch.priority[i]);
+    columns_.Store(s, batch.columns, i, total_inserts_);
+    sampler_->Insert(slot, batch.columns.priority.empty() ? 0.0 : batch.columns.priority[i]);
     ++total_inserts_;
   }
   size_ = std::min(total_inserts_, options_.capacity);
@@ -123,11 +118,10 @@ bool ReplayTable::Sample(int batch_size, std::mt19937_64* rng, const SampleSpans
   const auto obs_size = static_cast<size_t>(obs_size_);
   RL_CHECK(out.obs.size() == n * obs_size && out.next_obs.size() == n * obs_size)
       << "obs and next_obs must hold batch_size * obs_size = " << n * obs_size << " floats";
-  RL_CHECK(out.action.size() == n && out.reward.size() == n && out.discount.size() == n &&
-           out.index.size() == n && out.weight.size() == n)
-      << "action, reward, discount, index and weight must hold batch_size = " << n << " values";
-  RL_CHECK(out.episode_id.empty() || out.episode_id.size() == n)
-      << "episode_id must be empty or hold batch_size = " << n << " values";
+  RL_CHECK(columns_.Fits(out.columns, n))
+      << "action must hold batch_size * action_width floats, reward, discount, index and weight "
+         "batch_size = "
+      << n << " values, episode_id none or batch_size";
 
   // Let the sampler choose the slots, then gather their fields.
   if (items_.size() < n) items_.resize(n);
@@ -139,12 +133,8 @@ bool ReplayTable::Sample(int batch_size, std::mt19937_64* rng, const SampleSpans
     RL_DCHECK(items[i].slot >= 0 && items[i].slot < size_) << "sampler chose an empty slot";
     CopyN(obs_.data() + s * obs_size, obs_size, out.obs.data() + i * obs_size);
     CopyN(next_obs_.data() + s * obs_size, obs_size, out.next_obs.data() + i * obs_size);
-    out.action[i] = action_[s];
-    out.reward[i] = reward_[s];
-    out.discount[i] = discount_[s];
-    out.index[i] = insert_number_[s];
-    out.weight[i] = ImportanceWeight(items[i].probability, min_probability, beta_);
-    if (!out.episode_id.empty()) out.episode_id[i] = episode_id_[s];
+    columns_.Gather(s, i, out.columns);
+    out.columns.weight[i] = ImportanceWeight(items[i].probability, min_probability, beta_);
   }
   total_samples_ += batch_size;
   return true;
@@ -160,16 +150,14 @@ void ReplayTable::set_importance_exponent(double beta) {
 
 int64_t ReplayTable::UpdatePriorities(std::span<const int64_t> index,
                                       std::span<const float> priority) {
-  return ApplyPriorities(index, priority, insert_number_, total_inserts_, sampler_.get());
+  return ApplyPriorities(index, priority, columns_.insert_numbers(), total_inserts_,
+                         sampler_.get());
 }
 
 int64_t ReplayTable::memory_bytes() const {
   const size_t bytes = (obs_.capacity() + next_obs_.capacity()) * sizeof(float) +
-                       action_.capacity() * sizeof(int32_t) +
-                       (reward_.capacity() + discount_.capacity()) * sizeof(float) +
-                       (episode_id_.capacity() + insert_number_.capacity()) * sizeof(int64_t) +
                        items_.capacity() * sizeof(SampledItem);
-  return static_cast<int64_t>(bytes) + sampler_->memory_bytes();
+  return static_cast<int64_t>(bytes) + columns_.memory_bytes() + sampler_->memory_bytes();
 }
 
 }  // namespace rl::replay

@@ -7,9 +7,10 @@
 // is drawn from is decided by a Sampler (uniform by default, or PrioritizedSampler), which also
 // gives each draw's probability for the importance weights.
 //
-// Memory: capacity * (8 * obs_size + 28) bytes, allocated when obs_size becomes known (from the
-// options, or from the first batch), plus the sampler's (16 bytes per slot for the uniform
-// sampler, 32 to 64 for the prioritized one, allocated by its constructor).
+// Memory: capacity * (8 * obs_size + 4 * action_width + 24) bytes, allocated when obs_size and
+// action_width become known (from the options, or from the first batch), plus the sampler's (16
+// bytes per slot for the uniform sampler, 32 to 64 for the prioritized one, allocated by its
+// constructor).
 //
 // The table knows nothing about LCM: the caller hands it views of its own arrays. Not
 // thread-safe: one thread inserts and samples.
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "replay/sampler.h"
+#include "replay/transition_columns.h"
 
 namespace rl::replay {
 
@@ -31,60 +33,54 @@ struct ReplayTableOptions {
   // Floats per observation; 0: taken from the first batch inserted. Batches of any other size
   // are refused.
   int obs_size = 0;
+  // Floats per action (the env's action width: 1 for a discrete env); 0: taken from the first
+  // batch. Batches of any other width are refused.
+  int action_width = 0;
 
   /// Throws std::invalid_argument naming the field when a value is out of range.
   void Validate() const;
 };
 
 /// A batch of transitions to insert, as views of the caller's arrays. obs and next_obs hold
-/// count * obs_size floats (transition i at [i*obs_size, (i+1)*obs_size)); action, reward and
-/// discount hold count values; episode_id and priority hold count values or are empty (an
-/// empty episode_id is stored as -1; a priority that is empty or not > 0 means "not known", to
-/// which a prioritized sampler gives the largest priority seen so far).
+/// count * obs_size floats (transition i at [i*obs_size, (i+1)*obs_size)); the other fields as
+/// ColumnsView (transition_columns.h) says. Values are not checked here (finite, discount in
+/// [0, 1], actions in range): that is the caller's job.
 struct TransitionBatchView {
   int obs_size = 0;
   int count = 0;
   std::span<const float> obs;
   std::span<const float> next_obs;
-  std::span<const int32_t> action;
-  std::span<const float> reward;
-  std::span<const float> discount;
-  std::span<const int64_t> episode_id;
-  std::span<const float> priority;
+  ColumnsView columns;
 };
 
 /// Where Sample() writes a batch of `count` transitions: obs and next_obs have room for
-/// count * obs_size floats, the others for count values each; episode_id may be empty (not
-/// wanted). `index` receives each transition's insert number (0 for the first transition ever
-/// inserted, 1 for the next, ...; its slot is index % capacity), so that a later priority update
-/// can tell a transition that has been overwritten since. `weight` receives the importance
-/// weight (see ReplayTable::set_importance_exponent; 1 for uniform sampling).
+/// count * obs_size floats; the other fields as ColumnSpans says. `index` receives each
+/// transition's insert number (0 for the first transition ever inserted, 1 for the next, ...;
+/// its slot is index % capacity), so that a later priority update can tell a transition that
+/// has been overwritten since. `weight` receives the importance weight (see
+/// ReplayTable::set_importance_exponent; 1 for uniform sampling).
 struct SampleSpans {
   std::span<float> obs;
   std::span<float> next_obs;
-  std::span<int32_t> action;
-  std::span<float> reward;
-  std::span<float> discount;
-  std::span<int64_t> index;
-  std::span<float> weight;
-  std::span<int64_t> episode_id;
+  ColumnSpans columns;
 };
 
 /// A batch that owns its arrays, for callers that have none of their own. Resize() allocates
 /// only when the batch grows.
 struct SampleBatch {
   int obs_size = 0;
+  int action_width = 0;
   int count = 0;
   std::vector<float> obs;
   std::vector<float> next_obs;
-  std::vector<int32_t> action;
+  std::vector<float> action;
   std::vector<float> reward;
   std::vector<float> discount;
   std::vector<int64_t> index;
   std::vector<float> weight;
   std::vector<int64_t> episode_id;
 
-  void Resize(int new_count, int new_obs_size);
+  void Resize(int new_count, int new_obs_size, int new_action_width = 1);
   SampleSpans spans();
 };
 
@@ -98,7 +94,8 @@ class ReplayTable {
 
   /// Stores every transition of the batch, overwriting the oldest ones when full. Returns
   /// nullptr on success, or a short reason why the whole batch was refused (nothing stored):
-  /// an obs_size other than the table's, or views whose sizes do not match count and obs_size.
+  /// an obs_size or action width other than the table's, or views whose sizes do not match
+  /// count, obs_size and action_width.
   /// Values are stored as they are: checking them (finite, discount in [0, 1]) is the caller's
   /// job. O(count * obs_size); allocates only on the first batch when obs_size was 0.
   [[nodiscard]] const char* Insert(const TransitionBatchView& batch);
@@ -131,6 +128,8 @@ class ReplayTable {
   int64_t capacity() const { return options_.capacity; }
   /// Floats per observation; 0 until known.
   int obs_size() const { return obs_size_; }
+  /// Floats per action; 0 until known.
+  int action_width() const { return columns_.action_width(); }
   /// Transitions ever inserted (including overwritten ones).
   int64_t total_inserts() const { return total_inserts_; }
   /// Transitions ever drawn by Sample().
@@ -141,7 +140,7 @@ class ReplayTable {
   const Sampler& sampler() const { return *sampler_; }
 
  private:
-  void Allocate(int obs_size);
+  void Allocate(int obs_size, int action_width);
 
   ReplayTableOptions options_;
   std::unique_ptr<Sampler> sampler_;
@@ -154,11 +153,7 @@ class ReplayTable {
   // Per-slot storage (obs_ and next_obs_: obs_size_ floats per slot).
   std::vector<float> obs_;
   std::vector<float> next_obs_;
-  std::vector<int32_t> action_;
-  std::vector<float> reward_;
-  std::vector<float> discount_;
-  std::vector<int64_t> episode_id_;
-  std::vector<int64_t> insert_number_;
+  TransitionColumns columns_;
 
   std::vector<SampledItem> items_;  // scratch for Sample()
 };

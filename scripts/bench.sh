@@ -12,7 +12,8 @@
 #              run the peer's nature, small and latency modes; 0: skip them), KUKA_EPISODES
 #              (20: episodes of each policy in kuka_probe), KUKA_PIPELINE_SECONDS (300: length of
 #              the kuka_grasp launch that measures the whole pipeline's episodes per hour; 0 or
-#              --skip-goal: skip it).
+#              --skip-goal: skip it), TD3_SEEDS ("1": seeds of the Pendulum and
+#              LunarLanderContinuous runs to their goals), PEER_TD3 (1: run the peer's td3 mode).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -92,6 +93,29 @@ if [ "$skip_goal" -eq 0 ]; then
   done
 fi
 
+# TD3: wall time and env steps until the goal (Pendulum-v1: -200; LunarLanderContinuous-v3: 200).
+if [ "$skip_goal" -eq 0 ]; then
+  for preset in pendulum lunar_lander_continuous; do
+    case "$preset" in pendulum) budget=300 ;; *) budget=1200 ;; esac
+    for seed in ${TD3_SEEDS:-1}; do
+      echo "bench: launch $preset, seed $seed" >&2
+      start=$(date +%s.%N)
+      ok=0
+      isolated "$root/scripts/launch.sh" "$preset" --no-setup --build-dir "$build_dir" \
+        --seed "$seed" --time-budget "$budget" --out "$work/$preset-$seed" \
+        > "$work/$preset-$seed.log" 2>&1 && ok=1
+      end=$(date +%s.%N)
+      goal=$(sed -n 's/^goal *= *//p' "$work/$preset-$seed/config.ini" 2>/dev/null | tail -1)
+      # The env steps of the first evaluation at or above the goal.
+      steps=$(awk -v goal="${goal:-0}" '{
+          m = $0; sub(/.*"mean": */, "", m); sub(/[,}].*/, "", m)
+          s = $0; sub(/.*"env_steps": */, "", s); sub(/[,}].*/, "", s)
+          if (m + 0 >= goal + 0) { print s; exit } }' "$work/$preset-$seed/eval.jsonl" 2>/dev/null)
+      echo "{\"bench\": \"${preset}_time_to_goal\", \"value\": $(awk -v a="$start" -v b="$end" 'BEGIN{printf "%.1f", b - a}'), \"unit\": \"s\", \"seed\": $seed, \"solved\": $ok, \"goal\": ${goal:-null}, \"env_steps\": ${steps:-null}}" >> "$ours"
+    done
+  done
+fi
+
 # KUKA grasping, the whole pipeline (actors, replay, learner, evaluator on held-out objects) for
 # KUKA_PIPELINE_SECONDS: episodes per hour and env steps/s after the first minute (start-up,
 # replay warm-up), from the monitor's progress lines.
@@ -133,6 +157,13 @@ if [ "$skip_peer" -eq 0 ] && [ -f "$peer_dir/micro.py" ] && "$py" -c 'import tor
         --min-time 2 --tag "cnn-r$r") >> "$peer"
     done
   fi
+  if [ "${PEER_TD3:-1}" = 1 ]; then
+    for r in $(seq "${PEER_REPEATS:-3}"); do
+      echo "bench: peer micro TD3 (td3_mlp, td3_car; one thread), repeat $r" >&2
+      (cd "$peer_dir" && "$py" micro.py --only td3 --threads 1 --min-time 2 --tag "td3-r$r") \
+        >> "$peer"
+    done
+  fi
   if [ "${PEER_DQN:-1}" = 1 ] && [ "$skip_goal" -eq 0 ]; then
     echo "bench: peer DQN on CartPole (500,000 steps)" >&2
     start=$(date +%s.%N)
@@ -166,12 +197,17 @@ match = {
     "cartpole_time_to_goal": (lambda o: lambda p: p["bench"] == "peer_dqn_wall", "lower"),
     "learner_updates_nature_cnn": (peer_updates("nature_cnn"), "higher"),
     "learner_updates_grasp_cnn": (peer_updates("small_cnn_bn"), "higher"),
+    "learner_updates_td3": (lambda o: lambda p: p["bench"] == "updates" and p.get("net") == o.get("net")
+                            and p.get("batch") == o.get("batch") and p.get("threads") == 1, "higher"),
     # The peer reports microseconds per call (a mean over calls); ours are milliseconds (median).
     "inference_latency_nature_cnn": (lambda o: lambda p: p["bench"] == "latency"
                                      and p.get("net") == "nature_cnn"
                                      and p.get("threads") == o.get("threads"), "lower", 1e-3),
 }
+peaks = [o["value"] for o in ours if o["bench"] == "peak_fp32_gflops" and o.get("threads", 1) == 1]
 for o in ours:
+    if "gflops" in o and peaks:
+        o["fraction_of_peak"] = round(float(o["gflops"]) / peaks[0], 3)
     m = match.get(o["bench"])
     if m:
         lines = peer_lines(m[0](o))

@@ -46,12 +46,15 @@ struct Target {
   std::function<std::vector<uint8_t>(int64_t run_id)> invalid;
 };
 
+// A flat batch of one transition (CartPole-sized: 4 observations, one action index).
 rlmsg::transition_batch_t Transitions() {
   rlmsg::transition_batch_t m{};
-  m.obs_size = 4;
   m.count = 1;
+  m.obs_size = 4;
   m.num_values = 4;
   m.obs = m.next_obs = {0, 0, 0, 0};
+  m.action_width = 1;
+  m.num_action_values = 1;
   m.action = {0};
   m.reward = {1};
   m.discount = {0.99f};
@@ -60,23 +63,12 @@ rlmsg::transition_batch_t Transitions() {
   return m;
 }
 
-rlmsg::sample_batch_t Samples() {
-  rlmsg::sample_batch_t m{};
-  m.requester = "learner";
-  m.obs_size = 4;
-  m.count = 1;
-  m.num_values = 4;
-  m.obs = m.next_obs = {0, 0, 0, 0};
-  m.action = {0};
-  m.reward = {1};
-  m.discount = {0.99f};
-  m.index = {0};
-  m.weight = {1};
-  return m;
-}
-
-rlmsg::pixel_batch_t PixelTransitions() {
-  rlmsg::pixel_batch_t m{};
+// A pixel batch of two 2x2 frames and one transition naming them.
+rlmsg::transition_batch_t PixelTransitions() {
+  rlmsg::transition_batch_t m = Transitions();
+  m.obs_size = m.num_values = 0;
+  m.obs.clear();
+  m.next_obs.clear();
   m.height = 2;
   m.width = 2;
   m.stack = 2;
@@ -84,33 +76,40 @@ rlmsg::pixel_batch_t PixelTransitions() {
   m.frame_id = {0, 1};
   m.num_bytes = 8;
   m.frames.assign(8, 100);
-  m.count = 1;
   m.num_refs = 2;
   m.obs_frames = {0, 0};
   m.next_obs_frames = {0, 1};
-  m.action = {0};
-  m.reward = {1};
-  m.discount = {0.99f};
-  m.episode_id = {0};
-  m.priority = {0};
   return m;
 }
 
-rlmsg::pixel_sample_batch_t PixelSamples() {
-  rlmsg::pixel_sample_batch_t m{};
+rlmsg::sample_batch_t Samples() {
+  rlmsg::sample_batch_t m{};
   m.requester = "learner";
-  m.height = 2;
-  m.width = 2;
-  m.stack = 2;
   m.count = 1;
-  m.num_bytes = 8;
-  m.obs.assign(8, 0);
-  m.next_obs.assign(8, 0);
+  m.obs_size = 4;
+  m.num_values = 4;
+  m.obs = m.next_obs = {0, 0, 0, 0};
+  m.action_width = 1;
+  m.num_action_values = 1;
   m.action = {0};
   m.reward = {1};
   m.discount = {0.99f};
   m.index = {0};
   m.weight = {1};
+  return m;
+}
+
+rlmsg::sample_batch_t PixelSamples() {
+  rlmsg::sample_batch_t m = Samples();
+  m.obs_size = m.num_values = 0;
+  m.obs.clear();
+  m.next_obs.clear();
+  m.height = 2;
+  m.width = 2;
+  m.stack = 2;
+  m.num_bytes = 8;
+  m.obs_pixels.assign(8, 0);
+  m.next_obs_pixels.assign(8, 0);
   return m;
 }
 
@@ -164,11 +163,37 @@ std::vector<Target> Targets() {
                  m.obs[2] = nan;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kPixelTransitions, rl::Port::kMain,
+  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
                [](int64_t r) { return Encode(PixelTransitions(), r); },
                [](int64_t r) {
                  auto m = PixelTransitions();
                  m.frame_id = {1, 0};  // ids must increase
+                 return Encode(m, r);
+               }});
+  // The action fields: a NaN action (refused by every receiver's check), and actions that are
+  // well-formed but not the run env's (refused by the replay, which knows the env): an index far
+  // out of range, and a second action value. Each counts as one invalid message.
+  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
+               [](int64_t r) { return Encode(Transitions(), r); },
+               [nan](int64_t r) {
+                 auto m = Transitions();
+                 m.action[0] = nan;
+                 return Encode(m, r);
+               }});
+  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
+               [](int64_t r) { return Encode(Transitions(), r); },
+               [](int64_t r) {
+                 auto m = Transitions();
+                 m.action[0] = 99;
+                 return Encode(m, r);
+               }});
+  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
+               [](int64_t r) { return Encode(Transitions(), r); },
+               [](int64_t r) {
+                 auto m = Transitions();
+                 m.action_width = 2;
+                 m.num_action_values = 2;
+                 m.action = {0, 0};
                  return Encode(m, r);
                }});
   t.push_back({rl::channels::kPriorities, rl::Port::kMain,
@@ -178,7 +203,7 @@ std::vector<Target> Targets() {
                  m.priority[0] = nan;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kPixelSamples, rl::Port::kBulk,
+  t.push_back({rl::channels::kSamples, rl::Port::kBulk,
                [](int64_t r) { return Encode(PixelSamples(), r); },
                [](int64_t r) {
                  auto m = PixelSamples();
@@ -222,13 +247,15 @@ std::vector<Target> Targets() {
   return t;
 }
 
-// Channels each role subscribes to (what its drop counters must reflect).
+// The targets each role receives (what its drop counters must reflect): one entry per Target of
+// a channel it subscribes to.
 const std::map<std::string, std::vector<std::string>>& RoleChannels() {
   static const std::map<std::string, std::vector<std::string>> m = {
       {"replay",
-       {rl::channels::kTransitions, rl::channels::kPixelTransitions, rl::channels::kSampleRequest,
+       {rl::channels::kTransitions, rl::channels::kTransitions, rl::channels::kTransitions,
+        rl::channels::kTransitions, rl::channels::kTransitions, rl::channels::kSampleRequest,
         rl::channels::kPriorities}},
-      {"learner", {rl::channels::kSamples, rl::channels::kPixelSamples}},
+      {"learner", {rl::channels::kSamples, rl::channels::kSamples}},
       {"actor", {rl::channels::kWeights, rl::channels::kFlow}},
       {"evaluator", {rl::channels::kCheckpoint}},
   };

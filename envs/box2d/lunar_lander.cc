@@ -44,6 +44,7 @@
 
 #include "common/check.h"
 #include "envs/rng.h"
+#include "envs/specs.h"
 
 namespace rl::envs {
 namespace {
@@ -115,19 +116,7 @@ void LunarLanderConfig::Validate() const {
 
 LunarLander::LunarLander(const LunarLanderConfig& config) : config_(config) {
   config_.Validate();
-  spec_ = config_.continuous ? EnvSpec{.id = "LunarLanderContinuous-v3",
-                                       .observation_size = 8,
-                                       .num_actions = 0,
-                                       .max_episode_steps = 1000,
-                                       .reward_threshold = 200.0,
-                                       .action_dim = 2,
-                                       .action_low = -1.0f,
-                                       .action_high = 1.0f}
-                             : EnvSpec{.id = "LunarLander-v3",
-                                       .observation_size = 8,
-                                       .num_actions = 4,
-                                       .max_episode_steps = 1000,
-                                       .reward_threshold = 200.0};
+  spec_ = LunarLanderSpec(config_.continuous);
   // The reference warns about, but accepts, values outside the recommended ranges.
   if (config_.wind_power < 0.0 || config_.wind_power > 20.0) {
     std::fprintf(stderr, "WARN: LunarLander: wind_power %g is outside the recommended [0, 20]\n",

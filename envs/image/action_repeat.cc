@@ -22,11 +22,6 @@ ActionRepeat::ActionRepeat(std::unique_ptr<Env> env, const ImagePipelineConfig& 
   }
   config.Validate();
   spec_ = env_->spec();
-  if (spec_.num_actions <= 0) {
-    throw std::invalid_argument(
-        "ActionRepeat: \"" + spec_.id +
-        "\" is a continuous env; the pixel pipeline needs discrete actions");
-  }
   // ceil(max_episode_steps / frame_skip): the outer step that contains the inner limit.
   spec_.max_episode_steps = static_cast<int>(
       (static_cast<int64_t>(spec_.max_episode_steps) + frame_skip_ - 1) / frame_skip_);
@@ -53,13 +48,22 @@ void ActionRepeat::Reset() {
 }
 
 StepResult ActionRepeat::Step(int action) {
+  return Repeat([&] { return env_->Step(action); });
+}
+
+StepResult ActionRepeat::StepContinuous(std::span<const float> action) {
+  return Repeat([&] { return env_->StepContinuous(action); });
+}
+
+template <class InnerStep>
+StepResult ActionRepeat::Repeat(const InnerStep& inner_step) {
   if (current_ < 0) throw std::logic_error("ActionRepeat: call Reset() before Step()");
 
   // Repeat the action, keeping the raw frames of the last two inner steps when max-pooling.
   StepResult total;
   int taken = 0;
   while (taken < frame_skip_) {
-    const StepResult inner = env_->Step(action);
+    const StepResult inner = inner_step();
     ++taken;
     total.reward += inner.reward;
     total.terminated = inner.terminated;

@@ -16,15 +16,15 @@
 
 namespace rl::envs {
 
-/// Wraps a discrete env; its image() is the RGB frame of the current state, max-pooled over the
-/// last two inner steps. observation() is the wrapped env's, after its last inner step. Not
-/// thread-safe.
+/// Wraps an env (discrete or continuous); its image() is the RGB frame of the current state,
+/// max-pooled over the last two inner steps. observation() is the wrapped env's, after its last
+/// inner step. Not thread-safe.
 class ActionRepeat : public ImageSource {
  public:
   /// Takes ownership of `env` and reads config's render_width, render_height, frame_skip and
   /// max_pool. With render size 0,0 it resets `env` once with seed 0 and renders it, to learn the
   /// native size. Allocates all frame buffers. Throws std::invalid_argument if env is null or
-  /// continuous, or config.Validate() fails.
+  /// config.Validate() fails.
   ActionRepeat(std::unique_ptr<Env> env, const ImagePipelineConfig& config);
 
   /// The wrapped env's spec with max_episode_steps = ceil(wrapped / frame_skip).
@@ -40,6 +40,8 @@ class ActionRepeat : public ImageSource {
   /// last is known only when the loop stops); without, only the last. Throws std::logic_error
   /// before the first Reset; exceptions of the wrapped env's Step (a bad action) pass through.
   StepResult Step(int action) override;
+  /// The same for a continuous env.
+  StepResult StepContinuous(std::span<const float> action) override;
 
   std::span<const float> observation() const override { return env_->observation(); }
   void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override;
@@ -56,6 +58,10 @@ class ActionRepeat : public ImageSource {
   void Capture(int slot);
 
   std::unique_ptr<Env> env_;
+  // Repeats `inner_step` (one step of the wrapped env) as Step describes.
+  template <class InnerStep>
+  StepResult Repeat(const InnerStep& inner_step);
+
   EnvSpec spec_;
   int render_width_;
   int render_height_;

@@ -63,6 +63,12 @@ StepResult FrameProcessor::Step(int action) {
   return result;
 }
 
+StepResult FrameProcessor::StepContinuous(std::span<const float> action) {
+  const StepResult result = env_->StepContinuous(action);
+  Process();
+  return result;
+}
+
 void FrameProcessor::Process() {
   // OpenCV headers over our own buffers: cvtColor and resize see outputs of the right size and
   // type and write into them without reallocating. OpenCV has no read-only Mat, hence the

@@ -29,6 +29,7 @@ class FrameProcessor : public ImageSource {
   void Reset(uint64_t seed) override;
   void Reset() override;
   StepResult Step(int action) override;
+  StepResult StepContinuous(std::span<const float> action) override;
 
   std::span<const float> observation() const override { return env_->observation(); }
   void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override;

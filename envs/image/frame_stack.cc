@@ -48,7 +48,15 @@ void FrameStack::Reset() {
 
 StepResult FrameStack::Step(int action) {
   if (!has_frames_) throw std::logic_error("FrameStack: call Reset() before Step()");
-  const StepResult result = env_->Step(action);
+  return Push(env_->Step(action));
+}
+
+StepResult FrameStack::StepContinuous(std::span<const float> action) {
+  if (!has_frames_) throw std::logic_error("FrameStack: call Reset() before Step()");
+  return Push(env_->StepContinuous(action));
+}
+
+StepResult FrameStack::Push(StepResult result) {
   // Shift the stack one frame towards the front and append the new frame.
   std::copy(stacked_.begin() + static_cast<std::ptrdiff_t>(frame_size_), stacked_.end(),
             stacked_.begin());

@@ -37,6 +37,8 @@ class FrameStack : public Env {
   /// Steps the wrapped env, drops the oldest frame and appends the new one. O(observation_size).
   /// Throws std::logic_error before the first Reset.
   StepResult Step(int action) override;
+  /// The same for a continuous env.
+  StepResult StepContinuous(std::span<const float> action) override;
 
   /// The stacked frames (all 0 before the first Reset).
   std::span<const float> observation() const override { return stacked_; }
@@ -48,6 +50,8 @@ class FrameStack : public Env {
  private:
   // Writes the wrapped env's current image, divided by 255, into slot `slot` of the stack.
   void Store(int slot);
+  // After a step of the wrapped env: shifts the stack and appends the new frame.
+  StepResult Push(StepResult result);
 
   std::unique_ptr<ImageSource> env_;
   EnvSpec spec_;

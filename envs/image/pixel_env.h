@@ -1,5 +1,5 @@
-// The image pipeline that turns any discrete env with a Render() into a pixel env for a
-// convolutional DQN, in the spirit of the Atari preprocessing of Mnih et al. (2015) and
+// The image pipeline that turns any env with a Render() (discrete or continuous) into a pixel env
+// for a convolutional DQN, in the spirit of the Atari preprocessing of Mnih et al. (2015) and
 // Gymnasium's AtariPreprocessing and FrameStackObservation wrappers:
 //
 //   inner -> ActionRepeat (action repeat + max-pool, RGB) -> FrameProcessor (grayscale, crop,
@@ -11,41 +11,9 @@
 #include <memory>
 
 #include "envs/env.h"
+#include "envs/image/image_config.h"
 
 namespace rl::envs {
-
-/// Options of the image pipeline. Every wrapper takes the whole struct and reads its own fields.
-struct ImagePipelineConfig {
-  // Raw frames come from inner->RenderSized(render_width, render_height), or from inner->Render()
-  // at the native size when both are 0.
-  int render_width = 0;
-  int render_height = 0;
-  // Action repeat k >= 1: each Step applies the action k times and sums the rewards, stopping
-  // early on terminated or truncated.
-  int frame_skip = 1;
-  // The frame of a Step is the pixelwise max of the raw frames after its last two inner steps
-  // (after one inner step: that frame; after Reset: the reset frame). Off: the last raw frame.
-  bool max_pool = true;
-  // Pixels removed from each side of the raw frame, before resizing.
-  int crop_top = 0;
-  int crop_bottom = 0;
-  int crop_left = 0;
-  int crop_right = 0;
-  // Output frame size, resized from the cropped frame with area interpolation (cv::INTER_AREA);
-  // both 0 keep the cropped size.
-  int width = 84;
-  int height = 84;
-  // Frames in the observation (EnvSpec::frame_stack), oldest first.
-  int stack = 4;
-  // Clamp each Step's (summed) reward to [-1, 1].
-  bool clip_rewards = false;
-
-  /// Throws std::invalid_argument naming the field unless: render_width and render_height are
-  /// both 0 or both positive, frame_skip >= 1, the crops are >= 0 (and, with an explicit render
-  /// size, leave at least one pixel each way), width and height are both 0 or both positive, and
-  /// stack >= 1.
-  void Validate() const;
-};
 
 /// Wraps `inner` in the pipeline above and returns a pixel env. Its spec has the inner env's id,
 /// num_actions and reward_threshold, max_episode_steps = ceil(inner's / frame_skip),
@@ -71,8 +39,8 @@ struct ImagePipelineConfig {
 /// steps its envs on one thread, and OpenCV's workers would compete with the run's other
 /// processes for the cores.
 ///
-/// Throws std::invalid_argument if inner is null, is a continuous env (num_actions == 0; DQN is
-/// discrete), config.Validate() fails, or the crop leaves no pixel of the raw frame.
+/// Throws std::invalid_argument if inner is null, config.Validate() fails, or the crop leaves no
+/// pixel of the raw frame.
 std::unique_ptr<Env> MakePixelEnv(std::unique_ptr<Env> inner, const ImagePipelineConfig& config);
 
 }  // namespace rl::envs

@@ -10,6 +10,7 @@
 #include "envs/kuka/kuka_kinematics.h"
 #include "envs/kuka/kuka_renderer.h"
 #include "envs/rng.h"
+#include "envs/specs.h"
 
 namespace rl::envs {
 namespace {
@@ -67,12 +68,10 @@ void KukaDiverseObjectConfig::Validate() const {
 KukaDiverseObjectEnv::KukaDiverseObjectEnv(const KukaDiverseObjectConfig& config)
     : config_(config) {
   config_.Validate();
-  spec_ = EnvSpec{
-      .id = config_.is_test ? "KukaDiverseObjectGraspingTest-v0" : "KukaDiverseObjectGrasping-v0",
-      .observation_size = static_cast<int>(observation_.size()),
-      .num_actions = kNumActions,
-      .max_episode_steps = config_.max_steps,
-      .reward_threshold = 0.6};
+  spec_ = KukaDiverseObjectSpec(config_.is_test, config_.max_steps, config_.width, config_.height);
+  RL_CHECK(spec_.observation_size == static_cast<int>(observation_.size()) &&
+           spec_.num_actions == kNumActions)
+      << "KukaDiverseObjectSpec() disagrees with the env";
   pool_ = kuka::ObjectIds(config_.is_test);
   shapes_.resize(kuka::kNumObjectIds);
   scene_ = std::make_unique<KukaScene>();

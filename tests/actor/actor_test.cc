@@ -97,7 +97,8 @@ TEST_F(ActorTest, SwitchesToACompleteWeightsVersionAndActsGreedily) {
   for (int i = 0; i < 32; ++i) actor.StepEnvs();
   bus_.Handle(0);
   ASSERT_FALSE(batches_.empty());
-  for (int32_t a : batches_[0].action) EXPECT_EQ(a, 1);
+  EXPECT_EQ(batches_[0].action_width, 1);
+  for (float a : batches_[0].action) EXPECT_EQ(a, 1.0f);
 }
 
 TEST_F(ActorTest, RefusesWeightsOfANetworkThatDoesNotFitTheEnv) {
@@ -110,7 +111,17 @@ TEST_F(ActorTest, RefusesWeightsOfANetworkThatDoesNotFitTheEnv) {
     bus_.Publish(channels::kWeights, &c, Port::kBulk);
   }
   bus_.Handle(0);
+  // Refused (counted), not merely not yet complete: a fitting version after it is taken.
+  EXPECT_EQ(actor.weights_refused(), 1);
   EXPECT_EQ(actor.weights_version(), -1);
+  nn::Sequential fits = nn::MakeMlp(4, {8}, 2, &rng);
+  fits.GetFlat(&flat);
+  for (auto& c : learner::MakeWeightChunks(2, fits.Architecture(), flat)) {
+    bus_.Publish(channels::kWeights, &c, Port::kBulk);
+  }
+  bus_.Handle(0);
+  EXPECT_EQ(actor.weights_refused(), 1);
+  EXPECT_EQ(actor.weights_version(), 2);
 }
 
 TEST_F(ActorTest, PublishesStatsWithItsCounters) {
@@ -127,9 +138,69 @@ TEST_F(ActorTest, PublishesStatsWithItsCounters) {
   EXPECT_DOUBLE_EQ(stats[0].epsilon, 0.4);
 }
 
-TEST_F(ActorTest, RefusesAnEnvWithContinuousActions) {
+TEST_F(ActorTest, RefusesAnEpsilonPolicyOnAContinuousEnvAndNoiseOnADiscreteOne) {
   config_.env_id = "LunarLanderContinuous-v3";
   EXPECT_THROW(Actor(config_, &bus_), std::invalid_argument);
+  config_.env_id = "CartPole-v1";
+  config_.exploration.mode = "gaussian";
+  EXPECT_THROW(Actor(config_, &bus_), std::invalid_argument);
+}
+
+// Continuous actions: random within the bounds during the start steps, then the network's action
+// plus noise, clipped to the bounds; they travel as action_dim floats.
+TEST_F(ActorTest, ActsInAContinuousEnvWithNoiseClippedToTheBounds) {
+  config_.env_id = "LunarLanderContinuous-v3";
+  config_.exploration.mode = "gaussian";
+  config_.exploration.sigma = 0.1;
+  config_.exploration.start_steps = 20;
+  config_.n_step = 1;
+  Actor actor(config_, &bus_);
+  // Output 0 far above its bound (main engine: clipped to 1), output 1 at 0.5 (+ noise).
+  std::mt19937 rng(1);
+  nn::Sequential net = nn::MakeMlp(8, {8}, 2, &rng);
+  std::vector<float> flat;
+  net.GetFlat(&flat);
+  std::fill(flat.begin(), flat.end(), 0.0f);
+  flat[flat.size() - 2] = 100.0f;
+  flat[flat.size() - 1] = 0.5f;
+  for (auto& c : learner::MakeWeightChunks(1, net.Architecture(), flat)) {
+    bus_.Publish(channels::kWeights, &c, Port::kBulk);
+  }
+  bus_.Handle(0);
+  ASSERT_EQ(actor.weights_version(), 1);
+  EXPECT_DOUBLE_EQ(actor.exploration(), 1.0);  // random start
+  for (int i = 0; i < 200; ++i) actor.StepEnvs();
+  bus_.Handle(0);
+  std::vector<float> actions;
+  for (const auto& b : batches_) {
+    EXPECT_EQ(b.action_width, 2);
+    actions.insert(actions.end(), b.action.begin(), b.action.end());
+  }
+  ASSERT_GE(actions.size(), 2U * 150U);
+  int random_start = 0;
+  double sum = 0, sum_sq = 0;
+  int n = 0;
+  for (size_t i = 0; i < actions.size() / 2; ++i) {
+    const float main = actions[2 * i], side = actions[2 * i + 1];
+    EXPECT_GE(main, -1.0f);
+    EXPECT_LE(main, 1.0f);
+    EXPECT_GE(side, -1.0f);
+    EXPECT_LE(side, 1.0f);
+    if (i < 20) {
+      random_start += main != 1.0f;
+      continue;
+    }
+    EXPECT_EQ(main, 1.0f) << i;  // mu far above the bound: clipped
+    sum += side;
+    sum_sq += side * side;
+    ++n;
+  }
+  EXPECT_GT(random_start, 15);  // uniform draws are hardly ever exactly the bound
+  // The side engine: mu 0.5 plus noise of sigma 0.1 x half-range 1.
+  const double mean = sum / n;
+  const double sd = std::sqrt(sum_sq / n - mean * mean);
+  EXPECT_NEAR(mean, 0.5, 0.03);
+  EXPECT_NEAR(sd, 0.1, 0.03);
 }
 
 TEST_F(ActorTest, ActsInLunarLanderWithItsEightObservationsAndFourActions) {
@@ -139,9 +210,10 @@ TEST_F(ActorTest, ActsInLunarLanderWithItsEightObservationsAndFourActions) {
   bus_.Handle(0);
   ASSERT_FALSE(batches_.empty());
   EXPECT_EQ(batches_[0].obs_size, 8);
-  for (int32_t a : batches_[0].action) {
-    EXPECT_GE(a, 0);
-    EXPECT_LT(a, 4);
+  for (float a : batches_[0].action) {
+    EXPECT_GE(a, 0.0f);
+    EXPECT_LT(a, 4.0f);
+    EXPECT_EQ(a, std::floor(a));
   }
 }
 
@@ -150,10 +222,10 @@ TEST_F(ActorTest, ActsInLunarLanderWithItsEightObservationsAndFourActions) {
 // the observations the env produced, stack by stack, across episode boundaries.
 TEST(ActorPixelsTest, SendsEveryFrameOnceAndStacksThatRebuildTheEnvsObservations) {
   Bus bus(Memq());
-  std::vector<rlmsg::pixel_batch_t> batches;
-  bus.Subscribe<rlmsg::pixel_batch_t>(
-      channels::kPixelTransitions,
-      [&batches](const rlmsg::pixel_batch_t& m) { batches.push_back(m); });
+  std::vector<rlmsg::transition_batch_t> batches;
+  bus.Subscribe<rlmsg::transition_batch_t>(
+      channels::kTransitions,
+      [&batches](const rlmsg::transition_batch_t& m) { batches.push_back(m); });
   ActorConfig config;
   config.env_id = "Catch-v0+pixels(width=5,height=10,stack=3,max-pool=0)";
   config.batch_size = 8;
@@ -165,12 +237,14 @@ TEST(ActorPixelsTest, SendsEveryFrameOnceAndStacksThatRebuildTheEnvsObservations
 
   std::map<int64_t, std::vector<uint8_t>> frames;
   std::vector<int64_t> obs_ids, next_ids;
-  std::vector<int32_t> actions;
+  std::vector<float> actions;
   std::vector<float> discounts;
   for (const auto& b : batches) {
     EXPECT_EQ(b.height, 10);
     EXPECT_EQ(b.width, 5);
     EXPECT_EQ(b.stack, 3);
+    EXPECT_EQ(b.obs_size, 0);
+    EXPECT_TRUE(b.obs.empty());
     for (int f = 0; f < b.num_frames; ++f) {
       const auto at = b.frames.begin() + f * 50;
       EXPECT_TRUE(
@@ -211,7 +285,7 @@ TEST(ActorPixelsTest, SendsEveryFrameOnceAndStacksThatRebuildTheEnvsObservations
     const int64_t* ids = &obs_ids[3 * i];
     if (ids[0] == ids[2]) ++episode_starts;  // the first frame, repeated
     EXPECT_EQ(stack_bytes(ids), env_bytes(*replica)) << "transition " << i;
-    const envs::StepResult r = replica->Step(actions[i]);
+    const envs::StepResult r = replica->Act(std::span<const float>(&actions[i], 1));
     EXPECT_EQ(stack_bytes(&next_ids[3 * i]), env_bytes(*replica)) << "transition " << i;
     EXPECT_EQ(discounts[i] == 0.0f, r.terminated) << "transition " << i;
     if (r.terminated || r.truncated) replica->Reset();

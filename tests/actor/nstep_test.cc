@@ -1,5 +1,6 @@
 #include "actor/nstep.h"
 
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -21,13 +22,14 @@ std::vector<Out> Feed(int n, double gamma, const std::vector<double>& rewards, b
   NStepAccumulator acc(n, gamma, 1);
   std::vector<Out> out;
   auto sink = [&out](const Transition& t) {
-    out.push_back({t.obs[0], t.action, t.reward, t.discount, t.next_obs[0]});
+    out.push_back({t.obs[0], static_cast<int>(t.action[0]), t.reward, t.discount, t.next_obs[0]});
   };
   for (size_t t = 0; t < rewards.size(); ++t) {
     const float o = static_cast<float>(t);
     const float next = static_cast<float>(t + 1);
     const bool last = t + 1 == rewards.size();
-    acc.Add(std::span<const float>(&o, 1), static_cast<int>(t), rewards[t],
+    const float action = static_cast<float>(t);
+    acc.Add(std::span<const float>(&o, 1), std::span<const float>(&action, 1), rewards[t],
             std::span<const float>(&next, 1), last && terminate, last && truncate, sink);
   }
   return out;
@@ -75,6 +77,29 @@ TEST(NStepTest, ATruncationIsNotATerminalAndBootstrapsFromTheLastObservation) {
 TEST(NStepTest, RefusesBadParameters) {
   EXPECT_THROW(NStepAccumulator(0, 0.9, 1), std::invalid_argument);
   EXPECT_THROW(NStepAccumulator(1, 1.5, 1), std::invalid_argument);
+}
+
+// Continuous actions travel as vectors: each transition keeps the action of its first step.
+TEST(NStepTest, ActionVectorsStayWithTheirStep) {
+  NStepAccumulator acc(2, 0.5, 1, 3);
+  std::vector<std::vector<float>> actions;
+  auto sink = [&actions](const Transition& t) {
+    actions.emplace_back(t.action.begin(), t.action.end());
+  };
+  for (int t = 0; t < 4; ++t) {
+    const float o = static_cast<float>(t), next = o + 1;
+    const float a[] = {o, -o, 0.5f * o};
+    acc.Add(std::span<const float>(&o, 1), a, 1.0, std::span<const float>(&next, 1), false, t == 3,
+            sink);
+  }
+  ASSERT_EQ(actions.size(), 4U);
+  EXPECT_EQ(actions[1], (std::vector<float>{1, -1, 0.5f}));
+  EXPECT_EQ(actions[3], (std::vector<float>{3, -3, 1.5f}));
+  const float wrong[] = {0, 0};
+  const float o = 0;
+  EXPECT_THROW(acc.Add(std::span<const float>(&o, 1), wrong, 1.0, std::span<const float>(&o, 1),
+                       false, false, sink),
+               std::invalid_argument);
 }
 
 }  // namespace

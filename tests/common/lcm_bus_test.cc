@@ -28,7 +28,9 @@ rlmsg::transition_batch_t MakeBatch(int count, int obs_size) {
   m.num_values = count * obs_size;
   m.obs.assign(static_cast<size_t>(m.num_values), 0.5f);
   m.next_obs.assign(static_cast<size_t>(m.num_values), 0.25f);
-  m.action.assign(static_cast<size_t>(count), 1);
+  m.action_width = 1;
+  m.num_action_values = count;
+  m.action.assign(static_cast<size_t>(count), 1.0f);
   m.reward.assign(static_cast<size_t>(count), 1.0f);
   m.discount.assign(static_cast<size_t>(count), 0.99f);
   m.episode_id.assign(static_cast<size_t>(count), 7);
@@ -127,8 +129,10 @@ TEST_F(BusTest, DropsNonFiniteOrInconsistentContentAsInvalid) {
   auto bad_discount = MakeBatch(2, 4);
   bad_discount.discount[0] = 1.5f;
   bus_.Publish(channels::kTransitions, &bad_discount);
+  // Actions are floats of the env's width: a negative one may be a continuous action, so the
+  // message checks refuse a non-finite one (the replay checks range against the env).
   auto bad_action = MakeBatch(2, 4);
-  bad_action.action[0] = -1;
+  bad_action.action[0] = std::numeric_limits<float>::infinity();
   bus_.Publish(channels::kTransitions, &bad_action);
   bus_.Handle(100);
   EXPECT_TRUE(got_.empty());

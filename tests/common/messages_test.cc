@@ -1,6 +1,8 @@
 #include "common/messages.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -34,13 +36,83 @@ TEST(PrescanTest, AgreesWithTheEncodingOfATransitionBatch) {
   m.num_values = 15;
   m.obs.assign(15, 1.0f);
   m.next_obs.assign(15, 2.0f);
-  m.action.assign(5, 1);
+  m.action_width = 1;
+  m.num_action_values = 5;
+  m.action.assign(5, 1.0f);
   m.reward.assign(5, 0.5f);
   m.discount.assign(5, 0.9f);
   m.episode_id.assign(5, 3);
   m.priority.assign(5, 0.0f);
   ExpectPrescanMatchesTheEncoding(m);
   EXPECT_EQ(Validate(m), nullptr);
+}
+
+// A continuous batch: 3 floats per action (steer, gas, brake).
+rlmsg::transition_batch_t ContinuousBatch() {
+  rlmsg::transition_batch_t m{};
+  m.header.sender = "actor-0";
+  m.obs_size = 2;
+  m.count = 2;
+  m.num_values = 4;
+  m.obs.assign(4, 1.0f);
+  m.next_obs.assign(4, 2.0f);
+  m.action_width = 3;
+  m.num_action_values = 6;
+  m.action = {-0.5f, 1.0f, 0.0f, 0.25f, 0.0f, 0.75f};
+  m.reward.assign(2, 0.5f);
+  m.discount.assign(2, 0.9f);
+  m.episode_id.assign(2, 3);
+  m.priority.assign(2, 0.0f);
+  return m;
+}
+
+TEST(MessagesTest, ActionVectorsRoundTripAndBadActionsAreRefused) {
+  const rlmsg::transition_batch_t m = ContinuousBatch();
+  ExpectPrescanMatchesTheEncoding(m);
+  EXPECT_EQ(Validate(m), nullptr);
+  const auto bytes = Encode(m);
+  rlmsg::transition_batch_t back{};
+  ASSERT_EQ(back.decode(bytes.data(), 0, static_cast<int>(bytes.size())),
+            static_cast<int>(bytes.size()));
+  EXPECT_EQ(back.action, m.action);
+  EXPECT_EQ(back.action_width, 3);
+  rlmsg::transition_batch_t bad = ContinuousBatch();
+  bad.action[4] = std::nanf("");
+  EXPECT_STREQ(Validate(bad), "non-finite action");
+  bad = ContinuousBatch();
+  bad.action[1] = std::numeric_limits<float>::infinity();
+  EXPECT_STREQ(Validate(bad), "non-finite action");
+  bad = ContinuousBatch();
+  bad.num_action_values = 5;
+  bad.action.pop_back();
+  EXPECT_STREQ(Validate(bad), "num_action_values mismatch");
+  bad = ContinuousBatch();
+  bad.action_width = 0;
+  bad.num_action_values = 0;
+  bad.action.clear();
+  EXPECT_STREQ(Validate(bad), "action_width outside [1, 64]");
+  bad = ContinuousBatch();
+  bad.action_width = 65;
+  bad.num_action_values = 130;
+  bad.action.assign(130, 0.0f);
+  EXPECT_STREQ(Validate(bad), "action_width outside [1, 64]");
+  // A forged action count: prescan refuses it before the decoder sizes a vector from it.
+  auto forged = Encode(m);
+  const std::vector<uint8_t> six = {0, 0, 0, 6};
+  const auto at = std::search(forged.begin() + 40, forged.end(), six.begin(), six.end());
+  ASSERT_NE(at, forged.end());
+  *at = 0x7f;
+  EXPECT_NE(Prescan(&m, forged.data(), forged.size()), nullptr);
+}
+
+TEST(ValidateTest, RefusesBatchesWithBothOrNeitherObservationKind) {
+  rlmsg::transition_batch_t m = ContinuousBatch();
+  m.stack = 2;
+  m.height = m.width = 2;
+  EXPECT_STREQ(Validate(m), "neither or both of flat and pixel observations");
+  m = ContinuousBatch();
+  m.obs_size = 0;
+  EXPECT_STREQ(Validate(m), "neither or both of flat and pixel observations");
 }
 
 TEST(PrescanTest, AgreesWithTheEncodingOfASampleBatch) {
@@ -52,7 +124,9 @@ TEST(PrescanTest, AgreesWithTheEncodingOfASampleBatch) {
   m.num_values = 8;
   m.obs.assign(8, 1.0f);
   m.next_obs.assign(8, 2.0f);
-  m.action.assign(4, 0);
+  m.action_width = 1;
+  m.num_action_values = 4;
+  m.action.assign(4, 0.0f);
   m.reward.assign(4, 0.5f);
   m.discount.assign(4, 0.9f);
   m.index.assign(4, 11);
@@ -78,8 +152,8 @@ TEST(PrescanTest, AgreesWithTheEncodingOfAWeightsChunk) {
 }
 
 // Two 2 x 3 frames (ids 7 and 8) and one transition of stack 2 naming them.
-rlmsg::pixel_batch_t PixelBatch() {
-  rlmsg::pixel_batch_t m{};
+rlmsg::transition_batch_t PixelBatch() {
+  rlmsg::transition_batch_t m{};
   m.header.sender = "actor-0";
   m.height = 2;
   m.width = 3;
@@ -92,6 +166,8 @@ rlmsg::pixel_batch_t PixelBatch() {
   m.num_refs = 2;
   m.obs_frames = {7, 7};
   m.next_obs_frames = {7, 8};
+  m.action_width = 1;
+  m.num_action_values = 1;
   m.action = {2};
   m.reward = {1.0f};
   m.discount = {0.99f};
@@ -101,24 +177,25 @@ rlmsg::pixel_batch_t PixelBatch() {
 }
 
 TEST(PrescanTest, AgreesWithTheEncodingOfAPixelBatch) {
-  const rlmsg::pixel_batch_t m = PixelBatch();
+  const rlmsg::transition_batch_t m = PixelBatch();
   ExpectPrescanMatchesTheEncoding(m);
   EXPECT_EQ(Validate(m), nullptr);
 }
 
 TEST(PrescanTest, RefusesAPixelBatchWithAForgedFrameLength) {
-  rlmsg::pixel_batch_t m = PixelBatch();
+  rlmsg::transition_batch_t m = PixelBatch();
   auto bytes = Encode(m);
-  // num_bytes sits after the fingerprint, the header (8 + 4 + len("test") + 1 + 16), four int32
-  // fields, num_frames and two int64 frame ids.
-  const size_t at = 8 + 8 + 4 + 5 + 16 + 16 + 4 + 16;
+  // num_bytes sits after the fingerprint, the header (8 + 4 + len("test") + 1 + 16), actor_id,
+  // count, obs_size, num_values (and no obs), height, width, stack, num_frames and two int64
+  // frame ids.
+  const size_t at = 8 + 8 + 4 + 5 + 16 + 16 + 12 + 4 + 16;
   ASSERT_EQ(bytes[at + 3], 12);  // the encoded num_bytes, big-endian
   bytes[at] = 0x7f;              // about 2^31 bytes claimed
   EXPECT_NE(Prescan(&m, bytes.data(), bytes.size()), nullptr);
 }
 
 TEST(ValidateTest, RefusesInconsistentPixelBatches) {
-  rlmsg::pixel_batch_t m = PixelBatch();
+  rlmsg::transition_batch_t m = PixelBatch();
   m.num_bytes = 11;
   m.frames.resize(11);
   EXPECT_STREQ(Validate(m), "num_bytes mismatch");
@@ -139,7 +216,7 @@ TEST(ValidateTest, RefusesInconsistentPixelBatches) {
 }
 
 TEST(PrescanTest, AgreesWithTheEncodingOfAPixelSampleBatchAndAPriorityUpdate) {
-  rlmsg::pixel_sample_batch_t m{};
+  rlmsg::sample_batch_t m{};
   m.header.sender = "replay";
   m.requester = "learner";
   m.height = 2;
@@ -147,8 +224,10 @@ TEST(PrescanTest, AgreesWithTheEncodingOfAPixelSampleBatchAndAPriorityUpdate) {
   m.stack = 3;
   m.count = 2;
   m.num_bytes = 24;
-  m.obs.assign(24, 1);
-  m.next_obs.assign(24, 2);
+  m.obs_pixels.assign(24, 1);
+  m.next_obs_pixels.assign(24, 2);
+  m.action_width = 1;
+  m.num_action_values = 2;
   m.action = {0, 1};
   m.reward = {0.0f, 1.0f};
   m.discount = {0.9f, 0.0f};

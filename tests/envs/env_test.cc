@@ -62,8 +62,8 @@ TEST(EnvTest, DefaultRenderSizedRejectsEmptySizes) {
 TEST(EnvTest, DiscreteSpecsHaveNoContinuousActionsAndStepContinuousThrows) {
   TwoToneEnv env;
   EXPECT_EQ(env.spec().action_dim, 0);
-  EXPECT_EQ(env.spec().action_low, 0.0f);
-  EXPECT_EQ(env.spec().action_high, 0.0f);
+  EXPECT_TRUE(env.spec().action_low.empty());
+  EXPECT_TRUE(env.spec().action_high.empty());
   try {
     env.StepContinuous(std::array<float, 2>{0, 0});
     FAIL() << "expected std::logic_error";

@@ -157,8 +157,8 @@ class ScriptedContinuousEnv : public Env {
                 .max_episode_steps = 1000,
                 .reward_threshold = 0,
                 .action_dim = 1,
-                .action_low = -2,
-                .action_high = 2};
+                .action_low = {-2},
+                .action_high = {2}};
   std::array<float, 1> observation_{};
 };
 
@@ -167,8 +167,8 @@ TEST(TimeLimitTest, ForwardsContinuousStepsAndCountsThem) {
   ScriptedContinuousEnv* scripted = inner.get();
   TimeLimit env(std::move(inner), 2);
   EXPECT_EQ(env.spec().action_dim, 1);
-  EXPECT_EQ(env.spec().action_low, -2.0f);
-  EXPECT_EQ(env.spec().action_high, 2.0f);
+  EXPECT_EQ(env.spec().action_low, std::vector<float>{-2.0f});
+  EXPECT_EQ(env.spec().action_high, std::vector<float>{2.0f});
   env.Reset(0);
   const StepResult first = env.StepContinuous(std::array<float, 1>{1.5f});
   EXPECT_EQ(first.reward, 1.5);

@@ -1,13 +1,17 @@
 #include "evaluator/scorer.h"
 
 #include <cmath>
+#include <functional>
+#include <optional>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "envs/registry.h"
+#include "envs/specs.h"
 #include "nn/sequential.h"
 
 namespace rl::evaluator {
@@ -26,6 +30,31 @@ nn::Sequential AlwaysChooses(int action) {
   net.SetFlat(flat.data(), flat.size());
   return net;
 }
+
+// A policy played by a function of the observation (a stand-in for a network, to count calls
+// and script behaviour); `value`, when set, gives the estimate of the action chosen.
+class ScriptedPolicy : public actor::Policy {
+ public:
+  using ActionFn = std::function<float(std::span<const float>)>;
+  using ValueFn = std::function<double(std::span<const float>)>;
+  explicit ScriptedPolicy(ActionFn act, ValueFn value = {})
+      : Policy(envs::LookupSpec(kEnv), actor::ExplorationConfig{}, 0, 1, 1),
+        act_(std::move(act)),
+        value_fn_(std::move(value)) {}
+  void Act(std::span<const float> obs, int64_t /*step*/, std::span<float> action) override {
+    ++calls;
+    action[0] = act_(obs);
+    if (value_fn_) value_ = value_fn_(obs);
+  }
+  std::optional<double> last_value() const override { return value_; }
+  double exploration(int64_t /*step*/) const override { return 0.0; }
+  int calls = 0;
+
+ private:
+  ActionFn act_;
+  ValueFn value_fn_;
+  std::optional<double> value_;
+};
 
 // Plays the episodes first_seed .. first_seed + episodes - 1 with a fixed action.
 std::vector<double> PlayByHand(int action, int episodes, uint64_t first_seed) {
@@ -96,33 +125,26 @@ TEST(ScorerTest, RunsTheRequestedNumberOfEpisodes) {
 TEST(ScorerTest, CallsTheEpisodeHookOnceAfterEveryEpisode) {
   int calls = 0;
   int steps_at_last_call = -1;
-  int steps = 0;
-  const GreedyPolicy count_steps = [&steps](std::span<const float>) {
-    ++steps;
-    return 0;
-  };
-  ScoreGreedyPolicy(count_steps, "CartPole-v1", 4, 0.0, 1000, [&] {
+  ScriptedPolicy policy([](std::span<const float>) { return 0.0f; });
+  const EvalScore s = Score(&policy, "CartPole-v1", 4, 1000, kDefaultGamma, [&] {
     ++calls;
-    EXPECT_GT(steps, steps_at_last_call);  // an episode was played since the last call
-    steps_at_last_call = steps;
+    EXPECT_GT(policy.calls, steps_at_last_call);  // an episode was played since the last call
+    steps_at_last_call = policy.calls;
   });
   EXPECT_EQ(calls, 4);
-  EXPECT_EQ(steps_at_last_call, steps);
-}
-
-TEST(ScorerTest, EpsilonOneNeverAsksThePolicyAndEpsilonZeroAlwaysDoes) {
-  int calls = 0;
-  const GreedyPolicy counting = [&calls](std::span<const float>) {
-    ++calls;
-    return 0;
-  };
-  ScoreGreedyPolicy(counting, kEnv, 5, 1.0, 3);
-  EXPECT_EQ(calls, 0);
-  const EvalScore s = ScoreGreedyPolicy(counting, kEnv, 5, 0.0, 3);
-  // CartPole rewards 1 per step, so the returns add up to the steps taken.
+  EXPECT_EQ(steps_at_last_call, policy.calls);
+  // The policy is asked once per step: CartPole rewards 1 per step.
   double steps = 0;
   for (double r : s.returns) steps += r;
-  EXPECT_EQ(calls, static_cast<int>(steps));
+  EXPECT_EQ(policy.calls, static_cast<int>(steps));
+}
+
+TEST(ScorerTest, EpsilonZeroIsGreedyAndEpsilonOneUniformlyRandom) {
+  nn::Sequential net = AlwaysChooses(0);
+  EXPECT_EQ(ScorePolicy(&net, kEnv, 20, 0.0, 3).returns, PlayByHand(0, 20, 3));
+  // Random pushes balance far longer than always pushing left (about 22 steps against 9).
+  const EvalScore random = ScorePolicy(&net, kEnv, 20, 1.0, 3);
+  EXPECT_GT(random.mean, ScorePolicy(&net, kEnv, 20, 0.0, 3).mean + 5);
 }
 
 TEST(ScorerTest, SummarizeUsesThePopulationStd) {
@@ -145,8 +167,10 @@ TEST(ScorerTest, RefusesBadArgumentsAndANetworkThatDoesNotFitTheEnv) {
   EXPECT_THROW(ScorePolicy(&wide, kEnv, 5, 0.05, 1), std::invalid_argument);
   nn::Sequential three = nn::MakeMlp(4, {8}, 3, &rng);
   EXPECT_THROW(ScorePolicy(&three, kEnv, 5, 0.05, 1), std::invalid_argument);
-  const GreedyPolicy out_of_range = [](std::span<const float>) { return 2; };
-  EXPECT_THROW(ScoreGreedyPolicy(out_of_range, kEnv, 1, 0.0, 1), std::invalid_argument);
+  ScriptedPolicy out_of_range([](std::span<const float>) { return 2.0f; });
+  EXPECT_THROW(Score(&out_of_range, kEnv, 1, 1), std::invalid_argument);
+  EXPECT_FALSE(CheckNetworkFitsEnv(three, envs::LookupSpec(kEnv)).empty());
+  EXPECT_TRUE(CheckNetworkFitsEnv(net, envs::LookupSpec(kEnv)).empty());
 }
 
 TEST(ScorerTest, CorrelationIsPearsonsAndUndefinedForAConstantSeries) {
@@ -180,8 +204,8 @@ TEST(ScorerTest, ComparesTheValueOfEveryActionTakenWithTheDiscountedReturnThatFo
   EXPECT_NEAR(score.values->actual, sum / static_cast<double>(steps), 1e-9);
   EXPECT_TRUE(std::isnan(score.values->correlation));  // the estimates are constant
   // A policy without values has no calibration.
-  const GreedyPolicy greedy = [](std::span<const float>) { return 1; };
-  EXPECT_FALSE(ScoreGreedyPolicy(greedy, kEnv, 2, 0.0, 77).values.has_value());
+  ScriptedPolicy greedy([](std::span<const float>) { return 1.0f; });
+  EXPECT_FALSE(Score(&greedy, kEnv, 2, 77).values.has_value());
 }
 
 TEST(ScorerTest, OfAnEpisodeCutByItsTimeLimitOnlyStepsFarFromTheCutCount) {
@@ -189,14 +213,13 @@ TEST(ScorerTest, OfAnEpisodeCutByItsTimeLimitOnlyStepsFarFromTheCutCount) {
   // With gamma 0.99 the unseen rest weighs 0.99^(500 - t): at most 0.01 for t <= 41 (0.99^459 =
   // 0.00995, 0.99^458 = 0.01005), so 42 steps of each episode count. The values are the pole
   // angle's cosine, which tracks nothing of the return here but is not constant.
-  std::vector<float> q(2);
-  const ActionValues balance = [&q](std::span<const float> obs) {
-    const float push = obs[2] + 0.5f * obs[3] + 0.01f * obs[0] + 0.1f * obs[1];
-    q[0] = push > 0 ? 0.0f : std::cos(obs[2]);
-    q[1] = push > 0 ? std::cos(obs[2]) : 0.0f;
-    return std::span<const float>(q);
-  };
-  const EvalScore score = ScoreActionValues(balance, kEnv, 3, 0.0, 0.99, 5);
+  ScriptedPolicy balance(
+      [](std::span<const float> obs) {
+        const float push = obs[2] + 0.5f * obs[3] + 0.01f * obs[0] + 0.1f * obs[1];
+        return push > 0 ? 1.0f : 0.0f;
+      },
+      [](std::span<const float> obs) { return static_cast<double>(std::cos(obs[2])); });
+  const EvalScore score = Score(&balance, kEnv, 3, 5, 0.99);
   ASSERT_EQ(score.returns, (std::vector<double>{500, 500, 500}));
   ASSERT_TRUE(score.values.has_value());
   EXPECT_EQ(score.values->steps, 3 * 42);
@@ -207,15 +230,42 @@ TEST(ScorerTest, OfAnEpisodeCutByItsTimeLimitOnlyStepsFarFromTheCutCount) {
   EXPECT_LE(score.values->estimate, 1.0);
 }
 
-TEST(ScorerTest, RefusesAGammaOutsideTheUnitIntervalAndValuesOfTheWrongLength) {
+TEST(ScorerTest, RefusesAGammaOutsideTheUnitInterval) {
   nn::Sequential net = AlwaysChooses(0);
   EXPECT_THROW(ScorePolicy(&net, kEnv, 1, 0.0, 1, 1.5), std::invalid_argument);
   EXPECT_THROW(ScorePolicy(&net, kEnv, 1, 0.0, 1, -0.1), std::invalid_argument);
-  std::vector<float> three(3, 0.0f);
-  const ActionValues wrong = [&three](std::span<const float>) {
-    return std::span<const float>(three);
-  };
-  EXPECT_THROW(ScoreActionValues(wrong, kEnv, 1, 0.0, 0.99, 1), std::invalid_argument);
+}
+
+// A continuous env is scored with the actor network's action, without noise or epsilon: the
+// same returns as the same constant action played by hand, and no value calibration (an actor has
+// no value estimates).
+TEST(ScorerTest, ScoresAContinuousActorWithItsDeterministicAction) {
+  constexpr char kLander[] = "LunarLanderContinuous-v3";
+  std::mt19937 rng(1);
+  nn::Sequential actor = nn::MakeMlp(8, {4}, 2, &rng);
+  std::vector<float> flat(static_cast<size_t>(actor.NumParams()), 0.0f);
+  flat[flat.size() - 2] = 0.6f;   // main engine
+  flat[flat.size() - 1] = -0.4f;  // side engine
+  actor.SetFlat(flat.data(), flat.size());
+  const EvalScore score = ScorePolicy(&actor, kLander, 3, /*epsilon=*/0.05, 40);
+  auto env = envs::MakeEnv(kLander);
+  const float action[] = {0.6f, -0.4f};
+  std::vector<double> by_hand;
+  for (int i = 0; i < 3; ++i) {
+    env->Reset(40 + static_cast<uint64_t>(i));
+    double total = 0;
+    for (;;) {
+      const envs::StepResult r = env->StepContinuous(action);
+      total += r.reward;
+      if (r.terminated || r.truncated) break;
+    }
+    by_hand.push_back(total);
+  }
+  EXPECT_EQ(score.returns, by_hand);
+  EXPECT_FALSE(score.values.has_value());
+  // A Q-network's output size (4 actions) does not fit the 2 action dimensions.
+  nn::Sequential q = nn::MakeMlp(8, {4}, 4, &rng);
+  EXPECT_THROW(ScorePolicy(&q, kLander, 1, 0.05, 1), std::invalid_argument);
 }
 
 TEST(ScorerTest, TheDefaultSeedBaseIsFarFromTrainingSeeds) {

@@ -10,13 +10,7 @@ status=$?
 set -e
 cat "$dir/launch.log" | tail -20
 [ "$status" -eq 0 ] || fail "launch exited with $status"
-jsonl="$dir/run/eval.jsonl"
-[ -s "$jsonl" ] || fail "no eval.jsonl"
-best=$(best_mean "$jsonl")
-[ -n "$best" ] || fail "no evaluation in $jsonl"
-awk -v b="$best" 'BEGIN{exit !(b >= 475)}' || fail "best evaluation mean $best < 475"
-grep -E '"mean": *'"$best"'[,}]' "$jsonl" | grep -Eq '"episodes": *100[,}]' ||
-  fail "the best evaluation did not use 100 episodes"
+best=$(expect_best_mean "$dir/run" 475 --at-least)
 grep -q '<img' "$dir/run/report/index.html" || fail "the report has no learning curve"
 ls "$dir/run/checkpoints"/ckpt-*.bin >/dev/null || fail "no checkpoints"
 for role in replay learner evaluator actor-0; do

@@ -39,6 +39,23 @@ cleanup() {
 # The best evaluation mean in an eval.jsonl.
 best_mean() { grep -Eo '"mean": *[-0-9.e+]+' "$1" | grep -Eo '[-0-9.e+]+$' | sort -g | tail -1; }
 
+# Checks a finished run folder: its best evaluation mean is above MIN (at least MIN with
+# "--at-least"), over 100 episodes; prints the best mean.
+expect_best_mean() {  # expect_best_mean RUN_DIR MIN [--at-least]
+  local jsonl="$1/eval.jsonl" min=$2 best
+  [ -s "$jsonl" ] || fail "no eval.jsonl"
+  best=$(best_mean "$jsonl")
+  [ -n "$best" ] || fail "no evaluation in $jsonl"
+  if [ "${3:-}" = "--at-least" ]; then
+    awk -v b="$best" -v m="$min" 'BEGIN{exit !(b >= m)}' || fail "best evaluation mean $best < $min"
+  else
+    awk -v b="$best" -v m="$min" 'BEGIN{exit !(b > m)}' || fail "best evaluation mean $best <= $min"
+  fi
+  grep -E '"mean": *'"$best"'[,}]' "$jsonl" | grep -Eq '"episodes": *100[,}]' ||
+    fail "the best evaluation did not use 100 episodes"
+  echo "$best"
+}
+
 # Waits (bounded) until FILE has a line matching PATTERN.
 wait_line() {  # wait_line FILE PATTERN TIMEOUT_SECONDS
   local file=$1 pattern=$2 limit=$3

@@ -13,6 +13,7 @@
 #include "rlmsg/checkpoint_t.hpp"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
+#include "rlmsg/stats_learner_t.hpp"
 #include "rlmsg/weights_chunk_t.hpp"
 
 namespace rl::learner {
@@ -70,16 +71,25 @@ class LearnerTest : public ::testing::Test {
     rlmsg::sample_batch_t b{};
     b.requester = r.header.sender;
     b.request_id = r.request_id;
-    b.obs_size = 4;
+    b.obs_size = obs_size_;
     b.count = r.batch_size;
-    b.num_values = 4 * b.count;
+    b.num_values = obs_size_ * b.count;
     std::normal_distribution<float> normal;
     for (int i = 0; i < b.num_values; ++i) {
       b.obs.push_back(normal(rng_));
       b.next_obs.push_back(normal(rng_));
     }
+    // The first bad_replies_ replies carry one action value too many.
+    const int width = bad_replies_ > 0 ? action_width_ + 1 : action_width_;
+    if (bad_replies_ > 0) --bad_replies_;
+    b.action_width = width;
+    b.num_action_values = b.count * width;
+    std::uniform_real_distribution<float> torque(-2.0f, 2.0f);
     for (int i = 0; i < b.count; ++i) {
-      b.action.push_back(i % 2);
+      for (int k = 0; k < width; ++k) {
+        // CartPole: alternating indices; Pendulum: torques in [-2, 2].
+        b.action.push_back(continuous_ ? torque(rng_) : static_cast<float>(i % 2));
+      }
       b.reward.push_back(1.0f);
       b.discount.push_back(0.99f);
       b.index.push_back(i);
@@ -93,7 +103,7 @@ class LearnerTest : public ::testing::Test {
   // A batch of Catch-shaped pixel transitions (stack 2 of 10 x 5 frames); transition i is
   // reported as index 1000 * request_id + i.
   void ReplyPixels(const rlmsg::sample_request_t& r) {
-    rlmsg::pixel_sample_batch_t b{};
+    rlmsg::sample_batch_t b{};
     b.requester = r.header.sender;
     b.request_id = r.request_id;
     b.height = 10;
@@ -103,11 +113,13 @@ class LearnerTest : public ::testing::Test {
     b.num_bytes = 100 * b.count;
     std::uniform_int_distribution<int> byte(0, 255);
     for (int i = 0; i < b.num_bytes; ++i) {
-      b.obs.push_back(static_cast<uint8_t>(byte(rng_)));
-      b.next_obs.push_back(static_cast<uint8_t>(byte(rng_)));
+      b.obs_pixels.push_back(static_cast<uint8_t>(byte(rng_)));
+      b.next_obs_pixels.push_back(static_cast<uint8_t>(byte(rng_)));
     }
+    b.action_width = 1;
+    b.num_action_values = b.count;
     for (int i = 0; i < b.count; ++i) {
-      b.action.push_back(i % 3);
+      b.action.push_back(static_cast<float>(i % 3));
       b.reward.push_back(i % 2 == 0 ? 1.0f : -1.0f);
       b.discount.push_back(0.0f);
       b.index.push_back(1000 * r.request_id + i);
@@ -115,10 +127,14 @@ class LearnerTest : public ::testing::Test {
     }
     b.replay_size = 1000;
     b.total_inserts = 4321;
-    bus_->Publish(channels::kPixelSamples, &b, Port::kBulk);
+    bus_->Publish(channels::kSamples, &b, Port::kBulk);
   }
 
   bool pixels_ = false;
+  int obs_size_ = 4;
+  int action_width_ = 1;
+  int bad_replies_ = 0;
+  bool continuous_ = false;
   fs::path dir_;
   std::unique_ptr<Bus> bus_;
   std::mt19937 rng_{1};
@@ -155,10 +171,10 @@ TEST_F(LearnerTest, TrainsBroadcastsWeightsAndWritesLoadableCheckpoints) {
   EXPECT_EQ(ckpt.meta.update, 20);
   EXPECT_EQ(ckpt.meta.env_steps, 1234);
   EXPECT_EQ(ckpt.meta.run_id, 9U);
-  EXPECT_EQ(ckpt.architecture, learner.dqn().online().Architecture());
+  EXPECT_EQ(ckpt.architecture, learner.algorithm().policy().Architecture());
   // The last checkpoint holds the final parameters.
   std::vector<float> flat;
-  learner.dqn().online().GetFlat(&flat);
+  learner.algorithm().policy().GetFlat(&flat);
   EXPECT_EQ(nn::LoadCheckpoint(announced_.back()).params, flat);
 }
 
@@ -171,8 +187,8 @@ TEST_F(LearnerTest, TrainsOnPixelBatchesAndSendsTheirTdErrorsAsPriorities) {
   LearnerConfig c;
   c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)";
   c.dqn.network = "conv2d(2,4,3,1,1,10,5),relu,flatten,linear(200,3)";
-  // Random shifts need the frame size, which comes with each message (Dqn throws without it).
-  c.dqn.augment_shift = 2;
+  // Random shifts need the frame size, which comes from the env's static spec.
+  c.augment_shift = 2;
   c.batch_size = 16;
   c.max_updates = 20;
   c.checkpoint_every = 100;
@@ -226,9 +242,73 @@ TEST(LearnerConfigTest, RefusesBadSettings) {
 
 TEST_F(LearnerTest, RefusesRandomShiftsForAnEnvWithoutPixels) {
   LearnerConfig c;
-  c.dqn.augment_shift = 4;
+  c.augment_shift = 4;
   c.out_dir = dir_.string();
   EXPECT_THROW(Learner(c, bus_.get()), std::invalid_argument);
+}
+
+// TD3 on Pendulum-v1: trains on replies of one-float torques and broadcasts and checkpoints its
+// actor (3 inputs, 1 output in [-2, 2]), not a critic.
+TEST_F(LearnerTest, TrainsTd3AndPublishesItsActor) {
+  obs_size_ = 3;
+  continuous_ = true;
+  LearnerConfig c;
+  c.env_id = "Pendulum-v1";
+  c.algorithm = "td3";
+  c.td3.hidden = {16, 16};
+  c.batch_size = 16;
+  c.max_updates = 20;
+  c.checkpoint_every = 10;
+  c.request_timeout = 0.05;
+  c.out_dir = dir_.string();
+  Learner learner(c, bus_.get());
+  learner.Run();
+  bus_->Handle(0);
+  EXPECT_EQ(learner.updates(), 20);
+  EXPECT_EQ(learner.batches_refused(), 0);
+  const nn::Checkpoint ckpt = nn::LoadCheckpoint(announced_.back());
+  std::mt19937 rng(0);
+  nn::Sequential actor = nn::BuildFromArchitecture(ckpt.architecture, &rng);
+  EXPECT_EQ(actor.InputSize(), 3);
+  EXPECT_EQ(actor.OutputSize(), 1);
+  EXPECT_NE(ckpt.architecture.find("bounded(1,-2,2)"), std::string::npos) << ckpt.architecture;
+}
+
+// Replies whose actions are not the env's width are dropped and counted, never trained on; the
+// learner goes on with the next ones.
+TEST_F(LearnerTest, CountsAndDropsRepliesThatDoNotFitTheEnv) {
+  bad_replies_ = 3;  // two action values where CartPole has one
+  std::vector<rlmsg::stats_learner_t> stats;
+  bus_->Subscribe<rlmsg::stats_learner_t>(
+      channels::kStatsLearner, [&stats](const rlmsg::stats_learner_t& s) { stats.push_back(s); });
+  LearnerConfig c;
+  c.batch_size = 8;
+  c.max_updates = 5;
+  c.request_timeout = 0.05;
+  c.out_dir = dir_.string();
+  Learner learner(c, bus_.get());
+  learner.Run();
+  bus_->Handle(0);
+  EXPECT_EQ(learner.batches_refused(), 3);
+  EXPECT_EQ(learner.updates(), 5);
+  ASSERT_FALSE(stats.empty());
+  EXPECT_EQ(stats.back().dropped_invalid, 3);
+}
+
+TEST(LearnerConfigTest, RefusesAlgorithmsThatDoNotFitTheEnv) {
+  BusConfig bc;
+  bc.url = bc.bulk_url = "memq://";
+  bc.sender = "learner";
+  Bus bus(bc);
+  LearnerConfig c;
+  c.algorithm = "td3";  // CartPole-v1 is discrete
+  c.out_dir = (fs::temp_directory_path() / "learner_config_test").string();
+  EXPECT_THROW(Learner(c, &bus), std::invalid_argument);
+  c.algorithm = "dqn";
+  c.env_id = "Pendulum-v1";  // continuous
+  EXPECT_THROW(Learner(c, &bus), std::invalid_argument);
+  c.algorithm = "sac";
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
 }
 
 }  // namespace

@@ -52,7 +52,7 @@ struct OwnedPixelBatch {
   std::vector<int64_t> frame_id;
   std::vector<uint8_t> frames;
   std::vector<int64_t> obs_frames, next_obs_frames, episode_id;
-  std::vector<int32_t> action;
+  std::vector<float> action;
   std::vector<float> reward, discount, priority;
 
   PixelBatchView view() const {
@@ -63,14 +63,10 @@ struct OwnedPixelBatch {
             static_cast<int>(frame_id.size()),
             frame_id,
             frames,
-            static_cast<int>(action.size()),
+            static_cast<int>(reward.size()),
             obs_frames,
             next_obs_frames,
-            action,
-            reward,
-            discount,
-            episode_id,
-            priority};
+            ColumnsView{1, action, reward, discount, episode_id, priority}};
   }
   void AddFrame(int64_t id) {
     frame_id.push_back(id);
@@ -84,7 +80,7 @@ struct OwnedPixelBatch {
 struct Expected {
   int64_t key = 0;
   std::vector<int64_t> obs, next_obs;
-  int32_t action = 0;
+  float action = 0;
   float reward = 0.0f;
   float discount = 0.0f;
 };
@@ -121,7 +117,7 @@ class FakeActor {
     const Expected e{key_,
                      current_,
                      next,
-                     static_cast<int32_t>(f % 4),
+                     static_cast<float>(f % 4),
                      0.5f * static_cast<float>(f),
                      terminal ? 0.0f : 0.99f};
     AddTransition(b, e, priority);
@@ -551,15 +547,21 @@ TEST(PixelTableTest, RefusesBadBatchesAndStoresNoneOfThem) {
   v.obs_frames = v.obs_frames.first(2);
   refused(v, "obs_frames short");
   v = next.view();
-  v.reward = {};
+  v.columns.reward = {};
   refused(v, "reward short");
   v = next.view();
-  v.priority = v.priority.first(0);
-  v.discount = v.discount.first(0);
+  v.columns.priority = v.columns.priority.first(0);
+  v.columns.discount = v.columns.discount.first(0);
   refused(v, "discount short");
   v = next.view();
-  v.episode_id = std::span<const int64_t>(v.obs_frames);
+  v.columns.episode_id = std::span<const int64_t>(v.obs_frames);
   refused(v, "episode_id neither empty nor count");
+  v = next.view();
+  v.columns.action = {};
+  refused(v, "action short");
+  v = next.view();
+  v.columns.action_width = 2;
+  refused(v, "action width 2 with one value each");
   v = next.view();
   v.actor_id = -1;
   refused(v, "actor -1");
@@ -573,8 +575,8 @@ TEST(PixelTableTest, RefusesBadBatchesAndStoresNoneOfThem) {
 
   // The good batch still goes in, with episode ids and priorities left out.
   v = next.view();
-  v.episode_id = {};
-  v.priority = {};
+  v.columns.episode_id = {};
+  v.columns.priority = {};
   EXPECT_EQ(table.Insert(v), nullptr);
   EXPECT_EQ(table.size(), 2);
 }

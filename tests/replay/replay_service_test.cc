@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -46,12 +47,14 @@ rlmsg::transition_batch_t MakeBatch(int first, int count, int obs_size) {
   m.obs_size = obs_size;
   m.count = count;
   m.num_values = count * obs_size;
+  m.action_width = 1;
+  m.num_action_values = count;
   for (int v = first; v < first + count; ++v) {
     for (int j = 0; j < obs_size; ++j) {
       m.obs.push_back(static_cast<float>(v) + 0.5f * static_cast<float>(j));
       m.next_obs.push_back(static_cast<float>(v) + 0.5f * static_cast<float>(j) + 1000.0f);
     }
-    m.action.push_back(v % 2);
+    m.action.push_back(static_cast<float>(v % 2));
     m.reward.push_back(static_cast<float>(v) / 4.0f);
     m.discount.push_back(0.99f);
     m.episode_id.push_back(0);
@@ -170,7 +173,7 @@ TEST_F(ReplayServiceTest, HoldsARequestUntilMinSizeThenAnswersIt) {
       EXPECT_EQ(r.obs[i * 4 + j], v + 0.5f * static_cast<float>(j));
       EXPECT_EQ(r.next_obs[i * 4 + j], v + 0.5f * static_cast<float>(j) + 1000.0f);
     }
-    EXPECT_EQ(r.action[i], static_cast<int>(v) % 2);
+    EXPECT_EQ(r.action[i], static_cast<float>(static_cast<int>(v) % 2));
     EXPECT_EQ(r.reward[i], v / 4.0f);
     EXPECT_EQ(r.discount[i], 0.99f);
     EXPECT_EQ(r.index[i], static_cast<int64_t>(v));
@@ -364,8 +367,10 @@ TEST_F(ReplayServiceTest, TickPublishesFlowAndStatsAtTheirRates) {
 // Pixel transitions of one actor: frames 0 .. count (2 x 2 bytes, every byte of frame f equal
 // to f), transition t with stack 2 naming frames {t - 1, t} (frame 0 repeated for t = 0) and
 // next stack {t, t + 1}, action t % 3.
-rlmsg::pixel_batch_t MakePixelBatch(int count) {
-  rlmsg::pixel_batch_t m{};
+rlmsg::transition_batch_t MakePixelBatch(int count) {
+  rlmsg::transition_batch_t m{};
+  m.action_width = 1;
+  m.num_action_values = count;
   m.height = 2;
   m.width = 2;
   m.stack = 2;
@@ -380,7 +385,7 @@ rlmsg::pixel_batch_t MakePixelBatch(int count) {
   for (int t = 0; t < count; ++t) {
     m.obs_frames.insert(m.obs_frames.end(), {std::max(t - 1, 0), t});
     m.next_obs_frames.insert(m.next_obs_frames.end(), {t, t + 1});
-    m.action.push_back(t % 3);
+    m.action.push_back(static_cast<float>(t % 3));
     m.reward.push_back(static_cast<float>(t));
     m.discount.push_back(0.99f);
     m.episode_id.push_back(0);
@@ -390,30 +395,29 @@ rlmsg::pixel_batch_t MakePixelBatch(int count) {
 }
 
 TEST_F(ReplayServiceTest, StoresPixelTransitionsAndAnswersWithRebuiltStacks) {
-  std::vector<rlmsg::pixel_sample_batch_t> replies;
-  bus_.Subscribe<rlmsg::pixel_sample_batch_t>(
-      channels::kPixelSamples,
-      [&replies](const rlmsg::pixel_sample_batch_t& m) { replies.push_back(m); }, Port::kBulk);
+  const std::vector<rlmsg::sample_batch_t>& replies = replies_;
   Start(Options(8, 10, 200));
-  PublishAs(channels::kPixelTransitions, MakePixelBatch(20), "actor-0");
+  PublishAs(channels::kTransitions, MakePixelBatch(20), "actor-0");
   SendRequest(1, 16);
   Pump();
   EXPECT_EQ(service_->size(), 20);
   ASSERT_EQ(replies.size(), 1U);
-  const rlmsg::pixel_sample_batch_t& r = replies[0];
+  const rlmsg::sample_batch_t& r = replies[0];
   EXPECT_EQ(r.request_id, 1);
   EXPECT_EQ(r.count, 16);
   EXPECT_EQ(r.stack, 2);
+  EXPECT_EQ(r.obs_size, 0);
+  EXPECT_TRUE(r.obs.empty());
   EXPECT_EQ(r.num_bytes, 16 * 8);
   for (int i = 0; i < r.count; ++i) {
     // The reward tells which transition was drawn; its stacks hold the frames it named.
     const int t = static_cast<int>(r.reward[static_cast<size_t>(i)]);
-    EXPECT_EQ(r.action[static_cast<size_t>(i)], t % 3);
+    EXPECT_EQ(r.action[static_cast<size_t>(i)], static_cast<float>(t % 3));
     for (int b = 0; b < 4; ++b) {
-      EXPECT_EQ(r.obs[static_cast<size_t>(8 * i + b)], std::max(t - 1, 0));
-      EXPECT_EQ(r.obs[static_cast<size_t>(8 * i + 4 + b)], t);
-      EXPECT_EQ(r.next_obs[static_cast<size_t>(8 * i + b)], t);
-      EXPECT_EQ(r.next_obs[static_cast<size_t>(8 * i + 4 + b)], t + 1);
+      EXPECT_EQ(r.obs_pixels[static_cast<size_t>(8 * i + b)], std::max(t - 1, 0));
+      EXPECT_EQ(r.obs_pixels[static_cast<size_t>(8 * i + 4 + b)], t);
+      EXPECT_EQ(r.next_obs_pixels[static_cast<size_t>(8 * i + b)], t);
+      EXPECT_EQ(r.next_obs_pixels[static_cast<size_t>(8 * i + 4 + b)], t + 1);
     }
     EXPECT_EQ(r.weight[static_cast<size_t>(i)], 1.0f);  // uniform sampling
   }
@@ -422,6 +426,50 @@ TEST_F(ReplayServiceTest, StoresPixelTransitionsAndAnswersWithRebuiltStacks) {
   Pump();
   EXPECT_EQ(service_->counters().batches_refused, 1);
   EXPECT_EQ(service_->size(), 20);
+}
+
+// Continuous actions: three floats per transition go in and come back whole; a batch of another
+// width, or with an action the env's check refuses, is refused and counted, and nothing of it
+// is stored.
+TEST_F(ReplayServiceTest, StoresActionVectorsAndRefusesBatchesWithBadActions) {
+  ReplayServiceOptions o = Options(0, 1, 1000);
+  o.table.action_width = 3;
+  o.check_action = [](std::span<const float> a) -> const char* {
+    return a[1] < 0.0f || a[1] > 1.0f ? "gas outside [0, 1]" : nullptr;
+  };
+  Start(o);
+  auto batch = [](int first, int count, float gas) {
+    rlmsg::transition_batch_t m = MakeBatch(first, count, 4);
+    m.action_width = 3;
+    m.num_action_values = 3 * count;
+    m.action.clear();
+    for (int v = first; v < first + count; ++v) {
+      m.action.insert(m.action.end(), {-static_cast<float>(v) / 100, gas, 0.25f});
+    }
+    return m;
+  };
+  PublishAs(channels::kTransitions, batch(0, 10, 0.5f), "actor-0");
+  PublishAs(channels::kTransitions, batch(10, 5, 1.5f), "actor-0");  // one bad value: all refused
+  SendTransitions(20, 5);                                            // width 1
+  Pump();
+  EXPECT_EQ(service_->size(), 10);
+  EXPECT_EQ(service_->counters().batches_refused, 2);
+  SendRequest(1, 32);
+  Pump();
+  ASSERT_EQ(replies_.size(), 1U);
+  const rlmsg::sample_batch_t& r = replies_[0];
+  EXPECT_EQ(r.action_width, 3);
+  ASSERT_EQ(r.action.size(), 96U);
+  for (size_t i = 0; i < 32; ++i) {
+    const float v = r.obs[i * 4];
+    EXPECT_EQ(r.action[3 * i], -v / 100);
+    EXPECT_EQ(r.action[3 * i + 1], 0.5f);
+    EXPECT_EQ(r.action[3 * i + 2], 0.25f);
+  }
+  service_->Tick(1.0);
+  bus_.Handle(0);
+  ASSERT_FALSE(stats_.empty());
+  EXPECT_GE(stats_.back().dropped_invalid, 2);
 }
 
 TEST_F(ReplayServiceTest, PrioritizedSamplingFollowsThePrioritiesTheLearnerSends) {

@@ -23,12 +23,14 @@ namespace {
 struct OwnedBatch {
   int obs_size = 0;
   int count = 0;
+  int action_width = 1;
   std::vector<float> obs, next_obs, reward, discount, priority;
-  std::vector<int32_t> action;
+  std::vector<float> action;
   std::vector<int64_t> episode_id;
 
   TransitionBatchView view() const {
-    return {obs_size, count, obs, next_obs, action, reward, discount, episode_id, priority};
+    return {obs_size, count, obs, next_obs,
+            ColumnsView{action_width, action, reward, discount, episode_id, priority}};
   }
 };
 
@@ -41,7 +43,7 @@ OwnedBatch MakeBatch(int first, int count, int obs_size) {
       b.obs.push_back(static_cast<float>(v) + 0.25f * static_cast<float>(j));
       b.next_obs.push_back(static_cast<float>(v) + 0.25f * static_cast<float>(j) + 100.0f);
     }
-    b.action.push_back(v % 3);
+    b.action.push_back(static_cast<float>(v % 3));
     b.reward.push_back(2.0f * static_cast<float>(v));
     b.discount.push_back(v % 2 == 1 ? 0.5f : 1.0f);
     b.episode_id.push_back(v / 10);
@@ -364,12 +366,48 @@ TEST(ReplayTableTest, UpdatePrioritiesOfSampledTransitionsSteersTheSampler) {
 }
 
 TEST(ReplayTableTest, ReportsItsMemory) {
-  // Per slot: 2 * 4 floats of observations, 28 bytes of other fields, 16 of uniform sampler.
-  ReplayTable table(Options(1000, 4));
-  EXPECT_EQ(table.memory_bytes(), 1000 * (32 + 28 + 16));
+  // Per slot: 2 * 4 floats of observations, 4 bytes per action float, 24 of other fields, 16 of
+  // uniform sampler; allocated once the action width is known.
+  ReplayTableOptions options = Options(1000, 4);
+  options.action_width = 1;
+  ReplayTable table(options);
+  EXPECT_EQ(table.memory_bytes(), 1000 * (32 + 4 + 24 + 16));
   // With a prioritized sampler: its tree of 2 * 1024 nodes of two doubles instead.
-  ReplayTable prioritized(Options(1000, 4), std::make_unique<PrioritizedSampler>(1000, 0.6));
-  EXPECT_EQ(prioritized.memory_bytes(), 1000 * (32 + 28) + 32 * 1024);
+  ReplayTable prioritized(options, std::make_unique<PrioritizedSampler>(1000, 0.6));
+  EXPECT_EQ(prioritized.memory_bytes(), 1000 * (32 + 4 + 24) + 32 * 1024);
+  // Three action floats: 8 more bytes a slot.
+  options.action_width = 3;
+  ReplayTable wide(options);
+  EXPECT_EQ(wide.memory_bytes(), 1000 * (32 + 12 + 24 + 16));
+}
+
+// Actions are stored as action_width floats, whatever the width; a batch of another width than
+// the table's is refused whole.
+TEST(ReplayTableTest, StoresActionVectorsOfTheTablesWidth) {
+  ReplayTable table(Options(100, 2));
+  OwnedBatch b = MakeBatch(0, 5, 2);
+  b.action_width = 3;
+  b.action.clear();
+  for (int v = 0; v < 5; ++v) {
+    b.action.insert(b.action.end(), {static_cast<float>(v), -0.5f, 0.125f * static_cast<float>(v)});
+  }
+  ASSERT_EQ(table.Insert(b.view()), nullptr);
+  EXPECT_EQ(table.action_width(), 3);
+  OwnedBatch narrow = MakeBatch(5, 2, 2);
+  EXPECT_STREQ(table.Insert(narrow.view()), "action_width differs from the table's");
+  b.action.pop_back();
+  EXPECT_STREQ(table.Insert(b.view()), "action size is not count * action_width");
+  EXPECT_EQ(table.size(), 5);
+  std::mt19937_64 rng(3);
+  SampleBatch s;
+  s.Resize(20, 2, 3);
+  ASSERT_TRUE(table.Sample(20, &rng, s.spans()));
+  for (size_t i = 0; i < 20; ++i) {
+    const float v = s.obs[2 * i];
+    EXPECT_EQ(s.action[3 * i], v);
+    EXPECT_EQ(s.action[3 * i + 1], -0.5f);
+    EXPECT_EQ(s.action[3 * i + 2], 0.125f * v);
+  }
 }
 
 TEST(ReplayTableDeathTest, AbortsWhenTheOutputHasTheWrongSize) {

@@ -86,8 +86,8 @@ TEST(LunarLanderTest, DiscreteAndContinuousSpecsMatchTheV3Registrations) {
   EXPECT_EQ(continuous.spec().observation_size, 8);
   EXPECT_EQ(continuous.spec().num_actions, 0);
   EXPECT_EQ(continuous.spec().action_dim, 2);
-  EXPECT_EQ(continuous.spec().action_low, -1.0f);
-  EXPECT_EQ(continuous.spec().action_high, 1.0f);
+  EXPECT_EQ(continuous.spec().action_low, (std::vector<float>{-1.0f, -1.0f}));
+  EXPECT_EQ(continuous.spec().action_high, (std::vector<float>{1.0f, 1.0f}));
   EXPECT_EQ(continuous.spec().max_episode_steps, 1000);
   EXPECT_EQ(continuous.spec().reward_threshold, 200.0);
 }

@@ -202,12 +202,8 @@ TEST(ActionRepeatTest, RenderForwardsToTheWrappedEnv) {
   EXPECT_EQ(height, 2);
 }
 
-TEST(ActionRepeatTest, RejectsNullContinuousAndBadConfigs) {
+TEST(ActionRepeatTest, RejectsNullAndBadConfigs) {
   EXPECT_THROW(ActionRepeat(nullptr, Skip(1)), std::invalid_argument);
-  auto continuous = MakeScripted();
-  continuous->mutable_spec().num_actions = 0;
-  continuous->mutable_spec().action_dim = 2;
-  EXPECT_THROW(ActionRepeat(std::move(continuous), Skip(1)), std::invalid_argument);
   EXPECT_THROW(ActionRepeat(MakeScripted(), Skip(0)), std::invalid_argument);
 }
 

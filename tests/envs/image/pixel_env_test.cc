@@ -175,13 +175,8 @@ TEST(MakePixelEnvTest, RenderForwardsToTheInnerEnv) {
   EXPECT_EQ(rgb, GrayRgb({0, 51}));
 }
 
-TEST(MakePixelEnvTest, RejectsNullContinuousEnvsAndBadConfigs) {
+TEST(MakePixelEnvTest, RejectsNullEnvsAndBadConfigs) {
   EXPECT_THROW(MakePixelEnv(nullptr, {}), std::invalid_argument);
-  auto continuous = MakeScripted();
-  continuous->mutable_spec().num_actions = 0;
-  continuous->mutable_spec().action_dim = 2;
-  EXPECT_THROW(MakePixelEnv(std::move(continuous), {}), std::invalid_argument);
-  EXPECT_THROW(MakePixelEnv(MakeEnv("LunarLanderContinuous-v3"), {}), std::invalid_argument);
   ImagePipelineConfig config;
   config.stack = 0;
   EXPECT_THROW(MakePixelEnv(MakeScripted(), config), std::invalid_argument);
@@ -190,6 +185,28 @@ TEST(MakePixelEnvTest, RejectsNullContinuousEnvsAndBadConfigs) {
   config.crop_top = 1;
   config.crop_bottom = 1;
   EXPECT_THROW(MakePixelEnv(MakeScripted(), config), std::invalid_argument);
+}
+
+// A continuous env goes through the whole pipeline: its actions reach it through every wrapper,
+// repeated, and the frames are those of the states they lead to.
+TEST(MakePixelEnvTest, ContinuousEnvsStepThroughEveryWrapper) {
+  ImagePipelineConfig config;
+  config.frame_skip = 2;
+  config.width = config.height = 24;
+  config.stack = 2;
+  auto pixel = MakePixelEnv(MakeEnv("LunarLanderContinuous-v3"), config);
+  auto plain = MakeEnv("LunarLanderContinuous-v3");
+  EXPECT_TRUE(pixel->spec().continuous());
+  EXPECT_EQ(pixel->spec().action_dim, 2);
+  EXPECT_EQ(pixel->spec().max_episode_steps, 500);
+  pixel->Reset(5);
+  plain->Reset(5);
+  const float action[] = {1.0f, -0.7f};
+  double plain_reward = 0;
+  for (int k = 0; k < 2; ++k) plain_reward += plain->StepContinuous(action).reward;
+  const StepResult r = pixel->Act(action);
+  EXPECT_DOUBLE_EQ(r.reward, plain_reward);
+  EXPECT_THROW(pixel->Step(0), std::logic_error);
 }
 
 // The pixels of a grayscale frame of `width` columns that are 255, as (x, y); all others must be 0.

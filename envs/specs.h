@@ -1,0 +1,35 @@
+// Static env specs: what every registered env id is (sizes, action space, time limit, goal),
+// known without building the env, so that processes that need only sizes (the learner, the
+// replay) link no physics or rendering library. This file is the one source of these numbers:
+// each env class takes its spec from here.
+#pragma once
+
+#include <string>
+
+#include "envs/env.h"
+
+namespace rl::envs {
+
+struct ImagePipelineConfig;
+
+EnvSpec CartPoleSpec();
+EnvSpec CatchSpec();
+/// Pendulum-v1 (environments.md 4b); goal -200 (Gymnasium registers none; the usual bar).
+EnvSpec PendulumSpec();
+EnvSpec LunarLanderSpec(bool continuous);
+/// CarRacing-v3 (continuous: steer [-1, 1], gas [0, 1], brake [0, 1]) or its discrete variant
+/// "CarRacingDiscrete-v3" (5 actions); observation 96 x 96 x 3 RGB / 255; native render 96 x 96.
+EnvSpec CarRacingSpec(bool continuous);
+/// The KUKA grasping envs: training objects (15 steps) or held-out test objects (20 steps).
+EnvSpec KukaDiverseObjectSpec(bool is_test, int max_steps, int width, int height);
+
+/// The spec of `inner` behind the image pipeline `config` (as MakePixelEnv builds it): frame
+/// size from the render size, crops and output size; max_episode_steps divided by frame_skip,
+/// rounded up. Throws std::invalid_argument when the crops leave no pixel.
+EnvSpec PixelSpec(const EnvSpec& inner, const ImagePipelineConfig& config);
+
+/// The spec MakeEnv(id)->spec() has, time limit included, without building anything. Throws
+/// std::invalid_argument as MakeEnv does for an unknown id or a bad pixels setting.
+EnvSpec LookupSpec(const std::string& id);
+
+}  // namespace rl::envs

@@ -1,0 +1,57 @@
+// The algorithm seam of the learner: DQN (discrete actions) and TD3 (continuous actions) share
+// everything but the update. The learner decodes each sampled batch once (batch_decoder.h:
+// observations as network inputs, pixels divided by 255 and randomly shifted when asked) and hands
+// it to the Algorithm; what it broadcasts to actors and checkpoints is the algorithm's policy
+// network (the Q-network for DQN, the actor for TD3).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "nn/sequential.h"
+#include "nn/tensor.h"
+
+namespace rl::learner {
+
+/// A decoded batch of `count` transitions: obs and next_obs are network inputs (observation size
+/// x count, one transition per column); action holds count * action_width floats (transition i
+/// at [i * action_width, (i + 1) * action_width); a discrete action is its index); reward,
+/// discount (gamma^k, or 0 after a termination) and weight (importance weights) count values each.
+struct Batch {
+  int count = 0;
+  int action_width = 0;
+  const nn::Matrix* obs = nullptr;
+  const nn::Matrix* next_obs = nullptr;
+  std::span<const float> action;
+  std::span<const float> reward;
+  std::span<const float> discount;
+  std::span<const float> weight;  // empty: all ones
+};
+
+struct UpdateResult {
+  float loss = 0;    // mean (weighted) loss of the batch (TD3: the critics')
+  float mean_q = 0;  // mean Q of the batch's actions
+  float grad_norm = 0;
+};
+
+class Algorithm {
+ public:
+  virtual ~Algorithm() = default;
+
+  /// One update on the batch. Throws std::invalid_argument on a batch that does not fit the
+  /// networks (observation size, action width, a discrete action that is not an index in range);
+  /// the networks are unchanged then.
+  virtual UpdateResult Update(const Batch& batch) = 0;
+  /// |TD error| of each transition of the last Update (the replay's new priorities).
+  virtual const std::vector<float>& last_td_errors() const = 0;
+  /// The network actors act with and the evaluator scores.
+  virtual nn::Sequential& policy() = 0;
+  /// Updates so far.
+  virtual int64_t updates() const = 0;
+  /// A short description for the learner's ready line.
+  virtual std::string Describe() const = 0;
+};
+
+}  // namespace rl::learner

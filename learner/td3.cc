@@ -1,0 +1,221 @@
+#include "learner/td3.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "nn/losses.h"
+#include "nn/presets.h"
+
+namespace rl::learner {
+namespace {
+
+std::string Widths(const std::vector<int>& hidden) {
+  std::string s;
+  for (int h : hidden) {
+    if (!s.empty()) s += '-';
+    s += std::to_string(h);
+  }
+  return s;
+}
+
+void CheckContinuous(const envs::EnvSpec& spec) {
+  if (!spec.continuous()) {
+    throw std::invalid_argument(spec.id +
+                                " has discrete actions; TD3 needs continuous ones (use "
+                                "algorithm = dqn)");
+  }
+}
+
+}  // namespace
+
+void Td3Config::Validate() const {
+  if (network != "mlp" && network != "car") {
+    throw std::invalid_argument("td3 network must be mlp or car, not '" + network + "'");
+  }
+  if (hidden.empty()) throw std::invalid_argument("hidden: at least one hidden layer");
+  for (int h : hidden) {
+    if (h < 1) throw std::invalid_argument("hidden: widths must be >= 1");
+  }
+  if (!(actor_learning_rate > 0)) throw std::invalid_argument("actor-learning-rate must be > 0");
+  if (!(critic_learning_rate > 0)) throw std::invalid_argument("critic-learning-rate must be > 0");
+  if (!(adam_eps >= 0)) throw std::invalid_argument("adam-eps must be >= 0");
+  if (!(tau > 0 && tau <= 1)) throw std::invalid_argument("tau must be in (0, 1]");
+  if (policy_delay < 1) throw std::invalid_argument("policy-delay must be >= 1");
+  if (!(target_noise >= 0 && std::isfinite(target_noise))) {
+    throw std::invalid_argument("target-noise must be >= 0");
+  }
+  if (!(target_noise_clip >= 0 && std::isfinite(target_noise_clip))) {
+    throw std::invalid_argument("target-noise-clip must be >= 0");
+  }
+  if (!(max_grad_norm >= 0)) throw std::invalid_argument("max-grad-norm must be >= 0");
+}
+
+std::string Td3ActorArchitecture(const Td3Config& config, const envs::EnvSpec& spec) {
+  CheckContinuous(spec);
+  if (config.network == "car") {
+    if (spec.observation_size != 4 * 84 * 84) {
+      throw std::invalid_argument("td3 network 'car' takes 4 x 84 x 84 observations; " + spec.id +
+                                  " has " + std::to_string(spec.observation_size) + " values");
+    }
+    return nn::Td3CarActorArchitecture(spec.action_low, spec.action_high);
+  }
+  return nn::Td3MlpActorArchitecture(spec.observation_size, config.hidden, spec.action_low,
+                                     spec.action_high);
+}
+
+std::string Td3CriticArchitecture(const Td3Config& config, const envs::EnvSpec& spec) {
+  CheckContinuous(spec);
+  if (config.network == "car") {
+    if (spec.observation_size != 4 * 84 * 84 || spec.action_dim != 3) {
+      throw std::invalid_argument(
+          "td3 network 'car' takes 4 x 84 x 84 observations and 3-d "
+          "actions");
+    }
+    return nn::Td3CarCriticArchitecture();
+  }
+  return nn::Td3MlpCriticArchitecture(spec.observation_size, spec.action_dim, config.hidden);
+}
+
+namespace {
+
+nn::Sequential BuildActor(const Td3Config& config, const envs::EnvSpec& spec, std::mt19937* rng) {
+  config.Validate();
+  return nn::BuildFromArchitecture(Td3ActorArchitecture(config, spec), rng);
+}
+
+nn::ActionValueNet BuildCritic(const Td3Config& config, const envs::EnvSpec& spec,
+                               std::mt19937* rng) {
+  return nn::BuildActionValueNet(Td3CriticArchitecture(config, spec), spec.observation_size,
+                                 spec.action_dim, rng);
+}
+
+std::mt19937 InitRng(uint64_t seed) { return std::mt19937(static_cast<uint32_t>(seed)); }
+
+}  // namespace
+
+Td3::Td3(const envs::EnvSpec& spec, Td3Config config)
+    : spec_(spec), config_(std::move(config)), action_dim_(spec.action_dim) {
+  std::mt19937 rng = InitRng(config_.seed);
+  actor_ = BuildActor(config_, spec_, &rng);
+  q1_ = BuildCritic(config_, spec_, &rng);
+  q2_ = BuildCritic(config_, spec_, &rng);
+  actor_target_ = actor_;
+  q1_target_ = q1_;
+  q2_target_ = q2_;
+  actor_target_.set_training(false);
+  q1_target_.set_training(false);
+  q2_target_.set_training(false);
+  actor_params_ = actor_.Params();
+  critic_params_ = q1_.Params();
+  const std::vector<nn::Param> q2_params = q2_.Params();
+  critic_params_.insert(critic_params_.end(), q2_params.begin(), q2_params.end());
+  actor_optimizer_ = std::make_unique<nn::Adam>(actor_params_, config_.actor_learning_rate, 0.9f,
+                                                0.999f, config_.adam_eps);
+  critic_optimizer_ = std::make_unique<nn::Adam>(critic_params_, config_.critic_learning_rate, 0.9f,
+                                                 0.999f, config_.adam_eps);
+  noise_rng_.seed(config_.seed + 1);
+}
+
+std::string Td3::Describe() const {
+  std::string d = "TD3, " + config_.network;
+  if (config_.network == "mlp") d += ' ' + Widths(config_.hidden);
+  d += ", actor ";
+  d += actor_.Architecture();
+  return d;
+}
+
+void Td3::TargetActions(const nn::Matrix& next_obs) {
+  next_action_ = actor_target_.Forward(next_obs);
+  for (Eigen::Index i = 0; i < next_action_.cols(); ++i) {
+    for (int d = 0; d < action_dim_; ++d) {
+      const auto k = static_cast<size_t>(d);
+      const float half = (spec_.action_high[k] - spec_.action_low[k]) / 2;
+      const float clip = config_.target_noise_clip * half;
+      float noise = 0;
+      if (config_.target_noise > 0) {
+        noise = std::clamp(config_.target_noise * half * normal_(noise_rng_), -clip, clip);
+      }
+      next_action_(d, i) =
+          std::clamp(next_action_(d, i) + noise, spec_.action_low[k], spec_.action_high[k]);
+    }
+  }
+}
+
+UpdateResult Td3::Update(const Batch& b) {
+  const int n = b.count;
+  if (n < 1) throw std::invalid_argument("empty batch");
+  if (b.obs == nullptr || b.next_obs == nullptr || b.obs->rows() != spec_.observation_size ||
+      b.next_obs->rows() != spec_.observation_size || b.obs->cols() != n ||
+      b.next_obs->cols() != n) {
+    throw std::invalid_argument("batch observation size mismatch");
+  }
+  if (b.action_width != action_dim_ ||
+      static_cast<int64_t>(b.action.size()) != int64_t{n} * action_dim_) {
+    throw std::invalid_argument("batch action width " + std::to_string(b.action_width) +
+                                ", TD3 has " + std::to_string(action_dim_));
+  }
+  const nn::Matrix& obs = *b.obs;
+  const nn::Matrix& next_obs = *b.next_obs;
+  action_ = Eigen::Map<const nn::Matrix>(b.action.data(), action_dim_, n);
+  if (!action_.allFinite()) throw std::invalid_argument("action not finite");
+
+  // Targets: clipped double-Q at the smoothed target action.
+  TargetActions(next_obs);
+  const nn::Matrix& t1 = q1_target_.Forward(next_obs, next_action_);
+  y_ = t1.row(0).transpose();
+  const nn::Matrix& t2 = q2_target_.Forward(next_obs, next_action_);
+  for (int i = 0; i < n; ++i) {
+    const auto k = static_cast<size_t>(i);
+    y_[i] = b.reward[k] + b.discount[k] * std::min(y_[i], t2(0, i));
+  }
+
+  const nn::Vector* w = nullptr;
+  if (!b.weight.empty()) {
+    weights_ = Eigen::Map<const nn::Vector>(b.weight.data(), n);
+    w = &weights_;
+  }
+  // Critics: each regressed on y.
+  UpdateResult result;
+  q1_.ZeroGrad();
+  q2_.ZeroGrad();
+  q1_pred_ = q1_.Forward(obs, action_).row(0).transpose();
+  result.loss = nn::MseLoss(q1_pred_, y_, &loss_grad_, w);
+  grad_q_ = loss_grad_.transpose();
+  q1_.BackwardParams(grad_q_);
+  q2_pred_ = q2_.Forward(obs, action_).row(0).transpose();
+  result.loss += nn::MseLoss(q2_pred_, y_, &loss_grad_, w);
+  grad_q_ = loss_grad_.transpose();
+  q2_.BackwardParams(grad_q_);
+  if (config_.max_grad_norm > 0) {
+    result.grad_norm = nn::ClipGradNorm(critic_params_, config_.max_grad_norm);
+  }
+  critic_optimizer_->Step();
+  result.mean_q = q1_pred_.mean();
+  td_abs_.resize(static_cast<size_t>(n));
+  for (int i = 0; i < n; ++i) td_abs_[static_cast<size_t>(i)] = std::abs(y_[i] - q1_pred_[i]);
+  ++updates_;
+
+  if (updates_ % config_.policy_delay == 0) {
+    // Actor: ascend Q1(s, mu(s)); the critic's parameter gradients of this pass are discarded.
+    actor_.ZeroGrad();
+    const nn::Matrix& mu = actor_.Forward(obs);
+    q1_.Forward(obs, mu);
+    grad_q_.setConstant(1, n, -1.0f / static_cast<float>(n));
+    q1_.BackwardParams(grad_q_);  // computes dQ/da too
+    grad_actor_ = q1_.grad_action();
+    actor_.BackwardParams(grad_actor_);
+    if (config_.max_grad_norm > 0) nn::ClipGradNorm(actor_params_, config_.max_grad_norm);
+    actor_optimizer_->Step();
+    q1_.ZeroGrad();
+    ++actor_updates_;
+    // Targets follow slowly.
+    actor_target_.SoftUpdateFrom(actor_, config_.tau);
+    q1_target_.SoftUpdateFrom(q1_, config_.tau);
+    q2_target_.SoftUpdateFrom(q2_, config_.tau);
+  }
+  return result;
+}
+
+}  // namespace rl::learner

@@ -1,0 +1,102 @@
+// Td3: Twin Delayed DDPG (Fujimoto, van Hoof, Meger 2018) for continuous actions.
+//
+// A deterministic actor mu(s) (ending in the action bounds) and two critics Q1, Q2 (s, a) -> 1,
+// each with a Polyak-averaged target. Per update:
+//   a' = clip(mu_target(s') + clip(N(0, (target_noise * h)^2), -target_noise_clip * h,
+//                                  target_noise_clip * h), low, high),  h = (high - low) / 2
+//   y  = r + discount * min(Q1_target(s', a'), Q2_target(s', a'))       (clipped double-Q)
+//   critic loss = mean_i w_i (Q1(s_i, a_i) - y_i)^2 + mean_i w_i (Q2(s_i, a_i) - y_i)^2
+// and every policy_delay-th update also
+//   actor loss = -mean_i Q1(s_i, mu(s_i))     (its gradient through Q1's action input)
+//   targets    = tau * online + (1 - tau) * target, for the actor and both critics.
+// `discount` comes with the batch (gamma^k for n-step returns, 0 after a termination, gamma^k
+// after a time-limit truncation: truncations are bootstrapped), and w are the importance weights
+// of prioritized replay (1 for uniform). The critics and the actor have their own Adam optimizers
+// and learning rates. Knows nothing of LCM.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "envs/env.h"
+#include "learner/algorithm.h"
+#include "nn/action_value_net.h"
+#include "nn/optimizers.h"
+#include "nn/sequential.h"
+
+namespace rl::learner {
+
+struct Td3Config {
+  // The networks: "mlp" (actor obs -> hidden... -> action, critics [obs, action] -> hidden... ->
+  // 1; the author's 256-256) or "car" (the TD3 CarRacing article's networks on 4 x 84 x 84 stacks:
+  // a CNN encoder of its own in the actor and in each critic).
+  std::string network = "mlp";
+  std::vector<int> hidden = {256, 256};
+  float actor_learning_rate = 3e-4f;
+  float critic_learning_rate = 3e-4f;
+  float adam_eps = 1e-8f;
+  float tau = 0.005f;              // Polyak weight of the online networks
+  int policy_delay = 2;            // critic updates per actor and target update
+  float target_noise = 0.2f;       // target policy smoothing, relative to the half-range
+  float target_noise_clip = 0.5f;  // its clip, relative to the half-range
+  float max_grad_norm = 0.0f;      // global gradient-norm clip of each optimizer (0: none)
+  uint64_t seed = 0;               // initialisation and target-noise seed
+
+  // Throws std::invalid_argument naming the bad field.
+  void Validate() const;
+};
+
+/// The actor's architecture string for `spec` (nn::BuildFromArchitecture), and the critics'
+/// (nn::BuildActionValueNet). Throw std::invalid_argument when the network cannot take the env.
+std::string Td3ActorArchitecture(const Td3Config& config, const envs::EnvSpec& spec);
+std::string Td3CriticArchitecture(const Td3Config& config, const envs::EnvSpec& spec);
+
+class Td3 final : public Algorithm {
+ public:
+  /// Throws std::invalid_argument for a bad config or a discrete env.
+  Td3(const envs::EnvSpec& spec, Td3Config config);
+  Td3(const Td3&) = delete;
+  Td3& operator=(const Td3&) = delete;
+
+  UpdateResult Update(const Batch& batch) override;
+  const std::vector<float>& last_td_errors() const override { return td_abs_; }
+  nn::Sequential& policy() override { return actor_; }
+  int64_t updates() const override { return updates_; }
+  std::string Describe() const override;
+
+  /// Actor updates so far (one per policy_delay critic updates).
+  int64_t actor_updates() const { return actor_updates_; }
+  nn::Sequential& actor() { return actor_; }
+  const nn::Sequential& actor_target() const { return actor_target_; }
+  nn::ActionValueNet& critic(int i) { return i == 0 ? q1_ : q2_; }
+  const nn::ActionValueNet& critic_target(int i) const { return i == 0 ? q1_target_ : q2_target_; }
+  /// The targets y of the last Update.
+  const nn::Vector& last_targets() const { return y_; }
+  const Td3Config& config() const { return config_; }
+
+ private:
+  // Fills next_action_ with the smoothed target action for next_obs.
+  void TargetActions(const nn::Matrix& next_obs);
+
+  envs::EnvSpec spec_;
+  Td3Config config_;
+  int action_dim_;
+  nn::Sequential actor_, actor_target_;
+  nn::ActionValueNet q1_, q2_, q1_target_, q2_target_;
+  std::vector<nn::Param> actor_params_, critic_params_;
+  std::unique_ptr<nn::Adam> actor_optimizer_, critic_optimizer_;
+  std::mt19937_64 noise_rng_;
+  std::normal_distribution<float> normal_{0.0f, 1.0f};
+  int64_t updates_ = 0;
+  int64_t actor_updates_ = 0;
+
+  // Buffers reused by every update.
+  nn::Matrix action_, next_action_, grad_q_, grad_actor_;
+  nn::Vector y_, q1_pred_, q2_pred_, loss_grad_, weights_;
+  std::vector<float> td_abs_;
+};
+
+}  // namespace rl::learner

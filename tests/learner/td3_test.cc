@@ -1,0 +1,296 @@
+#include "learner/td3.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "envs/specs.h"
+
+namespace rl::learner {
+namespace {
+
+// A 2-d observation, 2-d action env spec with an asymmetric box (as CarRacing's gas).
+envs::EnvSpec SmallSpec() {
+  envs::EnvSpec spec = envs::PendulumSpec();
+  spec.id = "Small";
+  spec.observation_size = 2;
+  spec.action_dim = 2;
+  spec.action_low = {-1.0f, 0.0f};
+  spec.action_high = {1.0f, 1.0f};
+  return spec;
+}
+
+Td3Config SmallConfig() {
+  Td3Config c;
+  c.hidden = {8, 8};
+  c.target_noise = 0;  // deterministic targets unless a test turns it on
+  c.seed = 3;
+  return c;
+}
+
+// A batch of n random transitions of `spec`, owning its arrays.
+struct OwnedBatch {
+  nn::Matrix obs, next_obs;
+  std::vector<float> action, reward, discount, weight;
+  Batch view(int width) const {
+    Batch b;
+    b.count = static_cast<int>(reward.size());
+    b.action_width = width;
+    b.obs = &obs;
+    b.next_obs = &next_obs;
+    b.action = action;
+    b.reward = reward;
+    b.discount = discount;
+    b.weight = weight;
+    return b;
+  }
+};
+
+OwnedBatch RandomBatch(const envs::EnvSpec& spec, int n, std::mt19937* rng) {
+  std::normal_distribution<float> normal;
+  OwnedBatch b;
+  b.obs.resize(spec.observation_size, n);
+  b.next_obs.resize(spec.observation_size, n);
+  for (Eigen::Index i = 0; i < b.obs.size(); ++i) {
+    b.obs.data()[i] = normal(*rng);
+    b.next_obs.data()[i] = normal(*rng);
+  }
+  for (int i = 0; i < n; ++i) {
+    for (int d = 0; d < spec.action_dim; ++d) {
+      const auto k = static_cast<size_t>(d);
+      b.action.push_back(
+          std::uniform_real_distribution<float>(spec.action_low[k], spec.action_high[k])(*rng));
+    }
+    b.reward.push_back(normal(*rng));
+    // Terminal, bootstrapped one step, and bootstrapped after a 3-step return (or a truncation).
+    b.discount.push_back(i % 3 == 0 ? 0.0f : (i % 3 == 1 ? 0.99f : 0.99f * 0.99f * 0.99f));
+  }
+  return b;
+}
+
+std::vector<float> Flat(const nn::Sequential& net) {
+  std::vector<float> f;
+  net.GetFlat(&f);
+  return f;
+}
+std::vector<float> Flat(const nn::ActionValueNet& net) {
+  std::vector<float> f;
+  net.GetFlat(&f);
+  return f;
+}
+
+// y = r + discount * min(Q1'(s', a'), Q2'(s', a')) with a' = mu'(s') (no smoothing noise),
+// computed with copies of the target networks as they were before the update.
+TEST(Td3Test, TargetsAreTheClippedDoubleQOfTheTargetActorsAction) {
+  const envs::EnvSpec spec = SmallSpec();
+  Td3 td3(spec, SmallConfig());
+  std::mt19937 rng(1);
+  // Move the online networks away from the targets first, so that using the wrong ones shows.
+  for (int k = 0; k < 4; ++k) td3.Update(RandomBatch(spec, 16, &rng).view(2));
+  nn::Sequential actor_target = td3.actor_target();
+  nn::ActionValueNet q1 = td3.critic_target(0);
+  nn::ActionValueNet q2 = td3.critic_target(1);
+  const OwnedBatch b = RandomBatch(spec, 9, &rng);
+  td3.Update(b.view(2));
+  const nn::Matrix next_action = actor_target.Forward(b.next_obs);
+  const nn::Matrix v1 = q1.Forward(b.next_obs, next_action);
+  const nn::Matrix v2 = q2.Forward(b.next_obs, next_action);
+  ASSERT_EQ(td3.last_targets().size(), 9);
+  int differ = 0;
+  for (int i = 0; i < 9; ++i) {
+    const auto k = static_cast<size_t>(i);
+    const float expected = b.reward[k] + b.discount[k] * std::min(v1(0, i), v2(0, i));
+    EXPECT_NEAR(td3.last_targets()[i], expected, 1e-5f) << "transition " << i;
+    differ += v1(0, i) != v2(0, i);
+    if (b.discount[k] == 0) {
+      EXPECT_EQ(td3.last_targets()[i], b.reward[k]);
+    }
+  }
+  EXPECT_GT(differ, 0);  // the two target critics differ, so the min matters
+}
+
+TEST(Td3Test, TargetSmoothingNoiseIsClipped) {
+  const envs::EnvSpec spec = SmallSpec();
+  Td3Config off = SmallConfig();
+  Td3Config clipped = SmallConfig();
+  clipped.target_noise = 10;  // huge noise, clipped to nothing
+  clipped.target_noise_clip = 0;
+  Td3 a(spec, off), b(spec, clipped);
+  std::mt19937 rng(2);
+  const OwnedBatch batch = RandomBatch(spec, 8, &rng);
+  a.Update(batch.view(2));
+  b.Update(batch.view(2));
+  for (int i = 0; i < 8; ++i) EXPECT_EQ(a.last_targets()[i], b.last_targets()[i]);
+  // With a clip, the noise changes the targets, the same way for the same seed.
+  Td3Config noisy = SmallConfig();
+  noisy.target_noise = 0.2f;
+  noisy.target_noise_clip = 0.5f;
+  Td3 c(spec, noisy), d(spec, noisy);
+  c.Update(batch.view(2));
+  d.Update(batch.view(2));
+  EXPECT_NE(c.last_targets(), a.last_targets());
+  EXPECT_EQ(c.last_targets(), d.last_targets());
+}
+
+// The actor and the targets change on every policy_delay-th update only; the critics on every
+// update; the targets by Polyak averaging.
+TEST(Td3Test, DelaysActorAndTargetUpdatesAndAveragesTheTargets) {
+  const envs::EnvSpec spec = SmallSpec();
+  Td3Config c = SmallConfig();
+  c.policy_delay = 3;
+  c.tau = 0.1f;
+  Td3 td3(spec, c);
+  std::mt19937 rng(3);
+  for (int u = 1; u <= 6; ++u) {
+    const std::vector<float> actor = Flat(td3.actor());
+    const std::vector<float> critic = Flat(td3.critic(0));
+    const std::vector<float> actor_target = Flat(td3.actor_target());
+    const std::vector<float> critic_target = Flat(td3.critic_target(1));
+    td3.Update(RandomBatch(spec, 16, &rng).view(2));
+    EXPECT_EQ(td3.updates(), u);
+    EXPECT_NE(Flat(td3.critic(0)), critic) << "update " << u;
+    const bool delayed = u % 3 == 0;
+    EXPECT_EQ(td3.actor_updates(), u / 3);
+    EXPECT_EQ(Flat(td3.actor()) != actor, delayed) << "update " << u;
+    EXPECT_EQ(Flat(td3.actor_target()) != actor_target, delayed) << "update " << u;
+    if (!delayed) continue;
+    // target' = tau * online' + (1 - tau) * target, parameter by parameter.
+    const std::vector<float> online = Flat(td3.actor());
+    const std::vector<float> after = Flat(td3.actor_target());
+    for (size_t k = 0; k < after.size(); ++k) {
+      ASSERT_NEAR(after[k], 0.1f * online[k] + 0.9f * actor_target[k], 1e-6f) << k;
+    }
+    const std::vector<float> q2 = Flat(td3.critic(1));
+    const std::vector<float> q2_after = Flat(td3.critic_target(1));
+    for (size_t k = 0; k < q2_after.size(); ++k) {
+      ASSERT_NEAR(q2_after[k], 0.1f * q2[k] + 0.9f * critic_target[k], 1e-6f) << k;
+    }
+  }
+}
+
+// The actor's gradient: d(-mean_i Q1(s_i, mu(s_i)))/d(theta), through the critic's action input,
+// against central finite differences of that loss in the actor's parameters.
+TEST(Td3Test, TheActorsGradientThroughTheCriticMatchesFiniteDifferences) {
+  const envs::EnvSpec spec = SmallSpec();
+  Td3 td3(spec, SmallConfig());
+  std::mt19937 rng(4);
+  for (int k = 0; k < 3; ++k) td3.Update(RandomBatch(spec, 16, &rng).view(2));
+  const OwnedBatch b = RandomBatch(spec, 6, &rng);
+  nn::Sequential actor = td3.actor();
+  nn::ActionValueNet q1 = td3.critic(0);
+  const auto loss = [&]() {
+    const nn::Matrix mu = actor.Forward(b.obs);
+    return -static_cast<double>(q1.Forward(b.obs, mu).mean());
+  };
+  actor.ZeroGrad();
+  q1.ZeroGrad();
+  const nn::Matrix& mu = actor.Forward(b.obs);
+  q1.Forward(b.obs, mu);
+  nn::Matrix grad_q = nn::Matrix::Constant(1, 6, -1.0f / 6.0f);
+  q1.BackwardParams(grad_q);
+  const nn::Matrix grad_action = q1.grad_action();
+  actor.BackwardParams(grad_action);
+  int checked = 0;
+  for (nn::Param& p : actor.Params()) {
+    for (Eigen::Index k = 0; k < p.value->size(); k += 3) {
+      float& w = p.value->data()[k];
+      const float saved = w;
+      const float eps = 1e-2f;
+      w = saved + eps;
+      const double up = loss();
+      w = saved - eps;
+      const double down = loss();
+      w = saved;
+      const double numeric = (up - down) / (2 * eps);
+      const double analytic = p.grad->data()[k];
+      EXPECT_NEAR(analytic, numeric, 2e-3 + 2e-2 * std::abs(numeric)) << p.name << "[" << k << "]";
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 10);
+}
+
+// A one-step bandit: reward -(a - 0.3)^2, no bootstrapping. The critic learns the parabola and the
+// actor climbs it to a = 0.3.
+TEST(Td3Test, LearnsTheBestActionOfABandit) {
+  envs::EnvSpec spec = envs::PendulumSpec();
+  spec.observation_size = 1;
+  spec.action_low = {-1.0f};
+  spec.action_high = {1.0f};
+  Td3Config c;
+  c.hidden = {32, 32};
+  c.actor_learning_rate = 1e-3f;
+  c.critic_learning_rate = 1e-3f;
+  c.seed = 5;
+  Td3 td3(spec, c);
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  OwnedBatch b;
+  b.obs = nn::Matrix::Ones(1, 64);
+  b.next_obs = nn::Matrix::Ones(1, 64);
+  b.discount.assign(64, 0.0f);
+  for (int u = 0; u < 5000; ++u) {
+    b.action.clear();
+    b.reward.clear();
+    for (int i = 0; i < 64; ++i) {
+      const float a = uniform(rng);
+      b.action.push_back(a);
+      b.reward.push_back(-(a - 0.3f) * (a - 0.3f));
+    }
+    td3.Update(b.view(1));
+  }
+  const float one = 1.0f;
+  const float a = td3.actor().Predict(&one, 1)(0, 0);
+  EXPECT_NEAR(a, 0.3f, 0.05f);
+}
+
+TEST(Td3Test, RefusesDiscreteEnvsBatchesThatDoNotFitAndBadConfigs) {
+  EXPECT_THROW(Td3(envs::CartPoleSpec(), Td3Config{}), std::invalid_argument);
+  const envs::EnvSpec spec = SmallSpec();
+  Td3 td3(spec, SmallConfig());
+  std::mt19937 rng(7);
+  OwnedBatch b = RandomBatch(spec, 4, &rng);
+  EXPECT_THROW(td3.Update(b.view(1)), std::invalid_argument);  // width 1, the env has 2
+  b.action[3] = std::nanf("");
+  EXPECT_THROW(td3.Update(b.view(2)), std::invalid_argument);
+  EXPECT_EQ(td3.updates(), 0);
+  Td3Config c;
+  c.policy_delay = 0;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = Td3Config{};
+  c.tau = 0;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = Td3Config{};
+  c.network = "resnet";
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = Td3Config{};
+  c.network = "car";  // needs 4 x 84 x 84 observations
+  EXPECT_THROW(Td3(spec, c), std::invalid_argument);
+}
+
+TEST(Td3Test, BuildsTheArticlesCarRacingNetworks) {
+  envs::EnvSpec spec = envs::CarRacingSpec(true);
+  spec.observation_size = 4 * 84 * 84;
+  spec.frame_stack = 4;
+  spec.frame_height = spec.frame_width = 84;
+  Td3Config c;
+  c.network = "car";
+  Td3 td3(spec, c);
+  EXPECT_EQ(td3.actor().InputSize(), 4 * 84 * 84);
+  EXPECT_EQ(td3.actor().OutputSize(), 3);
+  EXPECT_NE(td3.actor().Architecture().find("bounded(3,-1,1,0,1,0,1)"), std::string::npos);
+  std::mt19937 rng(8);
+  OwnedBatch b = RandomBatch(spec, 4, &rng);
+  b.obs = b.obs.cwiseAbs().cwiseMin(1.0f);
+  b.next_obs = b.next_obs.cwiseAbs().cwiseMin(1.0f);
+  EXPECT_NO_THROW(td3.Update(b.view(3)));
+  EXPECT_NO_THROW(td3.Update(b.view(3)));
+  EXPECT_EQ(td3.actor_updates(), 1);
+}
+
+}  // namespace
+}  // namespace rl::learner
