@@ -149,8 +149,4 @@ ExplorationConfig EvaluationExploration(const envs::EnvSpec& spec, double epsilo
   return c;
 }
 
-int GreedyAction(nn::Sequential* q_network, std::span<const float> obs) {
-  return q_network->Argmax(obs.data(), static_cast<int>(obs.size()));
-}
-
 }  // namespace rl::actor

@@ -78,8 +78,4 @@ std::unique_ptr<Policy> MakePolicy(const envs::EnvSpec& spec, const ExplorationC
 /// and no random start for a continuous one.
 ExplorationConfig EvaluationExploration(const envs::EnvSpec& spec, double epsilon);
 
-/// The greedy action of a Q-network for one observation (the first largest output). No
-/// allocation after the first call.
-int GreedyAction(nn::Sequential* q_network, std::span<const float> obs);
-
 }  // namespace rl::actor

@@ -1,14 +1,17 @@
 // Pendulum: swing a pendulum up from any angle and hold it upright with a limited torque.
 //
 // Port of Gymnasium's Pendulum-v1 (environments.md section 4b), the usual first check of a
-// continuous-control learner. Internal state (theta, theta_dot) is double; theta 0 is upright,
-// positive counter-clockwise. The observation is [cos(theta), sin(theta), theta_dot] as float32.
-// The 200-step time limit is not part of this class: MakeEnv("Pendulum-v1") wraps it in TimeLimit.
+// continuous-control learner:
+// https://github.com/Farama-Foundation/Gymnasium/blob/main/gymnasium/envs/classic_control/pendulum.py
+// Internal state (theta, theta_dot) is double; theta 0 is upright, positive counter-clockwise. The
+// observation is [cos(theta), sin(theta), theta_dot] cast to float32. The 200-step time limit is
+// not part of this class: MakeEnv("Pendulum-v1") wraps it in TimeLimit.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <span>
 #include <vector>
@@ -17,73 +20,94 @@
 
 namespace rl::envs {
 
-/// Options of Pendulum; the defaults are Gymnasium's.
+/// Options of Pendulum. The defaults are those of Gymnasium's Pendulum-v1.
 struct PendulumConfig {
-  double g = 10.0;                   // gravity (the constructor argument of the reference)
-  double x_init = std::numbers::pi;  // theta starts uniform in [-x_init, x_init]
-  double y_init = 1.0;               // theta_dot starts uniform in [-y_init, y_init]
+  double g = 10.0;                   // Gravity (m/s^2), the reference's constructor argument.
+  double x_init = std::numbers::pi;  // theta starts uniform in [-x_init, x_init) (reset option).
+  double y_init = 1.0;  // theta_dot starts uniform in [-y_init, y_init) (reset option).
 
-  /// Throws std::invalid_argument unless g is finite and both bounds are finite and >= 0.
+  /// Throws std::invalid_argument unless g is finite and x_init, y_init are finite and >= 0.
   void Validate() const;
 };
 
-/// Pendulum-v1. One continuous action, the torque, clipped to [-2, 2]. The reward of a step is
-/// -(angle_normalize(theta)^2 + 0.1 theta_dot^2 + 0.001 u^2) of the state before the step; the
-/// episode never terminates. Copyable. Not thread-safe.
+/// Pendulum-v1. One continuous action, the torque u (N m), clipped to [-2, 2]. A step computes,
+/// from the state before it, cost = angle_normalize(theta)^2 + 0.1 theta_dot^2 + 0.001 u^2, then
+/// theta_dot += (3 g / (2 l) sin(theta) + 3 / (m l^2) u) dt clipped to [-8, 8], then theta +=
+/// theta_dot dt with the new velocity (semi-implicit), and returns reward -cost, which lies in
+/// [-16.2736044, 0]. theta itself is never wrapped. The episode never terminates or truncates.
+/// Copyable (the copy continues the same RNG stream). Not thread-safe.
 class Pendulum : public Env {
  public:
-  static constexpr double kMaxSpeed = 8.0;
-  static constexpr double kMaxTorque = 2.0;
-  static constexpr double kDt = 0.05;
-  static constexpr double kMass = 1.0;
-  static constexpr double kLength = 1.0;
+  // Physical constants (SI units), as in the reference.
+  static constexpr double kMaxSpeed = 8.0;   // rad/s
+  static constexpr double kMaxTorque = 2.0;  // N m
+  static constexpr double kDt = 0.05;        // Seconds per step.
+  static constexpr double kMass = 1.0;       // kg
+  static constexpr double kLength = 1.0;     // m
   // Native rendering size in pixels.
   static constexpr int kScreenSize = 500;
 
   /// Throws std::invalid_argument if config.Validate() fails.
   explicit Pendulum(const PendulumConfig& config = {});
 
+  /// PendulumSpec() (envs/specs.h): id "Pendulum-v1", observation_size 3, action_dim 1 in [-2, 2].
   const EnvSpec& spec() const override { return spec_; }
+  const PendulumConfig& config() const { return config_; }
 
-  /// Seeds the RNG (as every env: envs/rng.h) and draws theta, then theta_dot.
+  /// Seeds the RNG (SeedRng in rng.h) and draws theta, then theta_dot, each with one
+  /// UniformDouble. Forgets the last torque.
   void Reset(uint64_t seed) override;
+  /// Draws a new initial state from the continuing RNG stream (seeded from std::random_device if
+  /// no seeded Reset came before). Forgets the last torque.
   void Reset() override;
 
-  /// Discrete steps are refused: std::logic_error("continuous env").
+  /// Pendulum is continuous: always throws std::logic_error("continuous env").
   StepResult Step(int action) override;
-  /// One step with the torque action[0] (clipped to [-2, 2]). Throws std::invalid_argument for an
-  /// action of another size or a non-finite torque, std::logic_error before the first Reset.
+  /// One step with the torque action[0], clipped to [-2, 2] (so an infinite torque is the bound).
+  /// Throws std::invalid_argument for an action of another size or a NaN torque, and
+  /// std::logic_error before the first Reset (or SetState); the state is then unchanged.
   StepResult StepContinuous(std::span<const float> action) override;
 
   std::span<const float> observation() const override { return observation_; }
 
-  /// 500 x 500 RGB like the reference: white background, a rod of length 1 and width 0.2 (view
-  /// half-width 2.2) in (204, 77, 77) with round caps, a black axle, and the last torque shown as
-  /// an arc around the axle, its length proportional to |u| and its head in the torque's
-  /// direction (the reference draws an arrow image scaled by |u|).
+  /// 500 x 500 RGB like the reference's rgb_array: white background; a rod of length 1 and width
+  /// 0.2 (the view spans [-2.2, 2.2] world units) in (204, 77, 77) from the axle in the direction
+  /// theta + pi/2, with round caps; the last torque as a dark grey circular arrow around the axle,
+  /// its size proportional to |u| (1 world unit across at |u| = 2), counter-clockwise for u > 0
+  /// and clockwise for u < 0 (the reference blits an arrow image; this one is drawn); a black
+  /// axle of radius 0.05 on top. y is up. Throws std::logic_error before the first Reset.
   void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override;
-  /// The same drawing at any size (drawn at that size, not resampled).
+  /// Draws the same picture directly at width x height (geometry scaled per axis, not resampled).
+  /// Throws std::invalid_argument for a non-positive size, std::logic_error before the first Reset.
   void RenderSized(int width, int height, std::vector<uint8_t>* rgb) const override;
 
-  /// Sets the state (for tests and replays of recorded states).
+  /// Overwrites the physical state (and the observation), for tests and analysis. Leaves the last
+  /// torque unchanged; counts as a Reset for the Step precondition.
   void SetState(double theta, double theta_dot);
+  /// theta (rad, not wrapped) and theta_dot (rad/s).
   double theta() const { return theta_; }
   double theta_dot() const { return theta_dot_; }
-  /// ((x + pi) mod 2 pi) - pi with Python's modulo (the result of mod is in [0, 2 pi)).
+  /// The clipped torque of the last step, or nothing since the last Reset (shown by Render).
+  std::optional<double> last_u() const { return last_u_; }
+
+  /// ((x + pi) mod 2 pi) - pi with Python's modulo (the remainder takes the divisor's sign), so
+  /// the result is in [-pi, pi): pi maps to -pi.
   static double AngleNormalize(double x);
 
  private:
+  // Draws a new initial state from rng_ and starts a new episode.
+  void SampleInitialState();
+  // Refreshes observation_ from theta_ and theta_dot_.
   void UpdateObservation();
 
   EnvSpec spec_;
   PendulumConfig config_;
   std::mt19937_64 rng_;
   bool rng_seeded_ = false;
-  bool has_state_ = false;
+  bool has_state_ = false;  // Reset or SetState has been called.
   double theta_ = 0;
   double theta_dot_ = 0;
-  double last_u_ = 0;
-  bool has_last_u_ = false;
+  std::optional<double> last_u_;
   std::array<float, 3> observation_{};
 };
 
