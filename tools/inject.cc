@@ -21,6 +21,7 @@
 #include "common/clock.h"
 #include "common/options.h"
 #include "common/shutdown.h"
+#include "envs/specs.h"
 
 namespace {
 
@@ -46,16 +47,29 @@ struct Target {
   std::function<std::vector<uint8_t>(int64_t run_id)> invalid;
 };
 
-// A flat batch of one transition (CartPole-sized: 4 observations, one action index).
+// The run env's shapes (--env), so that an invalid message differs from a valid one only in
+// the field it breaks: a flat observation of the env's size and a valid action (index 0, or the
+// middle of every dimension's bounds).
+struct Shape {
+  int obs_size = 4;
+  std::vector<float> action = {0};
+};
+Shape& RunShape() {
+  static Shape shape;
+  return shape;
+}
+
+// A flat batch of one transition of the run env.
 rlmsg::transition_batch_t Transitions() {
+  const Shape& shape = RunShape();
   rlmsg::transition_batch_t m{};
   m.count = 1;
-  m.obs_size = 4;
-  m.num_values = 4;
-  m.obs = m.next_obs = {0, 0, 0, 0};
-  m.action_width = 1;
-  m.num_action_values = 1;
-  m.action = {0};
+  m.obs_size = shape.obs_size;
+  m.num_values = shape.obs_size;
+  m.obs = m.next_obs = std::vector<float>(static_cast<size_t>(shape.obs_size), 0.0f);
+  m.action_width = static_cast<int32_t>(shape.action.size());
+  m.num_action_values = m.action_width;
+  m.action = shape.action;
   m.reward = {1};
   m.discount = {0.99f};
   m.episode_id = {0};
@@ -83,15 +97,16 @@ rlmsg::transition_batch_t PixelTransitions() {
 }
 
 rlmsg::sample_batch_t Samples() {
+  const Shape& shape = RunShape();
   rlmsg::sample_batch_t m{};
   m.requester = "learner";
   m.count = 1;
-  m.obs_size = 4;
-  m.num_values = 4;
-  m.obs = m.next_obs = {0, 0, 0, 0};
-  m.action_width = 1;
-  m.num_action_values = 1;
-  m.action = {0};
+  m.obs_size = shape.obs_size;
+  m.num_values = shape.obs_size;
+  m.obs = m.next_obs = std::vector<float>(static_cast<size_t>(shape.obs_size), 0.0f);
+  m.action_width = static_cast<int32_t>(shape.action.size());
+  m.num_action_values = m.action_width;
+  m.action = shape.action;
   m.reward = {1};
   m.discount = {0.99f};
   m.index = {0};
@@ -160,7 +175,7 @@ std::vector<Target> Targets() {
                [](int64_t r) { return Encode(Samples(), r); },
                [nan](int64_t r) {
                  auto m = Samples();
-                 m.obs[2] = nan;
+                 m.obs[0] = nan;
                  return Encode(m, r);
                }});
   t.push_back({rl::channels::kTransitions, rl::Port::kMain,
@@ -171,8 +186,9 @@ std::vector<Target> Targets() {
                  return Encode(m, r);
                }});
   // The action fields: a NaN action (refused by every receiver's check), and actions that are
-  // well-formed but not the run env's (refused by the replay, which knows the env): an index far
-  // out of range, and a second action value. Each counts as one invalid message.
+  // well-formed but not the run env's (refused by the replay, which knows the env): a value far
+  // out of range (an index for a discrete env, a bound for a continuous one), and one action
+  // value too many. Each counts as one invalid message.
   t.push_back({rl::channels::kTransitions, rl::Port::kMain,
                [](int64_t r) { return Encode(Transitions(), r); },
                [nan](int64_t r) {
@@ -191,9 +207,8 @@ std::vector<Target> Targets() {
                [](int64_t r) { return Encode(Transitions(), r); },
                [](int64_t r) {
                  auto m = Transitions();
-                 m.action_width = 2;
-                 m.num_action_values = 2;
-                 m.action = {0, 0};
+                 m.action.push_back(m.action[0]);
+                 m.action_width = m.num_action_values = static_cast<int32_t>(m.action.size());
                  return Encode(m, r);
                }});
   t.push_back({rl::channels::kPriorities, rl::Port::kMain,
@@ -267,6 +282,7 @@ int Main(int argc, char** argv) {
   int count = 20;
   double timeout = 30;
   std::string roles = "replay,learner,actor,evaluator";
+  std::string env = "CartPole-v1";
   uint64_t seed = 1;
   rl::po::options_description desc("Options");
   rl::AddCommonOptions(&desc, &common);
@@ -276,6 +292,8 @@ int Main(int argc, char** argv) {
       ("roles", rl::po::value(&roles)->default_value(roles), "roles whose drops are checked")  //
       ("timeout", rl::po::value(&timeout)->default_value(timeout),
        "seconds to wait for the stats to show the drops")  //
+      ("env", rl::po::value(&env)->default_value(env),
+       "the run's env (flat observations): transitions and samples get its shapes")  //
       ("seed", rl::po::value(&seed)->default_value(seed), "seed of the random bytes");
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "inject",
@@ -284,6 +302,18 @@ int Main(int argc, char** argv) {
                         "of a run and checks that every process counted and dropped them.",
                         desc, &vm)) {
     return 0;
+  }
+  const rl::envs::EnvSpec spec = rl::envs::LookupSpec(env);  // throws, naming the known ids
+  if (spec.frame_stack > 0) {
+    std::fprintf(stderr, "inject: error: --env %s has pixel observations; give a flat env\n",
+                 env.c_str());
+    return 2;
+  }
+  RunShape().obs_size = spec.observation_size;
+  RunShape().action.assign(static_cast<size_t>(spec.action_width()), 0.0f);
+  for (int d = 0; spec.continuous() && d < spec.action_dim; ++d) {
+    RunShape().action[static_cast<size_t>(d)] =
+        (spec.action_low[static_cast<size_t>(d)] + spec.action_high[static_cast<size_t>(d)]) / 2;
   }
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("inject"));

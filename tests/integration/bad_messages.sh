@@ -1,19 +1,23 @@
 #!/usr/bin/env bash
 # Malformed, truncated, foreign-run and invalid messages on every channel are counted and dropped
-# by every process, and no process crashes.
+# by every process, and no process crashes. Usage: bad_messages.sh [PRESET] (default cartpole; the
+# pendulum preset makes it a continuous run, where the action fields carry a NaN torque, a torque
+# far outside the bounds and one torque too many).
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
+preset=${1:-cartpole}
 scratch
 # Job control gives the run its own process group, as a terminal would, so that the Ctrl-C below
 # reaches every process of the run (without it, bash starts background jobs ignoring SIGINT).
 set -m
-launch cartpole --out "$dir/run" --actors 2 --seed 3 --goal 1000000 --time-budget 120 \
+launch "$preset" --out "$dir/run" --actors 2 --seed 3 --goal 1000000 --time-budget 120 \
   > "$dir/launch.log" 2>&1 &
 launch_pid=$!
 set +m
 wait_line "$dir/launch.log" "running; logs in" 60
 run="$dir/run"
-"$bin/inject" --run-id "$(run_setting "$run" run-id)" --lcm-url "$(run_setting "$run" lcm-url)" \
+env_id=$(sed -n 's/^env = //p' "$run/config.ini" | head -1)
+"$bin/inject" --env "$env_id" --run-id "$(run_setting "$run" run-id)" --lcm-url "$(run_setting "$run" lcm-url)" \
   --lcm-bulk-url "$(run_setting "$run" lcm-bulk-url)" --count 20 --timeout 30 \
   --roles replay,learner,actor,evaluator || fail "the processes did not count every bad message"
 # Every process is still alive and still working.
@@ -31,4 +35,4 @@ while read -r role pid; do
 done < "$run/pids"
 grep -q "stopped" "$run/logs/replay.log" "$run/logs/learner.log" || fail "no clean stop"
 [ -s "$run/report/index.html" ] || fail "no report after Ctrl-C"
-echo "PASS: every bad message counted and dropped; clean stop"
+echo "PASS: every bad message counted and dropped ($preset, $env_id); clean stop"

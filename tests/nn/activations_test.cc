@@ -9,10 +9,6 @@
 namespace rl::nn {
 namespace {
 
-using testing::Dot;
-using testing::ExpectGradientsClose;
-using testing::NumericalGradient;
-using testing::RandomMatrix;
 
 // Inputs in +-[0.1, 2], away from ReLU's kink at 0 relative to the finite-difference step.
 Matrix AwayFromZero(int rows, int cols, std::mt19937* rng) {

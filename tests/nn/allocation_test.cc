@@ -53,8 +53,8 @@ TEST(AllocationTest, DqnUpdateDoesNotAllocateOnceShapesAreStable) {
   Sequential target = online;
   const std::vector<Param> params = online.Params();
   Adam adam(params, 1e-3f);
-  const Matrix obs = testing::RandomMatrix(4, kBatch, &rng);
-  const Matrix next_obs = testing::RandomMatrix(4, kBatch, &rng);
+  const Matrix obs = RandomMatrix(4, kBatch, &rng);
+  const Matrix next_obs = RandomMatrix(4, kBatch, &rng);
   Vector q_taken(kBatch);
   Vector td_target(kBatch);
   Vector grad;
@@ -153,10 +153,10 @@ TEST(AllocationTest, PixelNetworksDoNotAllocateWithTwoThreads) {
   Sequential nature_actor = nature;
   Sequential grasp_actor = grasp;
   const int64_t sections = internal::ParallelSections();
-  const Matrix nature_x = testing::RandomMatrix(nature.InputSize(), 4, &rng).cwiseAbs();
-  const Matrix grasp_x = testing::RandomMatrix(grasp.InputSize(), 32, &rng).cwiseAbs();
-  const Matrix nature_dq = testing::RandomMatrix(7, 4, &rng);
-  const Matrix grasp_dq = testing::RandomMatrix(7, 32, &rng);
+  const Matrix nature_x = RandomMatrix(nature.InputSize(), 4, &rng).cwiseAbs();
+  const Matrix grasp_x = RandomMatrix(grasp.InputSize(), 32, &rng).cwiseAbs();
+  const Matrix nature_dq = RandomMatrix(7, 4, &rng);
+  const Matrix grasp_dq = RandomMatrix(7, 32, &rng);
   auto work = [&] {
     nature.Forward(nature_x);
     nature.BackwardParams(nature_dq);

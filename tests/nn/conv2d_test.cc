@@ -13,10 +13,6 @@
 namespace rl::nn {
 namespace {
 
-using testing::Dot;
-using testing::ExpectGradientsClose;
-using testing::NumericalGradient;
-using testing::RandomMatrix;
 
 // The geometry of one test convolution.
 struct ConvCase {

@@ -12,10 +12,6 @@
 namespace rl::nn {
 namespace {
 
-using testing::Dot;
-using testing::ExpectGradientsClose;
-using testing::NumericalGradient;
-using testing::RandomMatrix;
 
 TEST(DuelingTest, OutputIsValuePlusAdvantageMinusMeanAdvantage) {
   std::mt19937 rng(1);

@@ -9,7 +9,7 @@
 
 #include "nn/tensor.h"
 
-namespace rl::nn::testing {
+namespace rl::nn {
 
 /// d(loss)/d(*x) by central differences: (loss(x + eps e_i) - loss(x - eps e_i)) / (2 eps) for
 /// every element i of *x. `loss` reads *x; *x is restored afterwards.
@@ -53,4 +53,4 @@ inline double Dot(const Matrix& r, const Matrix& m) {
   return (r.cast<double>().array() * m.cast<double>().array()).sum();
 }
 
-}  // namespace rl::nn::testing
+}  // namespace rl::nn

@@ -11,10 +11,6 @@
 namespace rl::nn {
 namespace {
 
-using testing::Dot;
-using testing::ExpectGradientsClose;
-using testing::NumericalGradient;
-using testing::RandomMatrix;
 
 TEST(LayerNormTest, NormalisesEachColumnOverItsFeatures) {
   LayerNorm ln(4);

@@ -11,10 +11,6 @@
 namespace rl::nn {
 namespace {
 
-using testing::Dot;
-using testing::ExpectGradientsClose;
-using testing::NumericalGradient;
-using testing::RandomMatrix;
 
 // Checks input, weight and bias gradients of a Linear layer against finite differences of
 // loss = sum(r .* layer(x)).

@@ -16,9 +16,6 @@
 namespace rl::nn {
 namespace {
 
-using testing::ExpectGradientsClose;
-using testing::NumericalGradient;
-using testing::RandomMatrix;
 
 constexpr char kCartPoleArch[] = "linear(4,120),relu,linear(120,84),relu,linear(84,2)";
 

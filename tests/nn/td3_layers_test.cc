@@ -19,10 +19,6 @@
 namespace rl::nn {
 namespace {
 
-using testing::Dot;
-using testing::ExpectGradientsClose;
-using testing::NumericalGradient;
-using testing::RandomMatrix;
 
 TEST(BoundedTest, MapsTanhOntoEachDimensionsBounds) {
   Bounded b({-1.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 2.0f});
