@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <type_traits>
@@ -70,9 +71,26 @@ Actor::Actor(ActorConfig config, Bus* bus) : config_(std::move(config)), bus_(bu
 
   bus_->Subscribe<rlmsg::weights_chunk_t>(
       channels::kWeights, [this](const rlmsg::weights_chunk_t& c) { OnWeights(c); }, Port::kBulk);
-  bus_->Subscribe<rlmsg::flow_control_t>(channels::kFlow, [this](const rlmsg::flow_control_t& f) {
-    insert_allowed_ = f.insert_allowed != 0;
-  });
+  bus_->Subscribe<rlmsg::flow_control_t>(channels::kFlow,
+                                         [this](const rlmsg::flow_control_t& f) { OnFlow(f); });
+}
+
+void Actor::OnFlow(const rlmsg::flow_control_t& f) {
+  insert_allowed_ = f.insert_allowed != 0;
+  if (f.insert_credit < 0) {
+    insert_limit_ = std::numeric_limits<int64_t>::max();
+    return;
+  }
+  const int64_t actors = std::max(config_.num_actors, 1);
+  const int64_t share = (f.insert_credit + actors - 1) / actors;
+  int64_t stored = 0;
+  for (size_t i = 0; i < f.actor_id.size(); ++i) {
+    if (f.actor_id[i] == config_.actor_id) stored = f.actor_inserts[i];
+  }
+  // A restarted actor may find more stored under its id than it has published: nothing of its
+  // own is then on the way.
+  const int64_t on_the_way = std::max<int64_t>(0, published_ - stored);
+  insert_limit_ = published_ + std::max<int64_t>(0, share - on_the_way);
 }
 
 void Actor::OnWeights(const rlmsg::weights_chunk_t& chunk) {
@@ -205,7 +223,7 @@ void Actor::PublishStats() {
   s.mean_return = mean_return();
   s.epsilon = exploration();
   s.weights_version = weights_version_;
-  s.paused = insert_allowed_ ? 0 : 1;
+  s.paused = paused() ? 1 : 0;
   s.transitions_published = published_;
   bus_->FillCounters(&s);
   bus_->Publish(channels::kStatsActor, &s);
@@ -217,7 +235,7 @@ void Actor::Run() {
   double next_log = MonoSeconds() + 5.0;
   while (!StopRequested()) {
     if (config_.max_steps > 0 && env_steps_ >= config_.max_steps) break;
-    if (insert_allowed_) {
+    if (!paused()) {
       // Step until a batch went out (or a bounded number of steps), then look at LCM.
       const int64_t before = published_;
       for (int i = 0; i < config_.batch_size && published_ == before; ++i) StepEnvs();
@@ -235,7 +253,7 @@ void Actor::Run() {
                   config_.actor_id, static_cast<long long>(env_steps_),
                   static_cast<long long>(episodes_), mean_return(),
                   spec_.continuous() ? "sigma" : "epsilon", exploration(),
-                  static_cast<long long>(weights_version_), insert_allowed_ ? "" : " (paused)");
+                  static_cast<long long>(weights_version_), paused() ? " (paused)" : "");
       std::fflush(stdout);
       next_log = now + 5.0;
     }

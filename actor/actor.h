@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -71,10 +72,21 @@ class Actor {
   // The exploration scale now: epsilon, or the noise sigma (1 during the random start).
   double exploration() const { return policy_->exploration(env_steps_); }
   int64_t weights_refused() const { return weights_refused_; }
-  bool paused() const { return !insert_allowed_; }
+  /// Transitions published so far.
+  int64_t published() const { return published_; }
+  /// Whether the replay's flow control holds this actor: no flow message yet, insert_allowed is
+  /// 0, or the actor has used its share of the insert credit of the last flow message (OnFlow).
+  bool paused() const { return !insert_allowed_ || published_ >= insert_limit_; }
+  /// Transitions this actor may have published in all before it waits for the next flow message.
+  int64_t insert_limit() const { return insert_limit_; }
   double mean_return() const;
 
  private:
+  // Takes the replay's flow control: insert_allowed, and this actor's share of the insert
+  // credit, credit / num_actors (rounded up), less its transitions still on the way (published
+  // but not yet stored by the replay, as far as the message says).
+  void OnFlow(const rlmsg::flow_control_t& f);
+
   struct EnvSlot {
     std::unique_ptr<envs::Env> env;
     std::vector<float> obs;     // observation the next action is chosen from
@@ -108,7 +120,11 @@ class Actor {
   int64_t weights_version_ = -1;
   int64_t weights_refused_ = 0;
 
+  // Nothing is published before the replay's first flow message: an actor can step far faster
+  // than the replay stores, and would otherwise fill the replay's socket queue before the
+  // replay has read enough to tell it to stop.
   bool insert_allowed_ = true;
+  int64_t insert_limit_ = 0;
   int64_t env_steps_ = 0;
   int64_t episodes_ = 0;
   int64_t published_ = 0;

@@ -14,11 +14,7 @@
 int main(int argc, char** argv) {
   const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
   const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
-  rl::BusConfig bc;
-  bc.url = bc.bulk_url = "memq://";
-  bc.run_id = 1;
-  bc.sender = "actor-0";
-  rl::Bus bus(bc);
+  rl::Bus bus(rl::InProcessBusConfig(1, "actor-0"));
   rl::actor::ActorConfig c;
   c.exploration.mode = "constant";
   c.exploration.end = 0.05;

@@ -67,6 +67,17 @@ rl::BusConfig Config(int port, const std::string& sender) {
   return c;
 }
 
+// Waits up to 10 s for the replay service's first stats message: its readiness.
+bool WaitForReplay(rl::Bus* bus) {
+  // Shared with the subscription, which outlives this call.
+  auto replay_up = std::make_shared<bool>(false);
+  bus->Subscribe<rlmsg::stats_replay_t>(
+      rl::channels::kStatsReplay, [replay_up](const rlmsg::stats_replay_t&) { *replay_up = true; });
+  const double ready_deadline = rl::MonoSeconds() + 10;
+  while (!*replay_up && rl::MonoSeconds() < ready_deadline) bus->Handle(50);
+  return *replay_up;
+}
+
 rlmsg::transition_batch_t Batch() {
   rlmsg::transition_batch_t m{};
   m.obs_size = 4;
@@ -113,12 +124,7 @@ int RunFlat(int repeats, double seconds, int port) {
         --in_flight;
       },
       rl::Port::kBulk);
-  bool replay_up = false;
-  bus.Subscribe<rlmsg::stats_replay_t>(rl::channels::kStatsReplay,
-                                       [&](const rlmsg::stats_replay_t&) { replay_up = true; });
-  const double ready_deadline = rl::MonoSeconds() + 10;
-  while (!replay_up && rl::MonoSeconds() < ready_deadline) bus.Handle(50);
-  if (!replay_up) {
+  if (!WaitForReplay(&bus)) {
     std::fprintf(stderr, "bench_replay: the replay service did not come up\n");
     stop = true;
     service_thread.join();
@@ -589,12 +595,7 @@ int RunPixelLcm(int repeats, double seconds, int port) {
   };
 
   rl::Bus bus(Config(port, "learner"));
-  bool replay_up = false;
-  bus.Subscribe<rlmsg::stats_replay_t>(rl::channels::kStatsReplay,
-                                       [&](const rlmsg::stats_replay_t&) { replay_up = true; });
-  const double ready_deadline = rl::MonoSeconds() + 10;
-  while (!replay_up && rl::MonoSeconds() < ready_deadline) bus.Handle(50);
-  if (!replay_up) {
+  if (!WaitForReplay(&bus)) {
     std::fprintf(stderr, "bench_replay: the pixel replay service did not come up\n");
     stop();
     return 1;

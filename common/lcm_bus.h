@@ -40,6 +40,16 @@ struct BusConfig {
   int queue_capacity = 10000;                 // per-subscription LCM queue (LCM's default: 30)
 };
 
+/// An in-process bus (LCM's memq:// provider on both ports): only this process receives what it
+/// publishes. For unit tests and benchmarks.
+inline BusConfig InProcessBusConfig(int64_t run_id, std::string sender) {
+  BusConfig c;
+  c.url = c.bulk_url = "memq://";
+  c.run_id = run_id;
+  c.sender = std::move(sender);
+  return c;
+}
+
 // What the bus dropped or lost, for the stats messages.
 struct BusCounters {
   int64_t received = 0;   // messages handed to handlers

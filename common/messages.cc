@@ -7,60 +7,6 @@
 namespace rl {
 namespace {
 
-// Reads big-endian LCM fields from a buffer, remembering whether anything ran past its end.
-class Reader {
- public:
-  Reader(const uint8_t* data, size_t size) : data_(data), size_(size) {}
-
-  bool Skip(int64_t n) {
-    if (n < 0 || static_cast<uint64_t>(n) > size_ - pos_) return ok_ = false;
-    pos_ += static_cast<size_t>(n);
-    return true;
-  }
-  int64_t ReadInt(int bytes) {
-    if (static_cast<size_t>(bytes) > size_ - pos_) {
-      ok_ = false;
-      return 0;
-    }
-    uint64_t v = 0;
-    for (int i = 0; i < bytes; ++i) v = (v << 8) | data_[pos_ + static_cast<size_t>(i)];
-    pos_ += static_cast<size_t>(bytes);
-    // Sign-extend.
-    const int shift = 64 - 8 * bytes;
-    return static_cast<int64_t>(v << shift) >> shift;
-  }
-  // A string: int32 length including the terminating NUL, then the bytes.
-  void String() {
-    const int64_t len = ReadInt(4);
-    if (len < 1) ok_ = false;
-    if (ok_) Skip(len);
-  }
-  // A variable array of `count` elements of `bytes` each.
-  void Array(int64_t count, int bytes) {
-    if (count < 0 || count > kMaxArrayElements) ok_ = false;
-    if (ok_) Skip(count * bytes);
-  }
-  void Header() {
-    Skip(8);   // run_id
-    String();  // sender
-    Skip(16);  // seq, utime
-  }
-  bool ok() const { return ok_; }
-  bool at_end() const { return pos_ == size_; }
-
- private:
-  const uint8_t* data_;
-  size_t size_;
-  size_t pos_ = 0;
-  bool ok_ = true;
-};
-
-const char* Finish(const Reader& r) {
-  if (!r.ok()) return "truncated or bad length";
-  if (!r.at_end()) return "trailing bytes";
-  return nullptr;
-}
-
 bool AllFinite(const std::vector<float>& v) {
   for (float x : v) {
     if (!std::isfinite(x)) return false;
@@ -69,87 +15,6 @@ bool AllFinite(const std::vector<float>& v) {
 }
 
 bool HeaderOk(const rlmsg::header_t& h) { return !h.sender.empty() && h.seq >= 0; }
-
-}  // namespace
-
-const char* Prescan(const rlmsg::transition_batch_t*, const uint8_t* data, size_t size) {
-  Reader r(data, size);
-  r.Skip(8);  // fingerprint
-  r.Header();
-  r.Skip(4);  // actor_id
-  const int64_t count = r.ReadInt(4);
-  r.Skip(4);  // obs_size
-  const int64_t num_values = r.ReadInt(4);
-  r.Array(num_values, 4);  // obs
-  r.Array(num_values, 4);  // next_obs
-  r.Skip(12);              // height, width, stack
-  const int64_t num_frames = r.ReadInt(4);
-  r.Array(num_frames, 8);  // frame_id
-  const int64_t num_bytes = r.ReadInt(4);
-  r.Array(num_bytes, 1);  // frames
-  const int64_t num_refs = r.ReadInt(4);
-  r.Array(num_refs, 8);  // obs_frames
-  r.Array(num_refs, 8);  // next_obs_frames
-  r.Skip(4);             // action_width
-  const int64_t num_action_values = r.ReadInt(4);
-  r.Array(num_action_values, 4);  // action
-  r.Array(count, 4);              // reward
-  r.Array(count, 4);              // discount
-  r.Array(count, 8);              // episode_id
-  r.Array(count, 4);              // priority
-  return Finish(r);
-}
-
-const char* Prescan(const rlmsg::sample_batch_t*, const uint8_t* data, size_t size) {
-  Reader r(data, size);
-  r.Skip(8);
-  r.Header();
-  r.String();  // requester
-  r.Skip(8);   // request_id
-  const int64_t count = r.ReadInt(4);
-  r.Skip(4);  // obs_size
-  const int64_t num_values = r.ReadInt(4);
-  r.Array(num_values, 4);  // obs
-  r.Array(num_values, 4);  // next_obs
-  r.Skip(12);              // height, width, stack
-  const int64_t num_bytes = r.ReadInt(4);
-  r.Array(num_bytes, 1);  // obs_pixels
-  r.Array(num_bytes, 1);  // next_obs_pixels
-  r.Skip(4);              // action_width
-  const int64_t num_action_values = r.ReadInt(4);
-  r.Array(num_action_values, 4);  // action
-  r.Array(count, 4);              // reward
-  r.Array(count, 4);              // discount
-  r.Array(count, 8);              // index
-  r.Array(count, 4);              // weight
-  r.Skip(16);                     // replay_size, total_inserts
-  return Finish(r);
-}
-
-const char* Prescan(const rlmsg::priority_update_t*, const uint8_t* data, size_t size) {
-  Reader r(data, size);
-  r.Skip(8);
-  r.Header();
-  const int64_t count = r.ReadInt(4);
-  r.Array(count, 8);  // index
-  r.Array(count, 4);  // priority
-  return Finish(r);
-}
-
-const char* Prescan(const rlmsg::weights_chunk_t*, const uint8_t* data, size_t size) {
-  Reader r(data, size);
-  r.Skip(8);
-  r.Header();
-  r.Skip(8);   // version
-  r.String();  // architecture
-  r.Skip(16);  // total_size, chunk_index, num_chunks, offset
-  const int64_t count = r.ReadInt(4);
-  r.Array(count, 4);  // data
-  r.Skip(8);          // crc32
-  return Finish(r);
-}
-
-namespace {
 
 // Frame geometry of pixel messages: positive and small enough that products cannot overflow.
 bool GeometryOk(int32_t height, int32_t width, int32_t stack) {
@@ -283,6 +148,14 @@ const char* Validate(const rlmsg::flow_control_t& m) {
   if (!HeaderOk(m.header)) return "bad header";
   if (m.insert_allowed != 0 && m.insert_allowed != 1) return "insert_allowed not 0 or 1";
   if (!std::isfinite(m.samples_per_insert)) return "non-finite value";
+  if (m.insert_credit < -1) return "insert_credit below -1";
+  if (m.num_actors < 0 || static_cast<size_t>(m.num_actors) != m.actor_id.size() ||
+      m.actor_inserts.size() != m.actor_id.size()) {
+    return "num_actors mismatch";
+  }
+  for (int64_t n : m.actor_inserts) {
+    if (n < 0) return "negative actor_inserts";
+  }
   return nullptr;
 }
 

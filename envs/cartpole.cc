@@ -25,8 +25,6 @@ constexpr double kCartWidth = 50.0;
 constexpr double kCartHeight = 30.0;
 constexpr double kAxleOffset = kCartHeight / 4.0;  // Axle above the cart's centre line.
 constexpr double kCartY = 100;                     // Cart centre line and track height.
-constexpr Rgb kWhite{255, 255, 255};
-constexpr Rgb kBlack{0, 0, 0};
 constexpr Rgb kPoleColor{202, 152, 101};
 constexpr Rgb kAxleColor{129, 132, 203};
 

@@ -34,10 +34,8 @@ constexpr double kArrowHeadHalfWidth = 0.15;  // Across the ring, from its centr
 constexpr double kArrowHeadLength = 0.2;      // Along the tangent.
 constexpr double kArrowSweep = 1.5 * std::numbers::pi;
 constexpr int kArrowSegments = 48;
-constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kRodColor{204, 77, 77};
 constexpr Rgb kArrowColor{64, 64, 64};
-constexpr Rgb kBlack{0, 0, 0};
 
 }  // namespace
 

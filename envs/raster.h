@@ -20,6 +20,8 @@ struct Rgb {
   uint8_t b = 0;
   friend bool operator==(const Rgb&, const Rgb&) = default;
 };
+inline constexpr Rgb kBlack{0, 0, 0};
+inline constexpr Rgb kWhite{255, 255, 255};
 
 /// A point in continuous image coordinates (pixels, y down).
 struct Point {

@@ -25,6 +25,16 @@
 namespace rl::evaluator {
 namespace {
 
+// The summary of a score, which EvalScore, EvalRecord and eval_result_t all carry.
+template <class From, class To>
+void CopySummary(const From& from, To* to) {
+  to->mean = from.mean;
+  to->std = from.std;
+  to->min = from.min;
+  to->max = from.max;
+  to->episodes = from.episodes;
+}
+
 std::string FileName(const std::string& path) {
   return std::filesystem::path(path).filename().string();
 }
@@ -96,11 +106,7 @@ EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_i
   r.update = meta.update;
   r.env_steps = meta.env_steps;
   r.wall_seconds = meta.wall_seconds;
-  r.mean = score.mean;
-  r.std = score.std;
-  r.min = score.min;
-  r.max = score.max;
-  r.episodes = score.episodes;
+  CopySummary(score, &r);
   r.eval_seconds = MonoSeconds() - start;
   if (score.values) {
     r.value_steps = score.values->steps;
@@ -280,11 +286,7 @@ bool EvaluatorService::ScorePending() {
   result.update = record.update;
   result.env_steps = record.env_steps;
   result.wall_seconds = record.wall_seconds;
-  result.episodes = record.episodes;
-  result.mean = record.mean;
-  result.std = record.std;
-  result.min = record.min;
-  result.max = record.max;
+  CopySummary(record, &result);
   result.goal_reached = reached ? 1 : 0;
   bus_->Publish(channels::kEval, &result);
 

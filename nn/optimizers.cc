@@ -110,27 +110,23 @@ void RmsProp::Step() {
       auto s = Chunk(&square_avg_[i], at, n);
       auto p = Chunk(ps[i].value, at, n);
       s = alpha_ * s + (1.0f - alpha_) * g.square();
+      // The step g / denom, through the momentum buffer when there is one.
+      const auto step = [&](const auto& denom) {
+        if (momentum_ > 0.0f) {
+          auto buf = Chunk(&momentum_buf_[i], at, n);
+          buf = momentum_ * buf + g / denom;
+          p -= lr * buf;
+        } else {
+          p -= lr * g / denom;
+        }
+      };
       if (centered_) {
         auto a = Chunk(&grad_avg_[i], at, n);
         a = alpha_ * a + (1.0f - alpha_) * g;
         // s - a^2 is a variance; clamp the rounding error that can make it slightly negative.
-        const auto denom = (s - a.square()).max(0.0f).sqrt() + eps_;
-        if (momentum_ > 0.0f) {
-          auto buf = Chunk(&momentum_buf_[i], at, n);
-          buf = momentum_ * buf + g / denom;
-          p -= lr * buf;
-        } else {
-          p -= lr * g / denom;
-        }
+        step((s - a.square()).max(0.0f).sqrt() + eps_);
       } else {
-        const auto denom = s.sqrt() + eps_;
-        if (momentum_ > 0.0f) {
-          auto buf = Chunk(&momentum_buf_[i], at, n);
-          buf = momentum_ * buf + g / denom;
-          p -= lr * buf;
-        } else {
-          p -= lr * g / denom;
-        }
+        step(s.sqrt() + eps_);
       }
     });
   }

@@ -66,6 +66,14 @@ bool RateLimiter::CanSample(int64_t n) const {
   return diff() - static_cast<double>(n) >= min_diff();
 }
 
+int64_t RateLimiter::InsertCredit() const {
+  if (!enabled()) return -1;
+  const double room = (max_diff() - diff()) / options_.samples_per_insert;
+  // Below min_size every insert is allowed, whatever the ratio says.
+  const double before_min = static_cast<double>(options_.min_size_to_sample - inserts_);
+  return static_cast<int64_t>(std::floor(std::max({0.0, room, before_min})));
+}
+
 int64_t RateLimiter::max_sample_batch() const {
   if (!enabled()) return 0;
   return static_cast<int64_t>(

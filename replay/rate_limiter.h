@@ -52,6 +52,12 @@ class RateLimiter {
   /// Whether sampling n more transitions keeps the ratio within bounds. O(1).
   bool CanSample(int64_t n) const;
 
+  /// How many more transitions CanInsert admits now, one at a time: the largest n such that
+  /// inserting n transitions one by one keeps CanInsert(1) true before each (at least the
+  /// transitions missing to min_size_to_sample); -1 when the ratio is not enforced. The replay
+  /// shares it out among the actors (flow_control_t), so that they stop in time even while
+  /// their transitions are still on the way. O(1).
+  int64_t InsertCredit() const;
   /// Records n transitions inserted (allowed or not).
   void Insert(int64_t n) { inserts_ += n; }
   /// Records n transitions sampled (allowed or not).

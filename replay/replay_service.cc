@@ -103,6 +103,7 @@ ReplayService::ReplayService(Bus* bus, ReplayServiceOptions options)
       limiter_(options_.limiter),
       rng_(options_.seed) {
   insert_allowed_ = limiter_.CanInsert(options_.insert_unit);
+  low_credit_ = limiter_.InsertCredit();
   bus_.Subscribe<rlmsg::transition_batch_t>(
       channels::kTransitions, [this](const rlmsg::transition_batch_t& m) { OnTransitions(m); });
   bus_.Subscribe<rlmsg::sample_request_t>(
@@ -151,6 +152,7 @@ void ReplayService::OnTransitions(const rlmsg::transition_batch_t& m) {
     return;
   }
   limiter_.Insert(total_inserts() - before);
+  actor_inserts_[m.actor_id] += total_inserts() - before;
   PublishFlow(/*force=*/false);
 }
 
@@ -312,12 +314,28 @@ void ReplayService::Answer(const PendingRequest& request) {
 
 void ReplayService::PublishFlow(bool force) {
   const bool allowed = limiter_.CanInsert(options_.insert_unit);
-  if (!force && allowed == insert_allowed_) return;
+  const int64_t credit = allowed ? limiter_.InsertCredit() : 0;
+  // The credit's range: from 0 to 2 * error_buffer / SPI once sampling runs.
+  const RateLimiterOptions& o = limiter_.options();
+  const double range = o.samples_per_insert > 0 ? 2 * o.error_buffer / o.samples_per_insert : 0;
+  low_credit_ = std::min(low_credit_, credit);
+  const bool grew =
+      credit >= 0 && static_cast<double>(credit - low_credit_) >= std::max(1.0, range / 4);
+  if (!force && allowed == insert_allowed_ && !grew) return;
   insert_allowed_ = allowed;
+  low_credit_ = credit;
   flow_.insert_allowed = allowed ? 1 : 0;
   flow_.samples_per_insert = limiter_.samples_per_insert();
-  flow_.target_samples_per_insert = limiter_.options().samples_per_insert;
-  flow_.error_buffer = limiter_.options().error_buffer;
+  flow_.target_samples_per_insert = o.samples_per_insert;
+  flow_.error_buffer = o.error_buffer;
+  flow_.insert_credit = credit;
+  flow_.num_actors = static_cast<int32_t>(actor_inserts_.size());
+  flow_.actor_id.clear();
+  flow_.actor_inserts.clear();
+  for (const auto& [id, n] : actor_inserts_) {
+    flow_.actor_id.push_back(id);
+    flow_.actor_inserts.push_back(n);
+  }
   bus_.Publish(channels::kFlow, &flow_);
 }
 

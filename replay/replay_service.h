@@ -37,6 +37,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <random>
 #include <span>
@@ -181,6 +182,9 @@ class ReplayService {
   // Why a request can never be answered, or nullptr.
   const char* Unanswerable(const PendingRequest& request);
   // Publishes flow_control_t when insert_allowed changed (or always, when forced).
+  // Publishes flow_control_t when `force`, when insert_allowed changes, or when the credit has
+  // grown by a quarter of its range above its lowest since the last publication (so that actors
+  // waiting for credit hear of it soon).
   void PublishFlow(bool force);
   void PublishStats(double now);
   void PrintProgress(double now);
@@ -195,6 +199,10 @@ class ReplayService {
   std::deque<PendingRequest> pending_;
   ServiceCounters counters_;
   bool insert_allowed_ = true;
+  // The lowest insert credit since the last flow message (which resets it to its credit).
+  int64_t low_credit_ = 0;
+  // Transitions stored from each actor (by actor_id), for the flow messages.
+  std::map<int32_t, int64_t> actor_inserts_;
   int64_t refusals_logged_ = 0;
 
   // Next due times of the periodic publications (monotonic seconds; < 0: at the next Tick).

@@ -59,33 +59,41 @@ Shape& RunShape() {
   return shape;
 }
 
-// A flat batch of one transition of the run env.
-rlmsg::transition_batch_t Transitions() {
+// The columns transition and sample batches share: one transition of the run env.
+template <class Msg>
+Msg OneTransition() {
   const Shape& shape = RunShape();
-  rlmsg::transition_batch_t m{};
+  Msg m{};
   m.count = 1;
-  m.obs_size = shape.obs_size;
-  m.num_values = shape.obs_size;
+  m.obs_size = m.num_values = shape.obs_size;
   m.obs = m.next_obs = std::vector<float>(static_cast<size_t>(shape.obs_size), 0.0f);
-  m.action_width = static_cast<int32_t>(shape.action.size());
-  m.num_action_values = m.action_width;
+  m.action_width = m.num_action_values = static_cast<int32_t>(shape.action.size());
   m.action = shape.action;
   m.reward = {1};
   m.discount = {0.99f};
+  return m;
+}
+
+// The same with pixel observations instead: stacks of two 2x2 frames.
+template <class Msg>
+Msg WithPixels(Msg m) {
+  m.obs_size = m.num_values = 0;
+  m.obs.clear();
+  m.next_obs.clear();
+  m.height = m.width = m.stack = 2;
+  return m;
+}
+
+rlmsg::transition_batch_t Transitions() {
+  auto m = OneTransition<rlmsg::transition_batch_t>();
   m.episode_id = {0};
   m.priority = {0};
   return m;
 }
 
-// A pixel batch of two 2x2 frames and one transition naming them.
+// Two 2x2 frames and one transition naming them.
 rlmsg::transition_batch_t PixelTransitions() {
-  rlmsg::transition_batch_t m = Transitions();
-  m.obs_size = m.num_values = 0;
-  m.obs.clear();
-  m.next_obs.clear();
-  m.height = 2;
-  m.width = 2;
-  m.stack = 2;
+  auto m = WithPixels(Transitions());
   m.num_frames = 2;
   m.frame_id = {0, 1};
   m.num_bytes = 8;
@@ -97,31 +105,15 @@ rlmsg::transition_batch_t PixelTransitions() {
 }
 
 rlmsg::sample_batch_t Samples() {
-  const Shape& shape = RunShape();
-  rlmsg::sample_batch_t m{};
+  auto m = OneTransition<rlmsg::sample_batch_t>();
   m.requester = "learner";
-  m.count = 1;
-  m.obs_size = shape.obs_size;
-  m.num_values = shape.obs_size;
-  m.obs = m.next_obs = std::vector<float>(static_cast<size_t>(shape.obs_size), 0.0f);
-  m.action_width = static_cast<int32_t>(shape.action.size());
-  m.num_action_values = m.action_width;
-  m.action = shape.action;
-  m.reward = {1};
-  m.discount = {0.99f};
   m.index = {0};
   m.weight = {1};
   return m;
 }
 
 rlmsg::sample_batch_t PixelSamples() {
-  rlmsg::sample_batch_t m = Samples();
-  m.obs_size = m.num_values = 0;
-  m.obs.clear();
-  m.next_obs.clear();
-  m.height = 2;
-  m.width = 2;
-  m.stack = 2;
+  auto m = WithPixels(Samples());
   m.num_bytes = 8;
   m.obs_pixels.assign(8, 0);
   m.next_obs_pixels.assign(8, 0);

@@ -17,14 +17,7 @@
 namespace rl::actor {
 namespace {
 
-BusConfig Memq() {
-  BusConfig c;
-  c.url = "memq://";
-  c.bulk_url = "memq://";
-  c.run_id = 5;
-  c.sender = "actor-0";
-  return c;
-}
+BusConfig Memq() { return InProcessBusConfig(5, "actor-0"); }
 
 class ActorTest : public ::testing::Test {
  protected:
@@ -65,13 +58,59 @@ TEST_F(ActorTest, PublishesFullBatchesOfConsistentTransitions) {
 
 TEST_F(ActorTest, PausesWhenTheReplayAsksAndResumesAfter) {
   Actor actor(config_, &bus_);
-  EXPECT_FALSE(actor.paused());
+  EXPECT_TRUE(actor.paused()) << "before the replay's first flow message";
   rlmsg::flow_control_t f{};
   f.insert_allowed = 0;
   bus_.Publish(channels::kFlow, &f);
   bus_.Handle(0);
   EXPECT_TRUE(actor.paused());
   f.insert_allowed = 1;
+  f.insert_credit = -1;  // the ratio is not enforced
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  EXPECT_FALSE(actor.paused());
+}
+
+// Actor 1 of 2 takes half the insert credit (rounded up), less its transitions that the replay
+// has not stored yet, and pauses once it has published that many more.
+TEST_F(ActorTest, PausesAtItsShareOfTheInsertCredit) {
+  config_.actor_id = 1;
+  config_.num_actors = 2;
+  Actor actor(config_, &bus_);
+  while (actor.published() < 32) actor.StepEnvs();
+  rlmsg::flow_control_t f{};
+  f.insert_allowed = 1;
+  f.insert_credit = 41;  // a share of 21
+  f.num_actors = 2;
+  f.actor_id = {0, 1};
+  f.actor_inserts = {500, 16};  // 16 of this actor's 32 are still on the way
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  EXPECT_EQ(actor.insert_limit(), 32 + 21 - 16);
+  EXPECT_FALSE(actor.paused());
+  while (!actor.paused()) actor.StepEnvs();
+  EXPECT_EQ(actor.published(), 48);  // one more batch of 16: 37 is within it
+  // More stored under this id than it has published (a restarted actor): nothing on the way.
+  f.actor_inserts = {500, 1000};
+  f.insert_credit = 7;
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  EXPECT_EQ(actor.insert_limit(), 48 + 4);
+  // A message that does not name this actor: all it published is on the way.
+  f.num_actors = 1;
+  f.actor_id = {0};
+  f.actor_inserts = {500};
+  f.insert_credit = 200;
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  EXPECT_EQ(actor.insert_limit(), 100);
+  // No credit without insert_allowed; no limit when the ratio is not enforced.
+  f.insert_allowed = 0;
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  EXPECT_TRUE(actor.paused());
+  f.insert_allowed = 1;
+  f.insert_credit = -1;
   bus_.Publish(channels::kFlow, &f);
   bus_.Handle(0);
   EXPECT_FALSE(actor.paused());

@@ -12,12 +12,7 @@ namespace rl {
 namespace {
 
 BusConfig MemqConfig(int64_t run_id, const std::string& sender) {
-  BusConfig c;
-  c.url = "memq://";
-  c.bulk_url = "memq://";
-  c.run_id = run_id;
-  c.sender = sender;
-  return c;
+  return InProcessBusConfig(run_id, sender);
 }
 
 rlmsg::transition_batch_t MakeBatch(int count, int obs_size) {

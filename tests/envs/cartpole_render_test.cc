@@ -15,14 +15,9 @@
 namespace rl::envs {
 namespace {
 
-constexpr Rgb kWhite{255, 255, 255};
-constexpr Rgb kBlack{0, 0, 0};
 constexpr Rgb kPole{202, 152, 101};
 constexpr Rgb kAxle{129, 132, 203};
 
-using testing::Blob;
-using testing::FindColor;
-using testing::Image;
 
 Image RenderState(const std::array<double, 4>& state) {
   CartPole env;
@@ -154,14 +149,12 @@ TEST(CartPoleRenderTest, RunawayStatesRenderWithoutCrashing) {
   }
 }
 
-TEST(CartPoleRenderTest, RenderThroughTheRegistryWorksAfterReset) {
+// (Render before Reset and the native size of every id: specs_test.cc.)
+TEST(CartPoleRenderTest, RenderThroughTheRegistryDrawsThePole) {
   auto env = MakeEnv("CartPole-v1");
-  Image image;
-  EXPECT_THROW(env->Render(&image.rgb, &image.width, &image.height), std::logic_error);
   env->Reset(0);
+  Image image;
   env->Render(&image.rgb, &image.width, &image.height);
-  EXPECT_EQ(image.width, 600);
-  EXPECT_EQ(image.height, 400);
   EXPECT_GT(FindColor(image, kPole).count, 1000);
 }
 

@@ -17,11 +17,7 @@
 namespace rl::envs {
 namespace {
 
-constexpr Rgb kWhite{255, 255, 255};
-constexpr Rgb kBlack{0, 0, 0};
 
-using testing::FindColor;
-using testing::Image;
 
 // Index of cell (row, column) in the flat observation.
 int Cell(int row, int column) { return row * Catch::kColumns + column; }
@@ -41,18 +37,6 @@ std::vector<int> Ones(const Catch& env) {
 
 // Action that moves the paddle one column towards `column` (1 = stay when already there).
 int Towards(int paddle, int column) { return paddle < column ? 2 : paddle > column ? 0 : 1; }
-
-TEST(CatchTest, SpecMatchesBsuiteCatch) {
-  Catch env;
-  EXPECT_EQ(env.spec().id, "Catch-v0");
-  EXPECT_EQ(env.spec().observation_size, 50);
-  EXPECT_EQ(env.spec().num_actions, 3);
-  EXPECT_EQ(env.spec().max_episode_steps, 9);
-  EXPECT_EQ(env.spec().reward_threshold, 0.9);
-  EXPECT_EQ(env.spec().action_dim, 0);
-  EXPECT_EQ(env.spec().frame_stack, 0);
-  EXPECT_EQ(env.observation().size(), 50u);
-}
 
 TEST(CatchTest, ResetPutsTheBallInTheTopRowAndThePaddleInTheMiddleOfTheBottomRow) {
   Catch env;

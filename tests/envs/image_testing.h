@@ -8,7 +8,7 @@
 
 #include "envs/raster.h"
 
-namespace rl::envs::testing {
+namespace rl::envs {
 
 // A rendered RGB image (row-major, top row first, 3 bytes a pixel).
 struct Image {
@@ -49,4 +49,4 @@ inline Blob FindColor(const Image& image, Rgb color, int skip_row = -1) {
   return blob;
 }
 
-}  // namespace rl::envs::testing
+}  // namespace rl::envs

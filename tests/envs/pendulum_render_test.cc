@@ -13,8 +13,6 @@ namespace rl::envs {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr Rgb kWhite{255, 255, 255};
-constexpr Rgb kBlack{0, 0, 0};
 constexpr Rgb kRod{204, 77, 77};
 constexpr Rgb kArrow{64, 64, 64};
 // 500 / 4.4 pixels per world unit; the axle is the reference's pixel (250, 250) before the
@@ -23,9 +21,6 @@ constexpr double kScale = 500 / 4.4;
 constexpr double kAxleX = 250.5;
 constexpr double kAxleY = 249.5;
 
-using testing::Blob;
-using testing::FindColor;
-using testing::Image;
 
 Image RenderState(double theta, double theta_dot = 0) {
   Pendulum env;

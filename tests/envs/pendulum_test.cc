@@ -43,21 +43,6 @@ Expected ByHand(double th, double thdot, double u) {
   return {-cost, th + new_thdot * 0.05, new_thdot};
 }
 
-TEST(PendulumTest, SpecIsTheContinuousPendulumV1) {
-  const Pendulum env;
-  const EnvSpec& spec = env.spec();
-  EXPECT_EQ(spec.id, "Pendulum-v1");
-  EXPECT_EQ(spec.observation_size, 3);
-  EXPECT_TRUE(spec.continuous());
-  EXPECT_EQ(spec.num_actions, 0);
-  EXPECT_EQ(spec.action_dim, 1);
-  EXPECT_EQ(spec.action_low, std::vector<float>{-2.0f});
-  EXPECT_EQ(spec.action_high, std::vector<float>{2.0f});
-  EXPECT_EQ(spec.max_episode_steps, 200);
-  EXPECT_EQ(spec.render_width, 500);
-  EXPECT_EQ(spec.render_height, 500);
-}
-
 TEST(PendulumTest, StepsFollowTheEquationsComputedByHand) {
   Pendulum env;
   env.SetState(0.5, -1.0);

@@ -14,7 +14,6 @@
 namespace rl::envs {
 namespace {
 
-constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kRed{255, 0, 0};
 
 int CountColor(const Canvas& canvas, Rgb color) {

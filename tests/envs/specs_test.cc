@@ -29,17 +29,54 @@ void ExpectSameSpec(const EnvSpec& built, const EnvSpec& looked_up, const std::s
   EXPECT_EQ(built.render_height, looked_up.render_height) << id;
 }
 
-// The static spec of every registered id is the spec of the env MakeEnv builds, and the native
-// render size is what Render() draws (KUKA is left out: building it needs an OpenGL context per
+// The values every spec must hold: the references' registrations (Gymnasium, bsuite, the KUKA
+// tutorial's env), read without building an env.
+TEST(SpecsTest, SpecsHoldTheReferencesValues) {
+  struct Row {
+    const char* id;
+    int observation_size, num_actions, action_dim, max_episode_steps;
+    double reward_threshold;
+    std::vector<float> low, high;
+    int render_width, render_height;
+  };
+  const std::vector<Row> rows = {
+      {"CartPole-v1", 4, 2, 0, 500, 475.0, {}, {}, 600, 400},
+      {"Catch-v0", 50, 3, 0, 9, 0.9, {}, {}, 40, 80},
+      {"Pendulum-v1", 3, 0, 1, 200, -200.0, {-2.0f}, {2.0f}, 500, 500},
+      {"LunarLander-v3", 8, 4, 0, 1000, 200.0, {}, {}, 600, 400},
+      {"LunarLanderContinuous-v3", 8, 0, 2, 1000, 200.0, {-1.0f, -1.0f}, {1.0f, 1.0f}, 600, 400},
+      {"KukaDiverseObjectGrasping-v0", 2, 7, 0, 15, 0.6, {}, {}, 48, 48},
+      {"KukaDiverseObjectGraspingTest-v0", 2, 7, 0, 20, 0.6, {}, {}, 48, 48},
+  };
+  for (const Row& row : rows) {
+    const EnvSpec spec = LookupSpec(row.id);
+    EXPECT_EQ(spec.id, row.id);
+    EXPECT_EQ(spec.observation_size, row.observation_size) << row.id;
+    EXPECT_EQ(spec.num_actions, row.num_actions) << row.id;
+    EXPECT_EQ(spec.action_dim, row.action_dim) << row.id;
+    EXPECT_EQ(spec.continuous(), row.action_dim > 0) << row.id;
+    EXPECT_EQ(spec.max_episode_steps, row.max_episode_steps) << row.id;
+    EXPECT_EQ(spec.reward_threshold, row.reward_threshold) << row.id;
+    EXPECT_EQ(spec.action_low, row.low) << row.id;
+    EXPECT_EQ(spec.action_high, row.high) << row.id;
+    EXPECT_EQ(spec.render_width, row.render_width) << row.id;
+    EXPECT_EQ(spec.render_height, row.render_height) << row.id;
+    EXPECT_EQ(spec.frame_stack, 0) << row.id;
+  }
+}
+
+// The static spec of every registered id is the spec of the env MakeEnv builds, Render() refuses
+// to draw before the first Reset, and the native render size is what it draws (KUKA is left out: building it needs an OpenGL context per
 // id, and its spec is checked against the env in its own tests).
 TEST(SpecsTest, EveryRegisteredIdHasTheSpecOfTheEnvItBuilds) {
   for (const std::string& id : RegisteredEnvs()) {
     if (id.rfind("Kuka", 0) == 0) continue;
     auto env = MakeEnv(id);
     ExpectSameSpec(env->spec(), LookupSpec(id), id);
-    env->Reset(1);
     std::vector<uint8_t> rgb;
     int width = 0, height = 0;
+    EXPECT_THROW(env->Render(&rgb, &width, &height), std::logic_error) << id << " before Reset";
+    env->Reset(1);
     env->Render(&rgb, &width, &height);
     EXPECT_EQ(width, env->spec().render_width) << id;
     EXPECT_EQ(height, env->spec().render_height) << id;

@@ -23,14 +23,7 @@ using testing::CountOccurrences;
 using testing::ReadFile;
 using testing::TempDir;
 
-BusConfig MemqConfig() {
-  BusConfig c;
-  c.url = "memq://";
-  c.bulk_url = "memq://";
-  c.run_id = 77;
-  c.sender = "evaluator";
-  return c;
-}
+BusConfig MemqConfig() { return InProcessBusConfig(77, "evaluator"); }
 
 // A CartPole network that always pushes left (its output is the last layer's bias).
 nn::Checkpoint AlwaysLeftCheckpoint(int64_t update) {

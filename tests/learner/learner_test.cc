@@ -26,13 +26,22 @@ namespace fs = std::filesystem;
 // request is answered until the learner has sent request 0 again, so the retry must happen.
 class LearnerTest : public ::testing::Test {
  protected:
+  // A short run against this fixture's replay: `max_updates` updates on batches of `batch_size`,
+  // a checkpoint every `checkpoint_every` updates into the scratch folder, lost replies retried
+  // after 50 ms.
+  LearnerConfig ShortRun(int batch_size, int max_updates, int checkpoint_every = 1000) const {
+    LearnerConfig c;
+    c.batch_size = batch_size;
+    c.max_updates = max_updates;
+    c.checkpoint_every = checkpoint_every;
+    c.request_timeout = 0.05;
+    c.out_dir = dir_.string();
+    return c;
+  }
+
   LearnerTest() : dir_(fs::temp_directory_path() / ("learner_test_" + std::to_string(getpid()))) {
     fs::remove_all(dir_);
-    BusConfig c;
-    c.url = c.bulk_url = "memq://";
-    c.run_id = 9;
-    c.sender = "learner";
-    bus_ = std::make_unique<Bus>(c);
+    bus_ = std::make_unique<Bus>(InProcessBusConfig(9, "learner"));
     bus_->Subscribe<rlmsg::sample_request_t>(
         channels::kSampleRequest, [this](const rlmsg::sample_request_t& r) { Answer(r); });
     bus_->Subscribe<rlmsg::checkpoint_t>(
@@ -147,13 +156,8 @@ class LearnerTest : public ::testing::Test {
 };
 
 TEST_F(LearnerTest, TrainsBroadcastsWeightsAndWritesLoadableCheckpoints) {
-  LearnerConfig c;
-  c.batch_size = 32;
-  c.max_updates = 30;
+  LearnerConfig c = ShortRun(32, 30, 10);
   c.weights_every = 10;
-  c.checkpoint_every = 10;
-  c.request_timeout = 0.05;
-  c.out_dir = dir_.string();
   Learner learner(c, bus_.get());
   learner.Run();
   bus_->Handle(0);
@@ -184,17 +188,12 @@ TEST_F(LearnerTest, TrainsOnPixelBatchesAndSendsTheirTdErrorsAsPriorities) {
   bus_->Subscribe<rlmsg::priority_update_t>(
       channels::kPriorities,
       [&updates](const rlmsg::priority_update_t& m) { updates.push_back(m); });
-  LearnerConfig c;
+  LearnerConfig c = ShortRun(16, 20, 100);
   c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)";
   c.dqn.network = "conv2d(2,4,3,1,1,10,5),relu,flatten,linear(200,3)";
   // Random shifts need the frame size, which comes from the env's static spec.
   c.augment_shift = 2;
-  c.batch_size = 16;
-  c.max_updates = 20;
-  c.checkpoint_every = 100;
-  c.request_timeout = 0.05;
   c.prioritized = true;
-  c.out_dir = dir_.string();
   Learner learner(c, bus_.get());
   learner.Run();
   bus_->Handle(0);
@@ -217,13 +216,8 @@ TEST_F(LearnerTest, TrainsOnPixelBatchesAndSendsTheirTdErrorsAsPriorities) {
 }
 
 TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFiles) {
-  LearnerConfig c;
-  c.batch_size = 8;
-  c.max_updates = 50;
-  c.checkpoint_every = 10;
+  LearnerConfig c = ShortRun(8, 50, 10);
   c.keep_checkpoints = 2;
-  c.request_timeout = 0.05;
-  c.out_dir = dir_.string();
   Learner learner(c, bus_.get());
   learner.Run();
   std::vector<std::string> left;
@@ -252,15 +246,10 @@ TEST_F(LearnerTest, RefusesRandomShiftsForAnEnvWithoutPixels) {
 TEST_F(LearnerTest, TrainsTd3AndPublishesItsActor) {
   obs_size_ = 3;
   continuous_ = true;
-  LearnerConfig c;
+  LearnerConfig c = ShortRun(16, 20, 10);
   c.env_id = "Pendulum-v1";
   c.algorithm = "td3";
   c.td3.hidden = {16, 16};
-  c.batch_size = 16;
-  c.max_updates = 20;
-  c.checkpoint_every = 10;
-  c.request_timeout = 0.05;
-  c.out_dir = dir_.string();
   Learner learner(c, bus_.get());
   learner.Run();
   bus_->Handle(0);
@@ -281,11 +270,7 @@ TEST_F(LearnerTest, CountsAndDropsRepliesThatDoNotFitTheEnv) {
   std::vector<rlmsg::stats_learner_t> stats;
   bus_->Subscribe<rlmsg::stats_learner_t>(
       channels::kStatsLearner, [&stats](const rlmsg::stats_learner_t& s) { stats.push_back(s); });
-  LearnerConfig c;
-  c.batch_size = 8;
-  c.max_updates = 5;
-  c.request_timeout = 0.05;
-  c.out_dir = dir_.string();
+  LearnerConfig c = ShortRun(8, 5);
   Learner learner(c, bus_.get());
   learner.Run();
   bus_->Handle(0);
@@ -296,10 +281,7 @@ TEST_F(LearnerTest, CountsAndDropsRepliesThatDoNotFitTheEnv) {
 }
 
 TEST(LearnerConfigTest, RefusesAlgorithmsThatDoNotFitTheEnv) {
-  BusConfig bc;
-  bc.url = bc.bulk_url = "memq://";
-  bc.sender = "learner";
-  Bus bus(bc);
+  Bus bus(InProcessBusConfig(0, "learner"));
   LearnerConfig c;
   c.algorithm = "td3";  // CartPole-v1 is discrete
   c.out_dir = (fs::temp_directory_path() / "learner_config_test").string();

@@ -228,6 +228,34 @@ TEST(SequentialTest, MlpGradientsThroughWeightedMseMatchFiniteDifferences) {
   CheckEndToEndGradients(/*huber=*/false);
 }
 
+// Runs clones of net's layers one by one (clones are never fused) on a random batch and expects
+// the same outputs, input gradients and parameter gradients as the (fused) network.
+void ExpectSameAsUnfusedLayers(Sequential* net, int batch, float grad_tolerance,
+                               std::mt19937* rng) {
+  std::vector<std::unique_ptr<Layer>> layers;
+  for (int i = 0; i < net->num_layers(); ++i) layers.push_back(net->layer(i).Clone());
+  const Matrix x = RandomMatrix(net->InputSize(), batch, rng);
+  const Matrix grad_out = RandomMatrix(net->OutputSize(), batch, rng);
+
+  const Matrix* h = &x;
+  for (auto& layer : layers) h = &layer->Forward(*h);
+  const Matrix* g = &grad_out;
+  for (size_t i = layers.size(); i-- > 0;) g = &layers[i]->Backward(*g);
+
+  EXPECT_TRUE(net->Forward(x).isApprox(*h, 1e-5f));
+  net->ZeroGrad();
+  EXPECT_TRUE(net->Backward(grad_out).isApprox(*g, 1e-5f));
+  std::vector<Param> expected;
+  for (auto& layer : layers) {
+    for (const Param& p : layer->Params()) expected.push_back(p);
+  }
+  const std::vector<Param> got = net->Params();
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < got.size(); ++i) {
+    EXPECT_TRUE(got[i].grad->isApprox(*expected[i].grad, grad_tolerance)) << got[i].name;
+  }
+}
+
 // Sequential fuses ReLUs into neighbouring Linear layers; running clones of the same layers one
 // by one (clones are never fused) must give the same outputs and gradients.
 TEST(SequentialTest, FusedReluGivesTheSameResultsAsSeparateLayers) {
@@ -237,28 +265,7 @@ TEST(SequentialTest, FusedReluGivesTheSameResultsAsSeparateLayers) {
     for (int batch : {1, 3, 16, 37}) {
       SCOPED_TRACE(arch + " batch " + std::to_string(batch));
       Sequential net = BuildFromArchitecture(arch, &rng);
-      std::vector<std::unique_ptr<Layer>> layers;
-      for (int i = 0; i < net.num_layers(); ++i) layers.push_back(net.layer(i).Clone());
-      const Matrix x = RandomMatrix(5, batch, &rng);
-      const Matrix grad_out = RandomMatrix(net.OutputSize(), batch, &rng);
-
-      const Matrix* h = &x;
-      for (auto& layer : layers) h = &layer->Forward(*h);
-      const Matrix* g = &grad_out;
-      for (size_t i = layers.size(); i-- > 0;) g = &layers[i]->Backward(*g);
-
-      EXPECT_TRUE(net.Forward(x).isApprox(*h, 1e-5f));
-      net.ZeroGrad();
-      EXPECT_TRUE(net.Backward(grad_out).isApprox(*g, 1e-5f));
-      std::vector<Param> expected;
-      for (auto& layer : layers) {
-        for (const Param& p : layer->Params()) expected.push_back(p);
-      }
-      const std::vector<Param> got = net.Params();
-      ASSERT_EQ(got.size(), expected.size());
-      for (size_t i = 0; i < got.size(); ++i) {
-        EXPECT_TRUE(got[i].grad->isApprox(*expected[i].grad, 1e-5f)) << got[i].name;
-      }
+      ExpectSameAsUnfusedLayers(&net, batch, 1e-5f, &rng);
     }
   }
 }
@@ -460,28 +467,7 @@ TEST(SequentialTest, FusedReluInConvNetsGivesTheSameResultsAsSeparateLayers) {
     for (int batch : {2, 9}) {
       SCOPED_TRACE(arch + " batch " + std::to_string(batch));
       Sequential net = BuildFromArchitecture(arch, &rng);
-      std::vector<std::unique_ptr<Layer>> layers;
-      for (int i = 0; i < net.num_layers(); ++i) layers.push_back(net.layer(i).Clone());
-      const Matrix x = RandomMatrix(net.InputSize(), batch, &rng);
-      const Matrix grad_out = RandomMatrix(net.OutputSize(), batch, &rng);
-
-      const Matrix* h = &x;
-      for (auto& layer : layers) h = &layer->Forward(*h);
-      const Matrix* g = &grad_out;
-      for (size_t i = layers.size(); i-- > 0;) g = &layers[i]->Backward(*g);
-
-      EXPECT_TRUE(net.Forward(x).isApprox(*h, 1e-5f));
-      net.ZeroGrad();
-      EXPECT_TRUE(net.Backward(grad_out).isApprox(*g, 1e-5f));
-      std::vector<Param> expected;
-      for (auto& layer : layers) {
-        for (const Param& p : layer->Params()) expected.push_back(p);
-      }
-      const std::vector<Param> got = net.Params();
-      ASSERT_EQ(got.size(), expected.size());
-      for (size_t i = 0; i < got.size(); ++i) {
-        EXPECT_TRUE(got[i].grad->isApprox(*expected[i].grad, 1e-4f)) << got[i].name;
-      }
+      ExpectSameAsUnfusedLayers(&net, batch, 1e-4f, &rng);
     }
   }
 }

@@ -98,6 +98,33 @@ TEST(RateLimiterTest, NeverBlocksBothSidesForBatchesUpToTheLimit) {
   EXPECT_GT(limiter.samples(), 0);
 }
 
+// The credit is exactly the number of single inserts CanInsert admits, before and after min_size,
+// and never negative; -1 without a ratio.
+TEST(RateLimiterTest, InsertCreditCountsTheInsertsCanInsertAdmits) {
+  RateLimiter limiter(Options(4.0, 10, 8.0));  // max_diff = 48
+  const auto admitted = [](RateLimiter copy) {
+    int64_t n = 0;
+    while (copy.CanInsert(1) && n < 1000) {
+      copy.Insert(1);
+      ++n;
+    }
+    return n;
+  };
+  EXPECT_EQ(limiter.InsertCredit(), 12);  // (48 - 0) / 4
+  EXPECT_EQ(limiter.InsertCredit(), admitted(limiter));
+  limiter.Insert(7);
+  EXPECT_EQ(limiter.InsertCredit(), admitted(limiter));
+  limiter.Insert(5);  // 12 in: diff 48, at the limit
+  EXPECT_EQ(limiter.InsertCredit(), 0);
+  EXPECT_FALSE(limiter.CanInsert(1));
+  limiter.Insert(3);  // stored anyway: diff 60, past the limit
+  EXPECT_EQ(limiter.InsertCredit(), 0);
+  limiter.Sample(22);  // diff 38
+  EXPECT_EQ(limiter.InsertCredit(), 2);
+  EXPECT_EQ(limiter.InsertCredit(), admitted(limiter));
+  EXPECT_EQ(RateLimiter(Options(0.0, 10, 8.0)).InsertCredit(), -1);
+}
+
 TEST(RateLimiterTest, ZeroSamplesPerInsertDisablesTheRatio) {
   RateLimiter limiter(Options(0.0, 10, 0));
   EXPECT_EQ(limiter.max_sample_batch(), 0);

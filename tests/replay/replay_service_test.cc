@@ -22,14 +22,7 @@ namespace {
 
 constexpr int64_t kRunId = 42;
 
-BusConfig MemqConfig() {
-  BusConfig c;
-  c.url = "memq://";
-  c.bulk_url = "memq://";
-  c.run_id = kRunId;
-  c.sender = "replay";
-  return c;
-}
+BusConfig MemqConfig() { return InProcessBusConfig(kRunId, "replay"); }
 
 ReplayServiceOptions Options(double spi, int64_t min_size, double error_buffer) {
   ReplayServiceOptions o;
@@ -246,6 +239,20 @@ TEST_F(ReplayServiceTest, FlowControlPausesActorsThatRunAheadAndResumesThemAfter
   ASSERT_EQ(flows_.size(), 2U);
   EXPECT_EQ(flows_[1].insert_allowed, 1);
   EXPECT_TRUE(service_->insert_allowed());
+  // The credit: (max_diff - diff) / SPI = 20 - 10 transitions, and what each actor has stored.
+  EXPECT_EQ(flows_[0].insert_credit, 0);
+  EXPECT_EQ(flows_[1].insert_credit, 10);
+  EXPECT_EQ(flows_[1].actor_id, std::vector<int32_t>{0});
+  EXPECT_EQ(flows_[1].actor_inserts, std::vector<int64_t>{22});
+
+  // Samples that raise the credit by a quarter of its range (2 * 10 / 1 / 4 = 5) announce it.
+  SendRequest(2, 4);  // credit 14: not yet
+  Pump();
+  EXPECT_EQ(flows_.size(), 2U);
+  SendRequest(3, 1);  // credit 15
+  Pump();
+  ASSERT_EQ(flows_.size(), 3U);
+  EXPECT_EQ(flows_[2].insert_credit, 15);
 }
 
 TEST_F(ReplayServiceTest, DropsForeignAndNonFiniteBatchesAndKeepsWorking) {

@@ -13,15 +13,10 @@
 namespace rl::envs {
 namespace {
 
-constexpr Rgb kBlack{0, 0, 0};
-constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kLanderFill{128, 102, 230};
 constexpr Rgb kLanderOutline{77, 77, 128};
 constexpr Rgb kFlag{204, 204, 0};
 
-using testing::Blob;
-using testing::FindColor;
-using testing::Image;
 
 Image RenderAt(LunarLander& env, const LanderKinematics& k) {
   env.SetLanderKinematics(k);
@@ -143,14 +138,12 @@ TEST(LunarLanderRenderTest, RenderSizedScalesThePicture) {
   EXPECT_THROW(env.RenderSized(10, -1, &tiny.rgb), std::invalid_argument);
 }
 
-TEST(LunarLanderRenderTest, RenderThroughTheRegistryWorksAfterReset) {
+// (Render before Reset and the native size of every id: specs_test.cc.)
+TEST(LunarLanderRenderTest, RenderThroughTheRegistryDrawsTheLander) {
   auto env = MakeEnv("LunarLanderContinuous-v3");
-  Image image;
-  EXPECT_THROW(env->Render(&image.rgb, &image.width, &image.height), std::logic_error);
   env->Reset(0);
+  Image image;
   env->Render(&image.rgb, &image.width, &image.height);
-  EXPECT_EQ(image.width, 600);
-  EXPECT_EQ(image.height, 400);
   // The lander starts at the top edge (y = H), so the upper part of its hull is cut off.
   EXPECT_GT(FindColor(image, kLanderFill).count, 200);
   EXPECT_EQ(image.at(300, 5), kLanderFill);

@@ -16,6 +16,7 @@
 
 #include "envs/registry.h"
 #include "envs/time_limit.h"
+#include "tests/envs/trajectory_hash.h"
 
 namespace rl::envs {
 namespace {
@@ -41,21 +42,6 @@ void PlaceAbovePad(LunarLander& env) {
   env.SetLanderKinematics(LanderKinematics{.x = 10.0, .y = PadHeight(env) + 0.65});
 }
 
-// FNV-1a over the bytes of the values added.
-class TrajectoryHash {
- public:
-  template <typename T>
-  void Add(const T& value) {
-    unsigned char bytes[sizeof(T)];
-    std::memcpy(bytes, &value, sizeof(T));
-    for (unsigned char b : bytes) hash_ = (hash_ ^ b) * 1099511628211ULL;
-  }
-  uint64_t value() const { return hash_; }
-
- private:
-  uint64_t hash_ = 14695981039346656037ULL;
-};
-
 // Plays one random-policy episode of MakeEnv("LunarLander-v3") from `seed` and returns the
 // observations of every step, flattened.
 std::vector<float> RandomEpisode(uint64_t seed, uint64_t policy_seed) {
@@ -70,26 +56,6 @@ std::vector<float> RandomEpisode(uint64_t seed, uint64_t policy_seed) {
     trace.push_back(static_cast<float>(r.reward));
   } while (!r.terminated && !r.truncated);
   return trace;
-}
-
-TEST(LunarLanderTest, DiscreteAndContinuousSpecsMatchTheV3Registrations) {
-  LunarLander discrete;
-  EXPECT_EQ(discrete.spec().id, "LunarLander-v3");
-  EXPECT_EQ(discrete.spec().observation_size, 8);
-  EXPECT_EQ(discrete.spec().num_actions, 4);
-  EXPECT_EQ(discrete.spec().action_dim, 0);
-  EXPECT_EQ(discrete.spec().max_episode_steps, 1000);
-  EXPECT_EQ(discrete.spec().reward_threshold, 200.0);
-
-  LunarLander continuous = ContinuousLander();
-  EXPECT_EQ(continuous.spec().id, "LunarLanderContinuous-v3");
-  EXPECT_EQ(continuous.spec().observation_size, 8);
-  EXPECT_EQ(continuous.spec().num_actions, 0);
-  EXPECT_EQ(continuous.spec().action_dim, 2);
-  EXPECT_EQ(continuous.spec().action_low, (std::vector<float>{-1.0f, -1.0f}));
-  EXPECT_EQ(continuous.spec().action_high, (std::vector<float>{1.0f, 1.0f}));
-  EXPECT_EQ(continuous.spec().max_episode_steps, 1000);
-  EXPECT_EQ(continuous.spec().reward_threshold, 200.0);
 }
 
 TEST(LunarLanderTest, ConfigRejectsGravityOutsideTheOpenIntervalAndNonFinitePowers) {
