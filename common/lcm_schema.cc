@@ -6,7 +6,6 @@
 #include <stdexcept>
 #include <utility>
 
-
 namespace rl {
 namespace {
 
@@ -50,9 +49,9 @@ std::vector<std::string> Tokenize(std::string_view text, const std::string& file
 
 // Encoded size of a primitive type, 0 for a string, -1 for anything else (a struct).
 int PrimitiveSize(const std::string& type) {
-  static const std::map<std::string, int> sizes = {
-      {"int8_t", 1}, {"byte", 1},  {"boolean", 1}, {"int16_t", 2}, {"int32_t", 4},
-      {"float", 4},  {"int64_t", 8}, {"double", 8},  {"string", 0}};
+  static const std::map<std::string, int> sizes = {{"int8_t", 1},  {"byte", 1},    {"boolean", 1},
+                                                   {"int16_t", 2}, {"int32_t", 4}, {"float", 4},
+                                                   {"int64_t", 8}, {"double", 8},  {"string", 0}};
   const auto it = sizes.find(type);
   return it == sizes.end() ? -1 : it->second;
 }
@@ -64,7 +63,7 @@ bool IsInteger(const std::string& type) {
 // A struct compiled for walking: per field its element kind and its dimensions.
 constexpr int kMaxFields = 64;
 struct Op {
-  int size = 0;                 // primitive bytes; 0: string; -1: struct
+  int size = 0;                           // primitive bytes; 0: string; -1: struct
   const struct Program* inner = nullptr;  // the struct's program when size == -1
   // Dimensions: a constant (field < 0) or the value of an earlier field.
   std::vector<std::pair<int64_t, int>> dims;
@@ -157,7 +156,8 @@ const Program& Compile(const std::string& name, Compiled* c) {
     throw std::invalid_argument("lcmtypes: no schema for struct '" + name + "'");
   }
   for (const std::string& open : c->compiling) {
-    if (open == name) throw std::invalid_argument("lcmtypes: struct '" + name + "' contains itself");
+    if (open == name)
+      throw std::invalid_argument("lcmtypes: struct '" + name + "' contains itself");
   }
   c->compiling.push_back(name);
   Program program;

@@ -3,9 +3,9 @@
 // Prescan() walks the encoded bytes of a message and checks that every string and array length
 // fits in the buffer, before lcm-gen's decoder sizes a vector from a length it has not checked
 // (a forged length would otherwise make a daemon allocate gigabytes). It follows the type's .lcm
-// file itself (common/lcm_schema.h), so it cannot fall out of step with the types. Validate() checks the
-// decoded content: sizes consistent, numbers finite, indices in range. Both return nullptr for a
-// good message, or a short reason for the drop counters and logs.
+// file itself (common/lcm_schema.h), so it cannot fall out of step with the types. Validate()
+// checks the decoded content: sizes consistent, numbers finite, indices in range. Both return
+// nullptr for a good message, or a short reason for the drop counters and logs.
 #pragma once
 
 #include <cstddef>

@@ -44,16 +44,12 @@ CartPole::CartPole(const CartPoleConfig& config) : spec_(CartPoleSpec()), config
 }
 
 void CartPole::Reset(uint64_t seed) {
-  SeedRng(seed, rng_);
-  rng_seeded_ = true;
+  rng_.Seed(seed);
   SampleInitialState();
 }
 
 void CartPole::Reset() {
-  if (!rng_seeded_) {
-    SeedRngRandomly(rng_);
-    rng_seeded_ = true;
-  }
+  rng_.SeedIfUnseeded();
   SampleInitialState();
 }
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "envs/env.h"
+#include "envs/rng.h"
 
 namespace rl::envs {
 
@@ -98,8 +99,7 @@ class CartPole : public Env {
 
   EnvSpec spec_;
   CartPoleConfig config_;
-  std::mt19937_64 rng_;
-  bool rng_seeded_ = false;
+  EnvRng rng_;
   bool has_state_ = false;  // Reset or set_state has been called.
   std::array<double, 4> state_{};
   std::array<float, 4> observation_{};

@@ -38,16 +38,12 @@ Catch::Catch() : spec_(CatchSpec()) {
 }
 
 void Catch::Reset(uint64_t seed) {
-  SeedRng(seed, rng_);
-  rng_seeded_ = true;
+  rng_.Seed(seed);
   SampleInitialState();
 }
 
 void Catch::Reset() {
-  if (!rng_seeded_) {
-    SeedRngRandomly(rng_);
-    rng_seeded_ = true;
-  }
+  rng_.SeedIfUnseeded();
   SampleInitialState();
 }
 

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "envs/env.h"
+#include "envs/rng.h"
 
 namespace rl::envs {
 
@@ -82,8 +83,7 @@ class Catch : public Env {
   void UpdateObservation();
 
   EnvSpec spec_;
-  std::mt19937_64 rng_;
-  bool rng_seeded_ = false;
+  EnvRng rng_;
   bool has_state_ = false;  // Reset has been called.
   int ball_row_ = 0;
   int ball_column_ = 0;

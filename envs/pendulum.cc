@@ -62,16 +62,12 @@ double Pendulum::AngleNormalize(double x) {
 }
 
 void Pendulum::Reset(uint64_t seed) {
-  SeedRng(seed, rng_);
-  rng_seeded_ = true;
+  rng_.Seed(seed);
   SampleInitialState();
 }
 
 void Pendulum::Reset() {
-  if (!rng_seeded_) {
-    SeedRngRandomly(rng_);
-    rng_seeded_ = true;
-  }
+  rng_.SeedIfUnseeded();
   SampleInitialState();
 }
 

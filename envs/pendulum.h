@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "envs/env.h"
+#include "envs/rng.h"
 
 namespace rl::envs {
 
@@ -102,8 +103,7 @@ class Pendulum : public Env {
 
   EnvSpec spec_;
   PendulumConfig config_;
-  std::mt19937_64 rng_;
-  bool rng_seeded_ = false;
+  EnvRng rng_;
   bool has_state_ = false;  // Reset or SetState has been called.
   double theta_ = 0;
   double theta_dot_ = 0;

@@ -34,4 +34,14 @@ int64_t UniformInt(std::mt19937_64& rng, int64_t low, int64_t high) {
   }
 }
 
+void EnvRng::Seed(uint64_t seed) {
+  SeedRng(seed, *this);
+  seeded_ = true;
+}
+
+void EnvRng::SeedIfUnseeded() {
+  if (!seeded_) SeedRngRandomly(*this);
+  seeded_ = true;
+}
+
 }  // namespace rl::envs

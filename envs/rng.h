@@ -14,6 +14,21 @@ void SeedRng(uint64_t seed, std::mt19937_64& rng);
 /// Seeds `rng` from std::random_device (for a Reset() that comes before any seeded Reset).
 void SeedRngRandomly(std::mt19937_64& rng);
 
+/// The RNG an env owns, with Gymnasium's seeding rule: Reset(seed) seeds it (Seed), and a Reset()
+/// without a seed continues its stream, seeded from std::random_device first if it never was
+/// (SeedIfUnseeded). It is the generator itself, so it goes wherever a std::mt19937_64 does.
+/// Copies continue the same stream.
+class EnvRng : public std::mt19937_64 {
+ public:
+  /// SeedRng(seed, *this).
+  void Seed(uint64_t seed);
+  /// SeedRngRandomly(*this) unless Seed or SeedIfUnseeded came before.
+  void SeedIfUnseeded();
+
+ private:
+  bool seeded_ = false;
+};
+
 /// A double uniform in [low, high) from 53 random bits, as numpy's Generator.uniform computes it:
 /// low + (high - low) * u with u = (bits >> 11) * 2^-53. One draw.
 double UniformDouble(std::mt19937_64& rng, double low, double high);

@@ -102,32 +102,30 @@ void ActionValueNet::ZeroGrad() {
   for (Sequential* part : Parts()) part->ZeroGrad();
 }
 
-std::vector<Param> ActionValueNet::Params() {
-  std::vector<Param> all;
+namespace {
+
+// Every part's items (Params or Buffers), each name prefixed with its part's: obs., act., head.
+template <class Item, class Get>
+std::vector<Item> Prefixed(const std::vector<Sequential*>& parts, Get get) {
+  std::vector<Item> all;
   const char* prefixes[] = {"obs.", "act.", "head."};
-  int k = 0;
-  for (Sequential* part : Parts()) {
-    for (Param p : part->Params()) {
-      p.name = prefixes[k] + p.name;
-      all.push_back(std::move(p));
+  for (size_t k = 0; k < parts.size(); ++k) {
+    for (Item item : get(parts[k])) {
+      item.name = prefixes[k] + item.name;
+      all.push_back(std::move(item));
     }
-    ++k;
   }
   return all;
 }
 
+}  // namespace
+
+std::vector<Param> ActionValueNet::Params() {
+  return Prefixed<Param>(Parts(), [](Sequential* s) { return s->Params(); });
+}
+
 std::vector<Buffer> ActionValueNet::Buffers() {
-  std::vector<Buffer> all;
-  const char* prefixes[] = {"obs.", "act.", "head."};
-  int k = 0;
-  for (Sequential* part : Parts()) {
-    for (Buffer b : part->Buffers()) {
-      b.name = prefixes[k] + b.name;
-      all.push_back(std::move(b));
-    }
-    ++k;
-  }
-  return all;
+  return Prefixed<Buffer>(Parts(), [](Sequential* s) { return s->Buffers(); });
 }
 
 void ActionValueNet::set_training(bool training) {

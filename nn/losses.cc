@@ -43,8 +43,9 @@ float HuberLoss(const Vector& pred, const Vector& target, Vector* grad, float de
 }
 
 float MseLoss(const Vector& pred, const Vector& target, Vector* grad, const Vector* weights) {
-  return WeightedMean("MseLoss", pred, target, grad, weights,
-                      [](float e) { return std::pair{e * e, 2.0f * e}; });
+  return WeightedMean("MseLoss", pred, target, grad, weights, [](float e) {
+    return std::pair{e * e, 2.0f * e};
+  });
 }
 
 }  // namespace rl::nn

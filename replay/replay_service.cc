@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "common/channels.h"
@@ -43,48 +44,34 @@ ReplayServiceOptions Validated(ReplayServiceOptions options) {
 void ReplayServiceOptions::Validate() const {
   table.Validate();
   limiter.Validate();
-  if (insert_unit < 1) {
-    throw std::invalid_argument("replay service: insert_unit must be at least 1, got " +
-                                std::to_string(insert_unit));
-  }
-  if (max_pending_requests < 1) {
-    throw std::invalid_argument("replay service: max_pending_requests must be at least 1, got " +
-                                std::to_string(max_pending_requests));
-  }
-  if (max_reply_bytes < 1024) {
-    throw std::invalid_argument("replay service: max_reply_bytes must be at least 1024, got " +
-                                std::to_string(max_reply_bytes));
-  }
+  // Throws "replay service: <name> must be <rule>, got <value>" unless ok.
+  const auto require = [](bool ok, const char* name, const char* rule, auto value) {
+    if (ok) return;
+    std::string got;
+    if constexpr (std::is_integral_v<decltype(value)>) {
+      got = std::to_string(value);
+    } else {
+      got = Str(value);
+    }
+    throw std::invalid_argument(std::string("replay service: ") + name + " must be " + rule +
+                                ", got " + got);
+  };
+  require(insert_unit >= 1, "insert_unit", "at least 1", insert_unit);
+  require(max_pending_requests >= 1, "max_pending_requests", "at least 1", max_pending_requests);
+  require(max_reply_bytes >= 1024, "max_reply_bytes", "at least 1024", max_reply_bytes);
   CheckRate("flow_hz", flow_hz);
   CheckRate("stats_hz", stats_hz);
-  if (!std::isfinite(progress_seconds) || progress_seconds < 0) {
-    throw std::invalid_argument("replay service: progress_seconds must be >= 0 (0: none), got " +
-                                Str(progress_seconds));
-  }
+  require(std::isfinite(progress_seconds) && progress_seconds >= 0, "progress_seconds",
+          ">= 0 (0: none)", progress_seconds);
   if (prioritized) {
-    if (!std::isfinite(alpha) || alpha < 0) {
-      throw std::invalid_argument("replay service: alpha must be >= 0, got " + Str(alpha));
-    }
-    if (!std::isfinite(beta) || beta < 0 || beta > 1) {
-      throw std::invalid_argument("replay service: beta must be in [0, 1], got " + Str(beta));
-    }
-    if (!std::isfinite(priority_epsilon) || priority_epsilon <= 0) {
-      throw std::invalid_argument("replay service: priority_epsilon must be > 0, got " +
-                                  Str(priority_epsilon));
-    }
+    require(std::isfinite(alpha) && alpha >= 0, "alpha", ">= 0", alpha);
+    require(std::isfinite(beta) && beta >= 0 && beta <= 1, "beta", "in [0, 1]", beta);
+    require(std::isfinite(priority_epsilon) && priority_epsilon > 0, "priority_epsilon", "> 0",
+            priority_epsilon);
   }
-  if (beta_anneal_samples < 0) {
-    throw std::invalid_argument("replay service: beta_anneal_samples must be >= 0, got " +
-                                std::to_string(beta_anneal_samples));
-  }
-  if (frame_capacity < 0) {
-    throw std::invalid_argument("replay service: frame_capacity must be >= 0, got " +
-                                std::to_string(frame_capacity));
-  }
-  if (handle_timeout_ms < 0) {
-    throw std::invalid_argument("replay service: handle_timeout_ms must be >= 0, got " +
-                                std::to_string(handle_timeout_ms));
-  }
+  require(beta_anneal_samples >= 0, "beta_anneal_samples", ">= 0", beta_anneal_samples);
+  require(frame_capacity >= 0, "frame_capacity", ">= 0", frame_capacity);
+  require(handle_timeout_ms >= 0, "handle_timeout_ms", ">= 0", handle_timeout_ms);
 }
 
 double ReplayService::IntervalRate::Take(int64_t count, double now) {

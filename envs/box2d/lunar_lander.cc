@@ -134,16 +134,12 @@ LunarLander::LunarLander(LunarLander&&) noexcept = default;
 LunarLander& LunarLander::operator=(LunarLander&&) noexcept = default;
 
 void LunarLander::Reset(uint64_t seed) {
-  SeedRng(seed, rng_);
-  rng_seeded_ = true;
+  rng_.Seed(seed);
   StartEpisode();
 }
 
 void LunarLander::Reset() {
-  if (!rng_seeded_) {
-    SeedRngRandomly(rng_);
-    rng_seeded_ = true;
-  }
+  rng_.SeedIfUnseeded();
   StartEpisode();
 }
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "envs/env.h"
+#include "envs/rng.h"
 
 namespace rl::envs {
 
@@ -194,8 +195,7 @@ class LunarLander : public Env {
 
   EnvSpec spec_;
   LunarLanderConfig config_;
-  std::mt19937_64 rng_;
-  bool rng_seeded_ = false;
+  EnvRng rng_;
   std::unique_ptr<Physics> physics_;  // Null until the first Reset.
   std::array<double, kChunks> chunk_x_{};
   std::array<double, kChunks> smooth_y_{};

@@ -80,16 +80,12 @@ KukaDiverseObjectEnv::KukaDiverseObjectEnv(const KukaDiverseObjectConfig& config
 KukaDiverseObjectEnv::~KukaDiverseObjectEnv() = default;
 
 void KukaDiverseObjectEnv::Reset(uint64_t seed) {
-  SeedRng(seed, rng_);
-  rng_seeded_ = true;
+  rng_.Seed(seed);
   StartEpisode();
 }
 
 void KukaDiverseObjectEnv::Reset() {
-  if (!rng_seeded_) {
-    SeedRngRandomly(rng_);
-    rng_seeded_ = true;
-  }
+  rng_.SeedIfUnseeded();
   StartEpisode();
 }
 

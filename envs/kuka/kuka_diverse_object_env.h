@@ -43,6 +43,7 @@
 #include "envs/kuka/kuka_camera.h"
 #include "envs/kuka/kuka_objects.h"
 #include "envs/kuka/kuka_scene.h"
+#include "envs/rng.h"
 
 namespace rl::envs {
 namespace kuka {
@@ -163,8 +164,7 @@ class KukaDiverseObjectEnv : public Env {
   std::unique_ptr<kuka::KukaScene> scene_;
   mutable std::unique_ptr<kuka::KukaRenderer> renderer_;  // Created by the first Render.
   mutable std::vector<kuka::DrawItem> draw_items_;
-  std::mt19937_64 rng_;
-  bool rng_seeded_ = false;
+  EnvRng rng_;
   bool has_state_ = false;
   kuka::CameraParams camera_;
   std::vector<int> object_ids_;

@@ -84,9 +84,9 @@ TEST(LcmSchemaTest, RefusesWhatItCannotReadWithTheFileName) {
 // Every type of lcmtypes/ is embedded, under its file's name.
 TEST(LcmSchemaTest, EmbedsEveryMessageType) {
   for (const char* type :
-       {"header_t", "transition_batch_t", "sample_batch_t", "sample_request_t",
-        "priority_update_t", "flow_control_t", "weights_chunk_t", "checkpoint_t", "eval_result_t",
-        "stats_actor_t", "stats_replay_t", "stats_learner_t", "stats_evaluator_t"}) {
+       {"header_t", "transition_batch_t", "sample_batch_t", "sample_request_t", "priority_update_t",
+        "flow_control_t", "weights_chunk_t", "checkpoint_t", "eval_result_t", "stats_actor_t",
+        "stats_replay_t", "stats_learner_t", "stats_evaluator_t"}) {
     ASSERT_EQ(LcmSchemas().count(type), 1u) << type;
     EXPECT_EQ(LcmSchemas().at(type).package, "rlmsg") << type;
   }
@@ -162,7 +162,8 @@ TEST(LcmSchemaTest, PrescanRefusesForgedLengths) {
   const size_t at = 8 + 8 + 4 + p.header.sender.size() + 1 + 16;
   ASSERT_EQ(bytes[at + 3], 1);
   for (const uint32_t forged : {0x7fffffffu, 0x80000000u, 2u, 0u}) {
-    for (int k = 0; k < 4; ++k) bytes[at + static_cast<size_t>(k)] = (forged >> (24 - 8 * k)) & 0xff;
+    for (int k = 0; k < 4; ++k)
+      bytes[at + static_cast<size_t>(k)] = (forged >> (24 - 8 * k)) & 0xff;
     EXPECT_NE(PrescanEncoded("priority_update_t", bytes.data(), bytes.size()), nullptr) << forged;
   }
   // A string length of 0 (lcm strings carry their NUL) and one past the end.

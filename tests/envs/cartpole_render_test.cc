@@ -18,7 +18,6 @@ namespace {
 constexpr Rgb kPole{202, 152, 101};
 constexpr Rgb kAxle{129, 132, 203};
 
-
 Image RenderState(const std::array<double, 4>& state) {
   CartPole env;
   env.set_state(state);

@@ -17,8 +17,6 @@
 namespace rl::envs {
 namespace {
 
-
-
 // Index of cell (row, column) in the flat observation.
 int Cell(int row, int column) { return row * Catch::kColumns + column; }
 

@@ -21,7 +21,6 @@ constexpr double kScale = 500 / 4.4;
 constexpr double kAxleX = 250.5;
 constexpr double kAxleY = 249.5;
 
-
 Image RenderState(double theta, double theta_dot = 0) {
   Pendulum env;
   env.SetState(theta, theta_dot);

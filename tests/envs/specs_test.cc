@@ -66,8 +66,9 @@ TEST(SpecsTest, SpecsHoldTheReferencesValues) {
 }
 
 // The static spec of every registered id is the spec of the env MakeEnv builds, Render() refuses
-// to draw before the first Reset, and the native render size is what it draws (KUKA is left out: building it needs an OpenGL context per
-// id, and its spec is checked against the env in its own tests).
+// to draw before the first Reset, and the native render size is what it draws (KUKA is left out:
+// building it needs an OpenGL context per id, and its spec is checked against the env in its own
+// tests).
 TEST(SpecsTest, EveryRegisteredIdHasTheSpecOfTheEnvItBuilds) {
   for (const std::string& id : RegisteredEnvs()) {
     if (id.rfind("Kuka", 0) == 0) continue;

@@ -9,7 +9,6 @@
 namespace rl::nn {
 namespace {
 
-
 // Inputs in +-[0.1, 2], away from ReLU's kink at 0 relative to the finite-difference step.
 Matrix AwayFromZero(int rows, int cols, std::mt19937* rng) {
   Matrix x = RandomMatrix(rows, cols, rng, 2.0f);

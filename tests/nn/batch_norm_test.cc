@@ -12,7 +12,6 @@
 namespace rl::nn {
 namespace {
 
-
 // Two channels of 1 x 2 images, batch 2. Channel 0 holds 1, 3 | 5, 7 (mean 4, biased variance 5,
 // unbiased 20/3); channel 1 holds 0, 0 | 2, -2 (mean 0, biased variance 2, unbiased 8/3).
 Matrix TinyBatch() {

@@ -13,7 +13,6 @@
 namespace rl::nn {
 namespace {
 
-
 // The geometry of one test convolution.
 struct ConvCase {
   int in_channels;

@@ -12,7 +12,6 @@
 namespace rl::nn {
 namespace {
 
-
 TEST(DuelingTest, OutputIsValuePlusAdvantageMinusMeanAdvantage) {
   std::mt19937 rng(1);
   Dueling head(6, 10, 4, &rng);

@@ -11,7 +11,6 @@
 namespace rl::nn::internal {
 namespace {
 
-
 // Compares Gemm with Eigen for c (m x n) = op(a) * op(b) (+ biases) over every combination of
 // transposed operands, transposed output, accumulation, row bias and column bias.
 void CheckAgainstEigen(int m, int n, int k) {

@@ -11,7 +11,6 @@
 namespace rl::nn {
 namespace {
 
-
 TEST(LayerNormTest, NormalisesEachColumnOverItsFeatures) {
   LayerNorm ln(4);
   Matrix x(4, 2);

@@ -11,7 +11,6 @@
 namespace rl::nn {
 namespace {
 
-
 // Checks input, weight and bias gradients of a Linear layer against finite differences of
 // loss = sum(r .* layer(x)).
 void CheckLinearGradients(int in, int out, int batch) {

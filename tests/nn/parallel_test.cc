@@ -23,7 +23,6 @@
 namespace rl::nn {
 namespace {
 
-
 // Sets the thread count for one scope and restores 1 (the default) after it.
 class Threads {
  public:

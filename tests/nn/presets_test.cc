@@ -12,7 +12,6 @@
 namespace rl::nn {
 namespace {
 
-
 std::vector<float> Flat(const Sequential& net) {
   std::vector<float> flat;
   net.GetFlat(&flat);

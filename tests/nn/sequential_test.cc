@@ -16,7 +16,6 @@
 namespace rl::nn {
 namespace {
 
-
 constexpr char kCartPoleArch[] = "linear(4,120),relu,linear(120,84),relu,linear(84,2)";
 
 std::vector<float> Flat(const Sequential& net) {

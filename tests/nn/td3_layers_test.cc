@@ -19,7 +19,6 @@
 namespace rl::nn {
 namespace {
 
-
 TEST(BoundedTest, MapsTanhOntoEachDimensionsBounds) {
   Bounded b({-1.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 2.0f});
   Matrix x(3, 2);

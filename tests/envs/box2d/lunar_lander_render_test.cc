@@ -17,7 +17,6 @@ constexpr Rgb kLanderFill{128, 102, 230};
 constexpr Rgb kLanderOutline{77, 77, 128};
 constexpr Rgb kFlag{204, 204, 0};
 
-
 Image RenderAt(LunarLander& env, const LanderKinematics& k) {
   env.SetLanderKinematics(k);
   Image image;
