@@ -214,12 +214,7 @@ void Actor::PublishStats() {
   s.actor_id = config_.actor_id;
   s.env_steps = env_steps_;
   s.episodes = episodes_;
-  const double dt = now - stats_last_time_;
-  s.steps_per_second = (stats_last_time_ > 0 && dt > 0)
-                           ? static_cast<double>(env_steps_ - stats_last_steps_) / dt
-                           : 0.0;
-  stats_last_time_ = now;
-  stats_last_steps_ = env_steps_;
+  s.steps_per_second = steps_rate_.Take(env_steps_, now);
   s.mean_return = mean_return();
   s.epsilon = exploration();
   s.weights_version = weights_version_;

@@ -22,6 +22,7 @@
 #include "actor/nstep.h"
 #include "actor/policy.h"
 #include "actor/weights_assembler.h"
+#include "common/clock.h"
 #include "common/lcm_bus.h"
 #include "envs/env.h"
 #include "rlmsg/transition_batch_t.hpp"
@@ -133,8 +134,7 @@ class Actor {
   bool pixels_ = false;  // the env gives frames
   int64_t next_frame_id_ = 0;
 
-  double stats_last_time_ = 0;
-  int64_t stats_last_steps_ = 0;
+  RateMeter steps_rate_;
 };
 
 }  // namespace rl::actor

@@ -18,26 +18,24 @@ inline double MonoSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// Counts events and reports their rate over the interval since the last call of Rate().
+// The rate of a growing count over the interval between two readings: the stats of every
+// process (steps/s, updates/s, inserts/s). Not thread-safe.
 class RateMeter {
  public:
-  void Add(int64_t n = 1) { count_ += n; }
-  // Events per second since the previous call (0 on the first call).
-  double Rate() {
-    const double now = MonoSeconds();
+  // (count - count at the previous call) / (now - time of the previous call), in events per
+  // second; 0 on the first call and when no time has passed.
+  double Take(int64_t count, double now) {
     const double dt = now - last_time_;
     const double rate =
-        (last_time_ > 0 && dt > 0) ? static_cast<double>(count_ - last_count_) / dt : 0.0;
+        (last_time_ >= 0 && dt > 0) ? static_cast<double>(count - last_count_) / dt : 0.0;
     last_time_ = now;
-    last_count_ = count_;
+    last_count_ = count;
     return rate;
   }
-  int64_t count() const { return count_; }
 
  private:
-  int64_t count_ = 0;
   int64_t last_count_ = 0;
-  double last_time_ = 0;
+  double last_time_ = -1.0;
 };
 
 }  // namespace rl

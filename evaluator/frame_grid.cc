@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "common/atomic_file.h"
 #include "envs/registry.h"
 #include "evaluator/report.h"
 #include "evaluator/scorer.h"

@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "common/atomic_file.h"
 #include "evaluator/flat_json.h"
 #include "evaluator/learning_curve.h"
 
@@ -225,39 +226,6 @@ std::string HtmlEscape(const std::string& text) {
     }
   }
   return out;
-}
-
-void WriteFileAtomically(const std::string& path, const std::string& content) {
-  const std::string tmp = path + ".tmp";
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) ThrowIo("create", tmp);
-  size_t done = 0;
-  while (done < content.size()) {
-    const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int saved_errno = errno;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      errno = saved_errno;
-      ThrowIo("write", tmp);
-    }
-    done += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    const int saved_errno = errno;
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    errno = saved_errno;
-    ThrowIo("sync", tmp);
-  }
-  ::close(fd);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int saved_errno = errno;
-    ::unlink(tmp.c_str());
-    errno = saved_errno;
-    ThrowIo("rename into", path);
-  }
 }
 
 void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,

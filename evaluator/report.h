@@ -91,8 +91,4 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
 /// Escapes &, <, >, " and ' for HTML text and attribute values.
 std::string HtmlEscape(const std::string& text);
 
-/// Writes `content` to `path` atomically: a temporary file next to it, fsync, rename. Throws
-/// std::runtime_error naming the file on an I/O error.
-void WriteFileAtomically(const std::string& path, const std::string& content);
-
 }  // namespace rl::evaluator

@@ -1,7 +1,6 @@
 #include "evaluator/video.h"
 
 #include <cstdio>
-#include <filesystem>
 #include <stdexcept>
 #include <vector>
 
@@ -9,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include "common/atomic_file.h"
 #include "envs/registry.h"
 #include "evaluator/scorer.h"
 
@@ -53,12 +53,7 @@ VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, ui
     if (r.terminated || r.truncated) break;
   }
   writer.release();
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::filesystem::remove(tmp, ec);
-    throw std::runtime_error("cannot write video " + path);
-  }
+  RenameIntoPlace(tmp, path, "video");
   return result;
 }
 

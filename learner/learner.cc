@@ -170,10 +170,7 @@ std::string Learner::Checkpoint() {
 void Learner::PublishStats(double now) {
   rlmsg::stats_learner_t s{};
   s.updates = algorithm_->updates();
-  const double dt = now - stats_last_time_;
-  s.updates_per_second = (stats_last_time_ > 0 && dt > 0)
-                             ? static_cast<double>(s.updates - stats_last_updates_) / dt
-                             : 0.0;
+  s.updates_per_second = updates_rate_.Take(s.updates, now);
   s.samples_per_second = s.updates_per_second * config_.batch_size;
   s.loss = stat_updates_ > 0 ? loss_sum_ / static_cast<double>(stat_updates_) : 0.0;
   s.mean_q = stat_updates_ > 0 ? q_sum_ / static_cast<double>(stat_updates_) : 0.0;
@@ -184,8 +181,6 @@ void Learner::PublishStats(double now) {
   bus_->FillCounters(&s);
   s.dropped_invalid += batches_refused_;
   bus_->Publish(channels::kStatsLearner, &s);
-  stats_last_time_ = now;
-  stats_last_updates_ = s.updates;
   loss_sum_ = q_sum_ = 0;
   stat_updates_ = 0;
 }

@@ -14,6 +14,7 @@
 #include <memory>
 #include <string>
 
+#include "common/clock.h"
 #include "common/lcm_bus.h"
 #include "envs/env.h"
 #include "learner/algorithm.h"
@@ -107,8 +108,7 @@ class Learner {
   // Stats since the last stats message.
   double loss_sum_ = 0, q_sum_ = 0;
   int64_t stat_updates_ = 0;
-  double stats_last_time_ = 0;
-  int64_t stats_last_updates_ = 0;
+  RateMeter updates_rate_;
 };
 
 }  // namespace rl::learner

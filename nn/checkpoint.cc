@@ -12,6 +12,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "common/atomic_file.h"
 #include "common/crc32.h"
 #include "nn/sequential.h"
 
@@ -119,20 +120,6 @@ std::vector<char> ReadFile(const std::string& path) {
   return bytes;
 }
 
-// Removes the temporary file of a failed save and reports why the save failed.
-[[noreturn]] void FailSave(const std::string& path, const std::string& tmp, const std::string& step,
-                           int err) {
-  ::unlink(tmp.c_str());
-  throw std::runtime_error("cannot save checkpoint " + path + ": " + step + ": " + ErrnoText(err));
-}
-
-std::string DirectoryOf(const std::string& path) {
-  const size_t slash = path.rfind('/');
-  if (slash == std::string::npos) return ".";
-  if (slash == 0) return "/";
-  return path.substr(0, slash);
-}
-
 }  // namespace
 
 void SaveCheckpoint(const std::string& path, const Checkpoint& ckpt) {
@@ -155,44 +142,7 @@ void SaveCheckpoint(const std::string& path, const Checkpoint& ckpt) {
   const uint32_t crc = Crc32(bytes.data(), bytes.size());
   w.Put(crc);
 
-  // Write a temporary file next to the target, make it durable, then rename it into place.
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  FILE* f = std::fopen(tmp.c_str(), "wbe");
-  if (f == nullptr) {
-    const int err = errno;
-    FailSave(path, tmp, "create " + tmp, err);
-  }
-  if (std::fwrite(bytes.data(), 1, bytes.size(), f) != bytes.size() || std::fflush(f) != 0 ||
-      ::fsync(::fileno(f)) != 0) {
-    const int err = errno;
-    std::fclose(f);
-    FailSave(path, tmp, "write " + tmp, err);
-  }
-  if (std::fclose(f) != 0) {
-    const int err = errno;
-    FailSave(path, tmp, "close " + tmp, err);
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    FailSave(path, tmp, "rename to " + path, err);
-  }
-
-  // Persist the rename. Some file systems cannot fsync a directory (EINVAL); the data is in
-  // place by then, so only real I/O errors are reported.
-  const std::string dir = DirectoryOf(path);
-  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir_fd < 0) {
-    const int err = errno;
-    throw std::runtime_error("cannot save checkpoint " + path + ": open directory " + dir + ": " +
-                             ErrnoText(err));
-  }
-  if (::fsync(dir_fd) != 0 && errno != EINVAL) {
-    const int err = errno;
-    ::close(dir_fd);
-    throw std::runtime_error("cannot save checkpoint " + path + ": fsync directory " + dir + ": " +
-                             ErrnoText(err));
-  }
-  ::close(dir_fd);
+  WriteFileAtomically(path, std::string_view(bytes.data(), bytes.size()), "checkpoint");
 }
 
 Checkpoint LoadCheckpoint(const std::string& path) {

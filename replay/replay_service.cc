@@ -74,15 +74,6 @@ void ReplayServiceOptions::Validate() const {
   require(handle_timeout_ms >= 0, "handle_timeout_ms", ">= 0", handle_timeout_ms);
 }
 
-double ReplayService::IntervalRate::Take(int64_t count, double now) {
-  const double dt = now - last_time_;
-  const double rate =
-      (last_time_ >= 0 && dt > 0) ? static_cast<double>(count - last_count_) / dt : 0.0;
-  last_time_ = now;
-  last_count_ = count;
-  return rate;
-}
-
 ReplayService::ReplayService(Bus* bus, ReplayServiceOptions options)
     : bus_(*bus),
       options_(Validated(std::move(options))),

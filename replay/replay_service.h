@@ -160,16 +160,6 @@ class ReplayService {
     int32_t batch_size = 0;
   };
 
-  // Events per second over the interval between two calls of Take().
-  class IntervalRate {
-   public:
-    double Take(int64_t count, double now);
-
-   private:
-    int64_t last_count_ = 0;
-    double last_time_ = -1.0;
-  };
-
   void OnTransitions(const rlmsg::transition_batch_t& m);
   // Stores a flat or a pixel batch; the reason it was refused, or nullptr.
   const char* InsertFlat(const rlmsg::transition_batch_t& m);
@@ -209,10 +199,10 @@ class ReplayService {
   double next_flow_ = -1.0;
   double next_stats_ = -1.0;
   double next_progress_ = -1.0;
-  IntervalRate stats_insert_rate_;
-  IntervalRate stats_sample_rate_;
-  IntervalRate progress_insert_rate_;
-  IntervalRate progress_sample_rate_;
+  RateMeter stats_insert_rate_;
+  RateMeter stats_sample_rate_;
+  RateMeter progress_insert_rate_;
+  RateMeter progress_sample_rate_;
 
   // Reused messages, so that a warm service does not allocate per reply.
   rlmsg::sample_batch_t reply_{};

@@ -1,0 +1,76 @@
+#include "common/atomic_file.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace rl {
+namespace {
+
+namespace fs = std::filesystem;
+
+class AtomicFileTest : public ::testing::Test {
+ protected:
+  AtomicFileTest() : dir_(fs::temp_directory_path() / ("atomic_file_" + std::to_string(getpid()))) {
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  ~AtomicFileTest() override { fs::remove_all(dir_); }
+
+  static std::string Read(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(AtomicFileTest, WritesReplacesAndLeavesNoTemporaryFile) {
+  const std::string path = (dir_ / "a.bin").string();
+  const std::string first("one\0two", 7);  // bytes, NUL included
+  WriteFileAtomically(path, first);
+  EXPECT_EQ(Read(path), first);
+  WriteFileAtomically(path, "replaced");
+  EXPECT_EQ(Read(path), "replaced");
+  EXPECT_FALSE(fs::exists(TemporaryPathFor(path)));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator{}), 1);
+}
+
+TEST_F(AtomicFileTest, AFailedWriteNamesThePathAndTheReasonAndKeepsTheOldFile) {
+  const std::string missing = (dir_ / "no_such_dir" / "c.bin").string();
+  try {
+    WriteFileAtomically(missing, "x", "checkpoint");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("cannot write checkpoint " + missing + ": create ", 0), 0u) << what;
+    EXPECT_NE(what.find("No such file or directory"), std::string::npos) << what;
+  }
+  // Renaming over a directory fails: the temporary file is removed, the target untouched.
+  const fs::path target = dir_ / "target";
+  fs::create_directories(target / "inside");
+  EXPECT_THROW(WriteFileAtomically(target.string(), "x"), std::runtime_error);
+  EXPECT_FALSE(fs::exists(TemporaryPathFor(target.string())));
+  EXPECT_TRUE(fs::is_directory(target / "inside"));
+}
+
+TEST_F(AtomicFileTest, RenameIntoPlaceCommitsAFileWrittenElsewhere) {
+  const fs::path tmp = dir_ / "video.tmp";
+  std::ofstream(tmp) << "frames";
+  const std::string path = (dir_ / "video.webm").string();
+  RenameIntoPlace(tmp.string(), path, "video");
+  EXPECT_EQ(Read(path), "frames");
+  EXPECT_FALSE(fs::exists(tmp));
+  EXPECT_THROW(RenameIntoPlace(tmp.string(), path, "video"), std::runtime_error);  // gone
+}
+
+}  // namespace
+}  // namespace rl
