@@ -50,6 +50,7 @@ EnvIdParts ParseEnvId(const std::string& id) {
       {"crop-right", &c.crop_right},
       {"render-width", &c.render_width},
       {"render-height", &c.render_height},
+      {"noop-start", &c.noop_start},
   };
   std::stringstream list(id.substr(open, close - open));
   std::string item;
@@ -61,17 +62,17 @@ EnvIdParts ParseEnvId(const std::string& id) {
       throw std::invalid_argument("env '" + id + "': expected key=value, got '" + item + "'");
     }
     const std::string value = item.substr(eq + 1);
-    if (key == "max-pool") {
+    if (key == "max-pool" || key == "off-track") {
       const int v = ParseInt(id, key, value);
-      if (v != 0 && v != 1) throw std::invalid_argument("env '" + id + "': max-pool is 0 or 1");
-      c.max_pool = v == 1;
+      if (v != 0 && v != 1) throw std::invalid_argument("env '" + id + "': " + key + " is 0 or 1");
+      (key == "max-pool" ? c.max_pool : c.off_track) = v == 1;
     } else if (auto it = ints.find(key); it != ints.end()) {
       *it->second = ParseInt(id, key, value);
     } else {
       throw std::invalid_argument(
           "env '" + id + "': unknown pixels key '" + key +
           "' (known: width, height, stack, skip, max-pool, crop-top, crop-bottom, crop-left, "
-          "crop-right, render-width, render-height)");
+          "crop-right, render-width, render-height, noop-start, off-track)");
     }
   }
   try {

@@ -16,7 +16,9 @@ ActionRepeat::ActionRepeat(std::unique_ptr<Env> env, const ImagePipelineConfig& 
       render_width_(config.render_width),
       render_height_(config.render_height),
       frame_skip_(config.frame_skip),
-      max_pool_(config.max_pool) {
+      max_pool_(config.max_pool),
+      noop_start_(config.noop_start),
+      off_track_(config.off_track) {
   if (env_ == nullptr) {
     throw std::invalid_argument("ActionRepeat: the wrapped env must not be null");
   }
@@ -33,18 +35,55 @@ ActionRepeat::ActionRepeat(std::unique_ptr<Env> env, const ImagePipelineConfig& 
     env_->Render(&frames_[0], &shape_.width, &shape_.height);
   }
   for (std::vector<uint8_t>& frame : frames_) frame.resize(shape_.bytes());
+  probe_.resize(shape_.bytes());
+  for (int d = 0; d < spec_.action_dim; ++d) {
+    const auto i = static_cast<std::size_t>(d);
+    zero_action_.push_back(std::clamp(0.0f, spec_.action_low[i], spec_.action_high[i]));
+  }
+}
+
+template <class InnerReset>
+void ActionRepeat::StartEpisode(const InnerReset& reset) {
+  reset();
+  // An episode that ends during the no-ops starts again, a bounded number of times.
+  constexpr int kMaxRestarts = 10;
+  int restarts = 0;
+  for (int i = 0; i < noop_start_; ++i) {
+    const StepResult r = NoOp();
+    if (!r.terminated && !r.truncated) continue;
+    if (++restarts > kMaxRestarts) {
+      throw std::runtime_error("ActionRepeat: \"" + spec_.id + "\" ended within " +
+                               std::to_string(noop_start_) + " no-op steps " +
+                               std::to_string(kMaxRestarts + 1) + " times; lower noop-start");
+    }
+    env_->Reset();
+    i = -1;
+  }
+  Capture(0);
+  current_ = 0;
+}
+
+StepResult ActionRepeat::NoOp() {
+  return spec_.continuous() ? env_->StepContinuous(zero_action_) : env_->Step(0);
 }
 
 void ActionRepeat::Reset(uint64_t seed) {
-  env_->Reset(seed);
-  Capture(0);
-  current_ = 0;
+  StartEpisode([&] { env_->Reset(seed); });
 }
 
 void ActionRepeat::Reset() {
-  env_->Reset();
-  Capture(0);
-  current_ = 0;
+  StartEpisode([&] { env_->Reset(); });
+}
+
+bool ActionRepeat::OffTrack(const std::vector<uint8_t>& frame) const {
+  // Row 75 and columns 41, 42, 52, 53 of the article's 96 x 96 frame, scaled to this one.
+  const int row = 75 * shape_.height / 96;
+  for (int column : {41, 42, 52, 53}) {
+    const int x = column * shape_.width / 96;
+    const std::size_t green = (static_cast<std::size_t>(row) * shape_.width + x) * 3 + 1;
+    if (frame[green] <= 200) return false;
+  }
+  return true;
 }
 
 StepResult ActionRepeat::Step(int action) {
@@ -63,18 +102,36 @@ StepResult ActionRepeat::Repeat(const InnerStep& inner_step) {
   StepResult total;
   int taken = 0;
   while (taken < frame_skip_) {
-    const StepResult inner = inner_step();
+    StepResult inner = inner_step();
     ++taken;
+    if (off_track_) {
+      Capture(probe_);
+      if (OffTrack(probe_)) {
+        inner.reward = -10.0;
+        inner.terminated = true;
+      }
+    }
     total.reward += inner.reward;
     total.terminated = inner.terminated;
     total.truncated = inner.truncated;
-    if (max_pool_) Capture(taken % 2);
+    if (max_pool_) {
+      // With the off-track test the frame was rendered already.
+      if (off_track_) {
+        frames_[static_cast<std::size_t>(taken % 2)] = probe_;
+      } else {
+        Capture(taken % 2);
+      }
+    }
     if (inner.terminated || inner.truncated) break;
   }
 
   // The frame of this step: the last raw frame, or the max of the last two.
   if (!max_pool_) {
-    Capture(0);
+    if (off_track_) {
+      std::swap(frames_[0], probe_);
+    } else {
+      Capture(0);
+    }
     current_ = 0;
   } else if (taken == 1) {
     current_ = 1;
@@ -86,8 +143,9 @@ StepResult ActionRepeat::Repeat(const InnerStep& inner_step) {
   return total;
 }
 
-void ActionRepeat::Capture(int slot) {
-  std::vector<uint8_t>& frame = frames_[static_cast<std::size_t>(slot)];
+void ActionRepeat::Capture(int slot) { Capture(frames_[static_cast<std::size_t>(slot)]); }
+
+void ActionRepeat::Capture(std::vector<uint8_t>& frame) {
   if (render_width_ > 0) {
     env_->RenderSized(render_width_, render_height_, &frame);
   } else {

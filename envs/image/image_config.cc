@@ -52,6 +52,7 @@ void ImagePipelineConfig::Validate() const {
   CheckSizePair(width, height,
                 "width and height must both be 0 (keep the cropped size) or both positive");
   CheckAtLeast(stack, 1, "stack");
+  CheckAtLeast(noop_start, 0, "noop_start");
 }
 
 }  // namespace rl::envs

@@ -29,11 +29,20 @@ struct ImagePipelineConfig {
   int stack = 4;
   // Clamp each Step's (summed) reward to [-1, 1].
   bool clip_rewards = false;
+  // Inner steps with the zero action after every Reset, their rewards discarded (the TD3
+  // CarRacing article plays 45 while the camera zooms in). An episode that ends during them is
+  // reset again.
+  int noop_start = 0;
+  // The TD3 CarRacing article's off-track rule, tested on the raw frame of every inner step (so
+  // every inner step is rendered): green above 200 at row 75 and columns 41, 42, 52 and 53 of a
+  // 96 x 96 frame (scaled to the render size), i.e. grass or white kerb on both sides of the car.
+  // That inner step's reward is replaced by -10 and the Step ends, terminated.
+  bool off_track = false;
 
   /// Throws std::invalid_argument naming the field unless: render_width and render_height are
   /// both 0 or both positive, frame_skip >= 1, the crops are >= 0 (and, with an explicit render
-  /// size, leave at least one pixel each way), width and height are both 0 or both positive, and
-  /// stack >= 1.
+  /// size, leave at least one pixel each way), width and height are both 0 or both positive,
+  /// stack >= 1 and noop_start >= 0.
   void Validate() const;
 };
 

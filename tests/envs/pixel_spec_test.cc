@@ -19,7 +19,7 @@ TEST(PixelSpecTest, AnIdWithoutPixelsIsJustTheRegisteredId) {
 TEST(PixelSpecTest, ReadsEveryKey) {
   const EnvIdParts p = ParseEnvId(
       "Catch-v0+pixels(width=6,height=12,stack=3,skip=2,max-pool=0,crop-top=1,crop-bottom=2,"
-      "crop-left=3,crop-right=4,render-width=40,render-height=80)");
+      "crop-left=3,crop-right=4,render-width=40,render-height=80,noop-start=45,off-track=1)");
   EXPECT_EQ(p.base, "Catch-v0");
   ASSERT_TRUE(p.pixels);
   EXPECT_EQ(p.image.width, 6);
@@ -33,6 +33,8 @@ TEST(PixelSpecTest, ReadsEveryKey) {
   EXPECT_EQ(p.image.crop_right, 4);
   EXPECT_EQ(p.image.render_width, 40);
   EXPECT_EQ(p.image.render_height, 80);
+  EXPECT_EQ(p.image.noop_start, 45);
+  EXPECT_TRUE(p.image.off_track);
   EXPECT_FALSE(p.image.clip_rewards);
 }
 
@@ -63,6 +65,8 @@ TEST(PixelSpecTest, RefusesBadSpecsWithTheReason) {
   EXPECT_NE(message("Catch-v0+pixels(stack)").find("expected key=value"), std::string::npos);
   EXPECT_NE(message("Catch-v0+pixels(max-pool=2)").find("max-pool is 0 or 1"), std::string::npos);
   EXPECT_NE(message("Catch-v0+pixels(stack=0)").find("stack"), std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(off-track=3)").find("off-track is 0 or 1"), std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(noop-start=-1)").find("noop_start"), std::string::npos);
 }
 
 TEST(PixelSpecTest, MakeEnvBuildsThePipelineTheIdDescribes) {

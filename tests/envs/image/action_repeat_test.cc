@@ -202,6 +202,65 @@ TEST(ActionRepeatTest, RenderForwardsToTheWrappedEnv) {
   EXPECT_EQ(height, 2);
 }
 
+// noop_start plays zero actions after every Reset, their rewards discarded, and resets again when
+// the episode ends during them.
+TEST(ActionRepeatTest, NoOpStartPlaysZeroActionsAfterReset) {
+  auto inner = MakeScripted({{1}, {2}, {4}, {8}});
+  ScriptedImageEnv* scripted = inner.get();
+  ImagePipelineConfig config = Skip(1, /*max_pool=*/false);
+  config.noop_start = 2;
+  ActionRepeat env(std::move(inner), config);
+  const int renders_before = scripted->renders;
+  env.Reset(3);
+  EXPECT_EQ(scripted->steps_taken, 2);
+  EXPECT_EQ(scripted->renders - renders_before, 1);  // only the frame after the no-ops
+  EXPECT_EQ(Bytes(env.image()), kF2);
+  EXPECT_EQ(env.Step(0).reward, 4.0);  // the third inner step; 1 and 2 were discarded
+
+  // An episode that ends during the no-ops starts again; one that always does is refused after
+  // ten restarts instead of looping for ever (the scripted env ends every episode at step 2).
+  auto ending = MakeScripted({{1}, {.reward = 2, .terminated = true}, {4}, {8}});
+  ScriptedImageEnv* ending_env = ending.get();
+  config.noop_start = 3;
+  ActionRepeat again(std::move(ending), config);
+  const int resets_before = ending_env->resets;
+  EXPECT_THROW(again.Reset(3), std::runtime_error);
+  EXPECT_EQ(ending_env->resets - resets_before, 11);
+  EXPECT_EQ(ending_env->steps_taken, 22);
+}
+
+// The off-track rule tests the raw frame of every inner step at the article's pixels (row 75,
+// columns 41, 42, 52, 53 of 96 x 96; in a 3 x 2 frame all four are pixel (1, 1)).
+TEST(ActionRepeatTest, OffTrackReplacesTheRewardAndEndsTheStep) {
+  std::vector<uint8_t> grass = kF3;
+  grass[(1 * 3 + 1) * 3 + 1] = 204;  // green of pixel (1, 1)
+  auto inner = std::make_unique<ScriptedImageEnv>(
+      RgbShape(3, 2), std::vector<std::vector<uint8_t>>{kF0, kF1, grass, kF3, kF4},
+      std::vector<ScriptedStep>{{1}, {2}, {4}, {8}});
+  ScriptedImageEnv* scripted = inner.get();
+  ImagePipelineConfig config = Skip(3, /*max_pool=*/false);
+  config.off_track = true;
+  ActionRepeat env(std::move(inner), config);
+  env.Reset(1);
+  const int renders_before = scripted->renders;
+  const StepResult r = env.Step(0);
+  // Inner step 1 is on the road (G 50 at (1, 1)); inner step 2 shows grass: -10, terminated.
+  EXPECT_EQ(r.reward, 1.0 - 10.0);
+  EXPECT_TRUE(r.terminated);
+  EXPECT_EQ(scripted->steps_taken, 2);
+  EXPECT_EQ(scripted->renders - renders_before, 2);  // every inner step, none twice
+  EXPECT_EQ(Bytes(env.image()), grass);
+  // Without the rule the same steps run to the end of the skip.
+  auto plain = std::make_unique<ScriptedImageEnv>(
+      RgbShape(3, 2), std::vector<std::vector<uint8_t>>{kF0, kF1, grass, kF3, kF4},
+      std::vector<ScriptedStep>{{1}, {2}, {4}, {8}});
+  ActionRepeat off(std::move(plain), Skip(3, /*max_pool=*/false));
+  off.Reset(1);
+  const StepResult p = off.Step(0);
+  EXPECT_EQ(p.reward, 1.0 + 2.0 + 4.0);
+  EXPECT_FALSE(p.terminated);
+}
+
 TEST(ActionRepeatTest, RejectsNullAndBadConfigs) {
   EXPECT_THROW(ActionRepeat(nullptr, Skip(1)), std::invalid_argument);
   EXPECT_THROW(ActionRepeat(MakeScripted(), Skip(0)), std::invalid_argument);
