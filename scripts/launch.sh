@@ -190,7 +190,7 @@ echo "launch: watch it with scripts/spy.sh --run $out"
 {
   echo "monitor $BASHPID" >> "$out/pids"
   exec "$bin/monitor" --lcm-url "$url" --lcm-bulk-url "$bulk_url" --run-id "$run_id" \
-    --goal "$goal" --time-budget "$time_budget"
+    --goal "$goal" --time-budget "$time_budget" --metrics "$out/metrics.jsonl"
 } | tee "$out/logs/monitor.log" &
 monitor_pid=$!
 set +e

@@ -2,12 +2,15 @@
 //
 // Listens to every process's stats and the evaluator's results, prints a progress line, and
 // exits when the run is over: 0 when an evaluation reached the goal, 1 when the time budget ran
-// out, 3 when the replay, the learner or the evaluator went silent, 130 on SIGINT/SIGTERM.
+// out, 3 when the replay, the learner or the evaluator went silent, 130 on SIGINT/SIGTERM. With
+// --metrics FILE it also appends the stats of every process to FILE as a time series
+// (tools/metrics_log.h).
 #include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <string>
 
 #include "common/channels.h"
@@ -19,6 +22,7 @@
 #include "rlmsg/stats_evaluator_t.hpp"
 #include "rlmsg/stats_learner_t.hpp"
 #include "rlmsg/stats_replay_t.hpp"
+#include "tools/metrics_log.h"
 
 namespace {
 
@@ -34,6 +38,16 @@ struct View {
   double best_eval = -1e300;
   bool goal_reached = false;
 };
+
+// The lines of one metrics row: the newest stats of every role heard from.
+std::string MetricsRow(const View& v, double t) {
+  std::string lines;
+  for (const auto& [sender, s] : v.actors) lines += rl::tools::MetricsLine(t, s);
+  if (v.replay_seen > 0) lines += rl::tools::MetricsLine(t, v.replay);
+  if (v.learner_seen > 0) lines += rl::tools::MetricsLine(t, v.learner);
+  if (v.evaluator_seen > 0) lines += rl::tools::MetricsLine(t, v.evaluator);
+  return lines;
+}
 
 // 1234567 -> "1,234,567" (appending: GCC 12 warns falsely about string::insert here).
 std::string Thousands(int64_t v) {
@@ -96,6 +110,7 @@ int Main(int argc, char** argv) {
   double time_budget = 600;
   double stale_seconds = 20;
   double print_seconds = 1;
+  std::string metrics_path;
   rl::po::options_description desc("Options");
   rl::AddCommonOptions(&desc, &common);
   desc.add_options()                                                                            //
@@ -105,7 +120,10 @@ int Main(int argc, char** argv) {
       ("stale-seconds", rl::po::value(&stale_seconds)->default_value(stale_seconds),
        "a replay, learner or evaluator silent this long ends the run")  //
       ("print-seconds", rl::po::value(&print_seconds)->default_value(print_seconds),
-       "seconds between progress lines");
+       "seconds between progress lines")  //
+      ("metrics", rl::po::value(&metrics_path),
+       "append every process's stats to this file as JSON lines (a row a second for the first "
+       "hour, then every 10 s)");
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "monitor",
                         "Usage: monitor [options]\n"
@@ -115,6 +133,8 @@ int Main(int argc, char** argv) {
     return 0;
   }
   rl::InstallStopHandlers();
+  std::unique_ptr<rl::tools::MetricsLog> metrics;
+  if (!metrics_path.empty()) metrics = std::make_unique<rl::tools::MetricsLog>(metrics_path);
   rl::Bus bus(common.MakeBusConfig("monitor"));
   View v;
   bus.Subscribe<rlmsg::stats_actor_t>(rl::channels::kStatsActor,
@@ -180,6 +200,10 @@ int Main(int argc, char** argv) {
       std::printf("\nmonitor: the %s has been silent for %.0f s\n", silent, stale_seconds);
       status = 3;
       break;
+    }
+    if (metrics != nullptr && metrics->Due(elapsed)) {
+      const std::string row = MetricsRow(v, elapsed);
+      if (!row.empty()) metrics->AppendRow(elapsed, row);
     }
     if (now >= next_print) {
       std::printf(tty ? "\r%s\033[K" : "%s\n", ProgressLine(v, elapsed, now).c_str());

@@ -1,0 +1,100 @@
+#include "tools/metrics_log.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace rl::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::vector<std::string> Lines(const fs::path& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+TEST(MetricsLineTest, WritesOneJsonObjectPerRoleWithTheStatsFields) {
+  rlmsg::stats_learner_t learner{};
+  learner.header.sender = "learner";
+  learner.updates = 5000;
+  learner.loss = 0.25;
+  learner.mean_q = std::numeric_limits<double>::quiet_NaN();
+  learner.lost = 2;
+  learner.dropped_invalid = 3;
+  EXPECT_EQ(MetricsLine(12.5, learner),
+            "{\"t\": 12.500, \"role\": \"learner\", \"updates\": 5000, \"updates_per_second\": 0, "
+            "\"loss\": 0.25, \"mean_q\": null, \"env_steps\": 0, \"weights_version\": 0, "
+            "\"lost\": 2, \"dropped\": 3}\n");
+  rlmsg::stats_actor_t actor{};
+  actor.header.sender = "actor-3";
+  actor.env_steps = 1234567;
+  actor.epsilon = 0.1;
+  const std::string a = MetricsLine(1, actor);
+  EXPECT_EQ(a.rfind("{\"t\": 1.000, \"role\": \"actor-3\", \"env_steps\": 1234567,", 0), 0u) << a;
+  EXPECT_NE(a.find("\"exploration\": 0.1,"), std::string::npos) << a;
+  rlmsg::stats_replay_t replay{};
+  replay.header.sender = "replay";
+  replay.size = 7;
+  EXPECT_NE(MetricsLine(1, replay).find("\"size\": 7,"), std::string::npos);
+  rlmsg::stats_evaluator_t evaluator{};
+  evaluator.header.sender = "evaluator";
+  evaluator.best_mean = -150.5;
+  EXPECT_NE(MetricsLine(1, evaluator).find("\"best_mean\": -150.5,"), std::string::npos);
+}
+
+class MetricsLogTest : public ::testing::Test {
+ protected:
+  MetricsLogTest()
+      : path_(fs::temp_directory_path() / ("metrics_" + std::to_string(getpid()) + ".jsonl")) {
+    fs::remove(path_);
+  }
+  ~MetricsLogTest() override { fs::remove(path_); }
+  fs::path path_;
+};
+
+TEST_F(MetricsLogTest, RowsFollowTheScheduleAndAppendAfterARestart) {
+  {
+    MetricsLog log(path_.string(), /*dense_seconds=*/10, /*dense_period=*/1,
+                   /*sparse_period=*/5);
+    int rows = 0;
+    for (double t = 0; t < 30; t += 0.25) {
+      if (!log.Due(t)) continue;
+      log.AppendRow(t, "{\"t\": " + std::to_string(t) + "}\n");
+      ++rows;
+    }
+    // Every second for 10 s (t = 0..9), then every 5 s (10, 15, 20, 25).
+    EXPECT_EQ(rows, 14);
+    EXPECT_EQ(log.rows(), 14);
+  }
+  {
+    MetricsLog again(path_.string());
+    again.AppendRow(31, "{\"t\": 31}\n");
+  }
+  const std::vector<std::string> lines = Lines(path_);
+  ASSERT_EQ(lines.size(), 15u);
+  EXPECT_EQ(lines.back(), "{\"t\": 31}");
+}
+
+TEST_F(MetricsLogTest, AnUnwritablePathIsRefusedWithItsName) {
+  const std::string bad = (path_.parent_path() / "no_such_dir" / "m.jsonl").string();
+  try {
+    MetricsLog log(bad);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace rl::tools

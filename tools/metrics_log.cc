@@ -1,0 +1,128 @@
+#include "tools/metrics_log.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+namespace rl::tools {
+namespace {
+
+// Builds {"t": ..., "role": "...", "key": value, ...} one field at a time.
+class Line {
+ public:
+  Line(double t, const std::string& role) {
+    char seconds[32];
+    std::snprintf(seconds, sizeof(seconds), "%.3f", t);  // milliseconds are plenty
+    text_ = std::string("{\"t\": ") + seconds + ", \"role\": \"" + role + "\"";
+  }
+  Line& Add(const char* key, double value) {
+    text_ += std::string(", \"") + key + "\": " + Number(value);
+    return *this;
+  }
+  std::string Done() { return text_ + "}\n"; }
+
+ private:
+  // Shortest round-trippable form; JSON has no NaN or infinity, so those are null.
+  static std::string Number(double v) {
+    if (!std::isfinite(v)) return "null";
+    char buf[32];
+    std::snprintf(buf, sizeof(buf), "%.10g", v);
+    return buf;
+  }
+  std::string text_;
+};
+
+template <class Stats>
+Line& AddDrops(Line& line, const Stats& s) {
+  return line.Add("lost", static_cast<double>(s.lost))
+      .Add("dropped",
+           static_cast<double>(s.dropped_malformed + s.dropped_foreign + s.dropped_invalid));
+}
+
+}  // namespace
+
+std::string MetricsLine(double t, const rlmsg::stats_actor_t& s) {
+  Line line(t, s.header.sender);
+  line.Add("env_steps", static_cast<double>(s.env_steps))
+      .Add("episodes", static_cast<double>(s.episodes))
+      .Add("mean_return", s.mean_return)
+      .Add("exploration", s.epsilon)
+      .Add("steps_per_second", s.steps_per_second)
+      .Add("weights_version", static_cast<double>(s.weights_version))
+      .Add("paused", s.paused);
+  return AddDrops(line, s).Done();
+}
+
+std::string MetricsLine(double t, const rlmsg::stats_replay_t& s) {
+  Line line(t, s.header.sender);
+  line.Add("size", static_cast<double>(s.size))
+      .Add("capacity", static_cast<double>(s.capacity))
+      .Add("inserts", static_cast<double>(s.total_inserts))
+      .Add("samples", static_cast<double>(s.total_samples))
+      .Add("inserts_per_second", s.inserts_per_second)
+      .Add("samples_per_second", s.samples_per_second)
+      .Add("samples_per_insert", s.samples_per_insert)
+      .Add("insert_allowed", s.insert_allowed)
+      .Add("memory_bytes", static_cast<double>(s.memory_bytes));
+  return AddDrops(line, s).Done();
+}
+
+std::string MetricsLine(double t, const rlmsg::stats_learner_t& s) {
+  Line line(t, s.header.sender);
+  line.Add("updates", static_cast<double>(s.updates))
+      .Add("updates_per_second", s.updates_per_second)
+      .Add("loss", s.loss)
+      .Add("mean_q", s.mean_q)
+      .Add("env_steps", static_cast<double>(s.env_steps))
+      .Add("weights_version", static_cast<double>(s.weights_version));
+  return AddDrops(line, s).Done();
+}
+
+std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s) {
+  Line line(t, s.header.sender);
+  line.Add("checkpoints_scored", static_cast<double>(s.checkpoints_scored))
+      .Add("last_mean", s.last_mean)
+      .Add("best_mean", s.best_mean)
+      .Add("busy", s.busy);
+  return AddDrops(line, s).Done();
+}
+
+MetricsLog::MetricsLog(const std::string& path, double dense_seconds, double dense_period,
+                       double sparse_period)
+    : path_(path),
+      dense_seconds_(dense_seconds),
+      dense_period_(dense_period),
+      sparse_period_(sparse_period) {
+  if (!(dense_period > 0) || !(sparse_period > 0) || !(dense_seconds >= 0)) {
+    throw std::invalid_argument("metrics: periods must be > 0 and dense_seconds >= 0");
+  }
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  if (fd_ < 0) {
+    throw std::runtime_error("cannot open metrics file " + path + ": " + std::strerror(errno));
+  }
+}
+
+MetricsLog::~MetricsLog() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool MetricsLog::Due(double t) const { return t >= next_; }
+
+void MetricsLog::AppendRow(double t, const std::string& lines) {
+  // One write: a kill between system calls leaves whole lines.
+  const ssize_t n = ::write(fd_, lines.data(), lines.size());
+  if (n != static_cast<ssize_t>(lines.size())) {
+    throw std::runtime_error("cannot append to metrics file " + path_ + ": " +
+                             (n < 0 ? std::strerror(errno) : "short write"));
+  }
+  ++rows_;
+  const double period = t < dense_seconds_ ? dense_period_ : sparse_period_;
+  next_ = (std::floor(t / period) + 1) * period;
+}
+
+}  // namespace rl::tools

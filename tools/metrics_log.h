@@ -1,0 +1,55 @@
+// The run's training metrics as a time series: what every process publishes on RL_STATS_*, kept in
+// the run folder as JSON lines (metrics.jsonl), one line per role and row.
+//
+//   {"t": 12.0, "role": "learner", "updates": 5000, "updates_per_second": 412.5, ...}
+//
+// Appending and crash-safe: each row (the lines of every role) is one write(2) to a file opened
+// with O_APPEND, so a process killed at any moment leaves whole lines, and a restarted writer
+// appends after them. Bounded for long runs: a row every second for the first hour, then every
+// ten seconds (about 4,000 rows in the first hour and 360 an hour after that, per role).
+#pragma once
+
+#include <string>
+
+#include "rlmsg/stats_actor_t.hpp"
+#include "rlmsg/stats_evaluator_t.hpp"
+#include "rlmsg/stats_learner_t.hpp"
+#include "rlmsg/stats_replay_t.hpp"
+
+namespace rl::tools {
+
+/// One JSON line (with its newline) for a stats message seen `t` seconds into the run. The role
+/// is the message's sender ("actor-3", "replay", "learner", "evaluator").
+std::string MetricsLine(double t, const rlmsg::stats_actor_t& s);
+std::string MetricsLine(double t, const rlmsg::stats_replay_t& s);
+std::string MetricsLine(double t, const rlmsg::stats_learner_t& s);
+std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s);
+
+class MetricsLog {
+ public:
+  /// Opens `path` for appending (creating it). Throws std::runtime_error naming the path.
+  /// `dense_seconds` and the two periods set the row schedule (see the file comment).
+  explicit MetricsLog(const std::string& path, double dense_seconds = 3600, double dense_period = 1,
+                      double sparse_period = 10);
+  MetricsLog(const MetricsLog&) = delete;
+  MetricsLog& operator=(const MetricsLog&) = delete;
+  ~MetricsLog();
+
+  /// Whether a row is due `t` seconds into the run (true at t = 0, then on the schedule).
+  bool Due(double t) const;
+  /// Appends the lines of one row with one write and schedules the next row after `t`. Throws
+  /// std::runtime_error on a write error.
+  void AppendRow(double t, const std::string& lines);
+  int64_t rows() const { return rows_; }
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  double dense_seconds_;
+  double dense_period_;
+  double sparse_period_;
+  double next_ = 0;
+  int64_t rows_ = 0;
+};
+
+}  // namespace rl::tools
