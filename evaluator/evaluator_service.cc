@@ -363,6 +363,9 @@ void EvaluatorService::WriteReportNow() {
   info.eval_settings = eval_settings_;
   info.checkpoints_skipped = skipped_;
   info.checkpoints_refused = refused_;
+  if (!config_.out_dir.empty()) {
+    info.metrics_file = (std::filesystem::path(config_.out_dir) / "metrics.jsonl").string();
+  }
   try {
     WriteReport(report_dir_, records_, info);
   } catch (const std::exception& e) {

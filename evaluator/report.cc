@@ -18,6 +18,7 @@
 #include "common/atomic_file.h"
 #include "evaluator/flat_json.h"
 #include "evaluator/learning_curve.h"
+#include "evaluator/training_curves.h"
 
 namespace rl::evaluator {
 namespace {
@@ -265,6 +266,21 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
   style.x_kind = XAxisKind::kSeconds;
   WriteFileAtomically(dir + "/" + kCurveWallTime, RenderLearningCurveSvg(by_time, style));
 
+  // The training curves, from the metrics the monitor keeps.
+  std::vector<TrainingSeries> training;
+  if (!info.metrics_file.empty()) training = LoadTrainingSeries(info.metrics_file);
+  for (TrainingSeries& s : training) {
+    CurveStyle ts;
+    ts.title = s.title;
+    ts.x_label = "time since the launch";
+    ts.y_label = s.y_label;
+    ts.x_kind = XAxisKind::kSeconds;
+    ts.goal = std::nan("");
+    ts.width = 560;
+    ts.height = 300;
+    WriteFileAtomically(dir + "/" + s.file, RenderLearningCurveSvg(std::move(s.points), ts));
+  }
+
   // Title.
   std::string run;
   if (!info.run_name.empty() && info.run_id != 0) {
@@ -341,6 +357,17 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
        "\" alt=\"evaluation mean return with a band of one standard deviation against wall "
        "time\" width=\"720\" height=\"380\"></figure>\n";
   h += "</section>\n";
+
+  // Training curves.
+  if (!training.empty()) {
+    h += "<section>\n<h2>Training</h2>\n<p>What the processes reported while the run went "
+         "(metrics.jsonl): whether it learns, stalls or diverges, and why.</p>\n";
+    for (const TrainingSeries& s : training) {
+      h += "<figure><img src=\"" + HtmlEscape(s.file) + "\" alt=\"" + HtmlEscape(s.title) +
+           " against time\" width=\"560\" height=\"300\"></figure>\n";
+    }
+    h += "</section>\n";
+  }
 
   // The greedy policy at work.
   if (!info.video_file.empty()) {

@@ -66,6 +66,9 @@ struct ReportInfo {
   std::string video_caption;        // what the video shows
   std::string frames_file;          // a grid of camera frames (PNG) in the report folder, or empty
   std::string frames_caption;       // what the grid shows
+  // The run's metrics.jsonl (tools/metrics_log.h), drawn as training curves; empty or missing:
+  // no training section.
+  std::string metrics_file;
 };
 
 /// Names of the files WriteReport writes into `dir`.

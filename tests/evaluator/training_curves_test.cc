@@ -1,0 +1,94 @@
+#include "evaluator/training_curves.h"
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "evaluator/report.h"
+#include "temp_dir.h"
+
+namespace rl::evaluator {
+namespace {
+
+using testing::ReadFile;
+using testing::TempDir;
+
+// Two rows of two actors, a learner and a replay, then a torn line.
+void WriteMetrics(const std::string& path) {
+  std::ofstream out(path);
+  out << R"({"t": 1.000, "role": "actor-0", "env_steps": 10, "mean_return": 10, "exploration": 0.4, "steps_per_second": 100})"
+      << "\n"
+      << R"({"t": 1.000, "role": "actor-1", "env_steps": 12, "mean_return": 30, "exploration": 0.2, "steps_per_second": 300})"
+      << "\n"
+      << R"({"t": 1.000, "role": "learner", "updates": 5, "updates_per_second": 50, "loss": 2.5, "mean_q": null})"
+      << "\n"
+      << R"({"t": 2.000, "role": "actor-0", "env_steps": 20, "mean_return": 50, "exploration": 0.1, "steps_per_second": 200})"
+      << "\n"
+      << R"({"t": 2.000, "role": "replay", "size": 77})"
+      << "\n"
+      << R"({"t": 2.000, "role": "learner", "updates": 9, "updates_per_second": 40, "loss": 1.5, "mean_q": 3})"
+      << "\n"
+      << R"({"t": 3.000, "role": "learner", "upd)";
+}
+
+const TrainingSeries* Find(const std::vector<TrainingSeries>& all, const std::string& file) {
+  for (const TrainingSeries& s : all) {
+    if (s.file == file) return &s;
+  }
+  return nullptr;
+}
+
+TEST(TrainingCurvesTest, CombinesTheActorsAndKeepsTheLearnerAndReplaySeries) {
+  TempDir dir;
+  const std::string path = dir / "metrics.jsonl";
+  WriteMetrics(path);
+  const std::vector<TrainingSeries> all = LoadTrainingSeries(path);
+
+  const TrainingSeries* ret = Find(all, "train_return.svg");
+  ASSERT_NE(ret, nullptr);
+  ASSERT_EQ(ret->points.size(), 2u);
+  EXPECT_DOUBLE_EQ(ret->points[0].x, 1.0);
+  EXPECT_DOUBLE_EQ(ret->points[0].mean, 20.0);  // the mean of 10 and 30
+  EXPECT_DOUBLE_EQ(ret->points[1].mean, 50.0);
+  const TrainingSeries* speed = Find(all, "train_env_steps.svg");
+  ASSERT_NE(speed, nullptr);
+  EXPECT_DOUBLE_EQ(speed->points[0].mean, 400.0);  // summed over the actors
+  const TrainingSeries* exploration = Find(all, "train_exploration.svg");
+  ASSERT_NE(exploration, nullptr);
+  EXPECT_NEAR(exploration->points[0].mean, 0.3, 1e-12);
+  const TrainingSeries* loss = Find(all, "train_loss.svg");
+  ASSERT_NE(loss, nullptr);
+  ASSERT_EQ(loss->points.size(), 2u);  // the torn line at t = 3 is skipped
+  EXPECT_DOUBLE_EQ(loss->points[1].mean, 1.5);
+  const TrainingSeries* q = Find(all, "train_mean_q.svg");
+  ASSERT_NE(q, nullptr);
+  EXPECT_EQ(q->points.size(), 1u);  // null at t = 1 is left out
+  const TrainingSeries* size = Find(all, "train_replay_size.svg");
+  ASSERT_NE(size, nullptr);
+  EXPECT_DOUBLE_EQ(size->points[0].mean, 77.0);
+  EXPECT_TRUE(LoadTrainingSeries(dir / "missing.jsonl").empty());
+}
+
+TEST(TrainingCurvesTest, TheReportShowsATrainingSectionOnlyWithMetrics) {
+  TempDir dir;
+  ReportInfo info;
+  info.env_id = "CartPole-v1";
+  info.goal = 475;
+  WriteReport(dir / "plain", {}, info);
+  EXPECT_EQ(ReadFile(dir / "plain/index.html").find("<h2>Training</h2>"), std::string::npos);
+
+  info.metrics_file = dir / "metrics.jsonl";
+  WriteMetrics(info.metrics_file);
+  WriteReport(dir / "report", {}, info);
+  const std::string html = ReadFile(dir / "report/index.html");
+  EXPECT_NE(html.find("<h2>Training</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<img src=\"train_loss.svg\""), std::string::npos);
+  const std::string svg = ReadFile(dir / "report/train_loss.svg");
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  EXPECT_NE(svg.find("Learner loss"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rl::evaluator
