@@ -4,6 +4,7 @@
 #include <exception>
 #include <fstream>
 #include <iostream>
+#include <set>
 #include <stdexcept>
 
 namespace rl {
@@ -41,21 +42,28 @@ bool ParseOptions(int argc, char** argv, const std::string& role, const std::str
     const std::string path = (*vm)["config"].as<std::string>();
     std::ifstream in(path);
     if (!in) throw std::runtime_error("cannot open config file '" + path + "'");
-    // Read every key, keep the top-level ones we know and those of our section.
+    // Read every key, keep those of our section and the top-level ones we know; a key of our
+    // section wins over the same top-level key (e.g. an [evaluator] env without the training-only
+    // pipeline options).
     po::parsed_options parsed = po::parse_config_file(in, desc, /*allow_unregistered=*/true);
     po::parsed_options kept(&desc);
     const std::string prefix = role + ".";
+    std::set<std::string> in_section;
     for (po::option& opt : parsed.options) {
       const std::string& key = opt.string_key;
-      if (key.rfind(prefix, 0) == 0) {
-        opt.string_key = key.substr(prefix.size());
-        if (desc.find_nothrow(opt.string_key, false) == nullptr) {
-          throw std::runtime_error("config file '" + path + "': unknown key '" + opt.string_key +
-                                   "' in section [" + role + "]");
-        }
-        opt.unregistered = false;
-        kept.options.push_back(opt);
-      } else if (key.find('.') == std::string::npos && !opt.unregistered) {
+      if (key.rfind(prefix, 0) != 0) continue;
+      opt.string_key = key.substr(prefix.size());
+      if (desc.find_nothrow(opt.string_key, false) == nullptr) {
+        throw std::runtime_error("config file '" + path + "': unknown key '" + opt.string_key +
+                                 "' in section [" + role + "]");
+      }
+      opt.unregistered = false;
+      in_section.insert(opt.string_key);
+      kept.options.push_back(opt);
+    }
+    for (const po::option& opt : parsed.options) {
+      const std::string& key = opt.string_key;
+      if (key.find('.') == std::string::npos && !opt.unregistered && !in_section.count(key)) {
         kept.options.push_back(opt);
       }
     }

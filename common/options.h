@@ -30,9 +30,10 @@ struct CommonOptions {
 
 void AddCommonOptions(po::options_description* desc, CommonOptions* common);
 
-// Parses argv and the --config file into *vm and notifies the bound variables. Returns false
-// when --help was asked for (the help text has been printed). Throws on bad options, with a
-// message that names the option.
+// Parses argv and the --config file into *vm and notifies the bound variables. The command line
+// wins over the file, and in the file a key of `role`'s section wins over the same top-level
+// key. Returns false when --help was asked for (the help text has been printed). Throws on bad
+// options, with a message that names the option.
 bool ParseOptions(int argc, char** argv, const std::string& role, const std::string& usage,
                   const po::options_description& desc, po::variables_map* vm);
 

@@ -1,0 +1,68 @@
+#include "common/options.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace rl {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Parses `args` (after the program name) with --config set to an INI file of `ini`, for role
+// "evaluator", and returns the env and episodes read.
+struct Parsed {
+  std::string env;
+  int episodes = 0;
+};
+Parsed Parse(const std::string& ini, std::vector<std::string> args = {}) {
+  const fs::path path =
+      fs::temp_directory_path() / ("options_" + std::to_string(getpid()) + ".ini");
+  std::ofstream(path) << ini;
+  CommonOptions common;
+  Parsed p;
+  po::options_description desc("Options");
+  AddCommonOptions(&desc, &common);
+  desc.add_options()("env", po::value(&p.env)->default_value("CartPole-v1"), "env")  //
+      ("episodes", po::value(&p.episodes)->default_value(100), "episodes");
+  args.insert(args.begin(), {"evaluator", "--config", path.string()});
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  po::variables_map vm;
+  ParseOptions(static_cast<int>(argv.size()), argv.data(), "evaluator", "usage", desc, &vm);
+  fs::remove(path);
+  return p;
+}
+
+TEST(OptionsTest, TheSectionWinsOverTheTopLevelAndTheCommandLineOverBoth) {
+  const std::string ini =
+      "env = CarRacing-v3+pixels(skip=5,off-track=1)\nepisodes = 7\nunknown-top = 1\n"
+      "[actor]\nepisodes = 3\n[evaluator]\nenv = CarRacing-v3+pixels(skip=5)\n";
+  Parsed p = Parse(ini);
+  EXPECT_EQ(p.env, "CarRacing-v3+pixels(skip=5)");  // the [evaluator] section's
+  EXPECT_EQ(p.episodes, 7);                         // top level; [actor] is not ours
+  p = Parse(ini, {"--env", "Pendulum-v1"});
+  EXPECT_EQ(p.env, "Pendulum-v1");
+  p = Parse("env = Pendulum-v1\n");
+  EXPECT_EQ(p.env, "Pendulum-v1");
+}
+
+TEST(OptionsTest, AnUnknownKeyInOurSectionIsRefusedWithItsName) {
+  try {
+    Parse("[evaluator]\nepsiodes = 3\n");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown key 'epsiodes' in section [evaluator]"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace rl
