@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "envs/box2d/car_racing.h"
 #include "envs/box2d/lunar_lander.h"
 #include "envs/cartpole.h"
 #include "envs/catch.h"
@@ -36,6 +37,17 @@ constexpr std::array kRegistrations = {
                  []() -> std::unique_ptr<Env> {
                    return std::make_unique<TimeLimit>(
                        std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true}), 1000);
+                 }},
+    // CarRacing: 1,000 frames; an episode also ends when every tile is visited or the car leaves
+    // the playfield.
+    Registration{"CarRacing-v3",
+                 []() -> std::unique_ptr<Env> {
+                   return std::make_unique<TimeLimit>(std::make_unique<CarRacing>(), 1000);
+                 }},
+    Registration{"CarRacingDiscrete-v3",
+                 []() -> std::unique_ptr<Env> {
+                   return std::make_unique<TimeLimit>(
+                       std::make_unique<CarRacing>(CarRacingConfig{.continuous = false}), 1000);
                  }},
     Registration{"Pendulum-v1",
                  []() -> std::unique_ptr<Env> {
