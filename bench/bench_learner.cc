@@ -102,7 +102,10 @@ double Td3UpdateFlops(rl::learner::Td3& td3, int batch) {
     if (bar == std::string::npos) break;
     start = bar + 1;
   }
-  return 2.0 * batch * (2.5 * actor + 9.5 * critic);
+  // A shared encoder (network "drq") runs forward on s and s' and backward once (parameter and
+  // input gradients of its second layer; about two forwards): 4 E more, on top of the heads.
+  const double encoder = td3.shared_encoder() ? ForwardMacs(td3.encoder().Architecture()) : 0;
+  return 2.0 * batch * (4 * encoder + 2.5 * actor + 9.5 * critic);
 }
 
 rl::learner::Batch View(const Data& d, int batch, int width) {
@@ -157,6 +160,8 @@ int main(int argc, char** argv) {
   const Td3Case cases[] = {
       {"td3_mlp", mlp_spec, "mlp", 256, 3e-4f, 3e-4f, 0.005f, false},
       {"td3_car", car_spec, "car", 128, 2.5e-4f, 1e-3f, 0.05f, true},
+      // The car_racing_td3 preset: the article's encoder shared, DrQ-v2 heads of 256.
+      {"td3_car_drq", car_spec, "drq", 128, 2.5e-4f, 1e-3f, 0.05f, true},
   };
   for (const Td3Case& t : cases) {
     rl::learner::Td3Config c;

@@ -49,9 +49,12 @@ int Main(int argc, char** argv) {
       ("network", rl::po::value(&network),
        "dqn: the Q network, mlp (default), nature (Mnih et al. 2015, 4x84x84 frames), grasp "
        "(stacks of 40x40 frames), grasp48 (stacks of 48x48 frames) or an architecture string; "
-       "td3: mlp (default) or car (the TD3 CarRacing article's CNNs, 4x84x84 frames)")  //
+       "td3: mlp (default), car (the TD3 CarRacing article's CNNs, 4x84x84 frames) or drq (the "
+       "article's encoder shared by actor and critics, trained by the critics, with DrQ-v2 heads "
+       "of width hidden[0])")  //
       ("hidden", rl::po::value(&hidden),
-       "hidden layer widths of the MLPs (dqn default 120,84; td3 default 256,256)")  //
+       "hidden layer widths of the MLPs (dqn default 120,84; td3 default 256,256; td3 drq: the "
+       "heads' width is the first)")  //
       ("tau", rl::po::value(&tau),
        "target update weight of the online network (dqn default 1: hard copy every "
        "target-update-period; td3 default 0.005: Polyak, every policy-delay updates)")  //

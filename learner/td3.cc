@@ -31,8 +31,8 @@ void CheckContinuous(const envs::EnvSpec& spec) {
 }  // namespace
 
 void Td3Config::Validate() const {
-  if (network != "mlp" && network != "car") {
-    throw std::invalid_argument("td3 network must be mlp or car, not '" + network + "'");
+  if (network != "mlp" && network != "car" && network != "drq") {
+    throw std::invalid_argument("td3 network must be mlp, car or drq, not '" + network + "'");
   }
   if (hidden.empty()) throw std::invalid_argument("hidden: at least one hidden layer");
   for (int h : hidden) {
@@ -52,14 +52,28 @@ void Td3Config::Validate() const {
   if (!(max_grad_norm >= 0)) throw std::invalid_argument("max-grad-norm must be >= 0");
 }
 
+namespace {
+
+void CheckCarInput(const Td3Config& config, const envs::EnvSpec& spec) {
+  if (spec.observation_size != 4 * 84 * 84) {
+    throw std::invalid_argument("td3 network '" + config.network +
+                                "' takes 4 x 84 x 84 observations; " + spec.id + " has " +
+                                std::to_string(spec.observation_size) + " values");
+  }
+}
+
+}  // namespace
+
 std::string Td3ActorArchitecture(const Td3Config& config, const envs::EnvSpec& spec) {
   CheckContinuous(spec);
   if (config.network == "car") {
-    if (spec.observation_size != 4 * 84 * 84) {
-      throw std::invalid_argument("td3 network 'car' takes 4 x 84 x 84 observations; " + spec.id +
-                                  " has " + std::to_string(spec.observation_size) + " values");
-    }
+    CheckCarInput(config, spec);
     return nn::Td3CarActorArchitecture(spec.action_low, spec.action_high);
+  }
+  if (config.network == "drq") {
+    CheckCarInput(config, spec);
+    return nn::CarEncoderArchitecture() + "," +
+           nn::DrqActorHeadArchitecture(config.hidden.front(), spec.action_low, spec.action_high);
   }
   return nn::Td3MlpActorArchitecture(spec.observation_size, config.hidden, spec.action_low,
                                      spec.action_high);
@@ -75,6 +89,10 @@ std::string Td3CriticArchitecture(const Td3Config& config, const envs::EnvSpec& 
     }
     return nn::Td3CarCriticArchitecture();
   }
+  if (config.network == "drq") {
+    CheckCarInput(config, spec);
+    return nn::DrqCriticHeadArchitecture(config.hidden.front(), spec.action_dim);
+  }
   return nn::Td3MlpCriticArchitecture(spec.observation_size, spec.action_dim, config.hidden);
 }
 
@@ -87,8 +105,9 @@ nn::Sequential BuildActor(const Td3Config& config, const envs::EnvSpec& spec, st
 
 nn::ActionValueNet BuildCritic(const Td3Config& config, const envs::EnvSpec& spec,
                                std::mt19937* rng) {
-  return nn::BuildActionValueNet(Td3CriticArchitecture(config, spec), spec.observation_size,
-                                 spec.action_dim, rng);
+  // A shared encoder's critics are heads on its 512 features.
+  const int input = config.network == "drq" ? 512 : spec.observation_size;
+  return nn::BuildActionValueNet(Td3CriticArchitecture(config, spec), input, spec.action_dim, rng);
 }
 
 std::mt19937 InitRng(uint64_t seed) { return std::mt19937(static_cast<uint32_t>(seed)); }
@@ -98,7 +117,22 @@ std::mt19937 InitRng(uint64_t seed) { return std::mt19937(static_cast<uint32_t>(
 Td3::Td3(const envs::EnvSpec& spec, Td3Config config)
     : spec_(spec), config_(std::move(config)), action_dim_(spec.action_dim) {
   std::mt19937 rng = InitRng(config_.seed);
-  actor_ = BuildActor(config_, spec_, &rng);
+  shared_encoder_ = config_.network == "drq";
+  if (shared_encoder_) {
+    // The policy that is broadcast: encoder then actor head, in one Sequential whose flat
+    // parameters are the encoder's followed by the head's (neither has buffers).
+    policy_ = BuildActor(config_, spec_, &rng);
+    encoder_ = nn::BuildFromArchitecture(nn::CarEncoderArchitecture(), &rng);
+    actor_ = nn::BuildFromArchitecture(
+        nn::DrqActorHeadArchitecture(config_.hidden.front(), spec_.action_low, spec_.action_high),
+        &rng);
+    if (encoder_.NumBuffers() != 0 || actor_.NumBuffers() != 0 ||
+        policy_.FlatSize() != encoder_.FlatSize() + actor_.FlatSize()) {
+      throw std::logic_error("td3 drq: the policy is not the encoder followed by the head");
+    }
+  } else {
+    actor_ = BuildActor(config_, spec_, &rng);
+  }
   q1_ = BuildCritic(config_, spec_, &rng);
   q2_ = BuildCritic(config_, spec_, &rng);
   actor_target_ = actor_;
@@ -108,7 +142,9 @@ Td3::Td3(const envs::EnvSpec& spec, Td3Config config)
   q1_target_.set_training(false);
   q2_target_.set_training(false);
   actor_params_ = actor_.Params();
-  critic_params_ = q1_.Params();
+  critic_params_ = shared_encoder_ ? encoder_.Params() : std::vector<nn::Param>{};
+  const std::vector<nn::Param> q1_params = q1_.Params();
+  critic_params_.insert(critic_params_.end(), q1_params.begin(), q1_params.end());
   const std::vector<nn::Param> q2_params = q2_.Params();
   critic_params_.insert(critic_params_.end(), q2_params.begin(), q2_params.end());
   actor_optimizer_ = std::make_unique<nn::Adam>(actor_params_, config_.actor_learning_rate, 0.9f,
@@ -118,9 +154,22 @@ Td3::Td3(const envs::EnvSpec& spec, Td3Config config)
   noise_rng_.seed(config_.seed + 1);
 }
 
+nn::Sequential& Td3::policy() {
+  if (!shared_encoder_) return actor_;
+  encoder_.GetFlat(&flat_);
+  actor_.GetFlat(&head_flat_);
+  flat_.insert(flat_.end(), head_flat_.begin(), head_flat_.end());
+  policy_.SetFlat(flat_.data(), flat_.size());
+  return policy_;
+}
+
 std::string Td3::Describe() const {
   std::string d = "TD3, " + config_.network;
   if (config_.network == "mlp") d += ' ' + Widths(config_.hidden);
+  if (shared_encoder_) {
+    d += " (one encoder trained by the critics, heads of " +
+         std::to_string(config_.hidden.front()) + ")";
+  }
   d += ", actor ";
   d += actor_.Architecture();
   return d;
@@ -156,8 +205,19 @@ UpdateResult Td3::Update(const Batch& b) {
     throw std::invalid_argument("batch action width " + std::to_string(b.action_width) +
                                 ", TD3 has " + std::to_string(action_dim_));
   }
-  const nn::Matrix& obs = *b.obs;
-  const nn::Matrix& next_obs = *b.next_obs;
+  // With a shared encoder the networks below see its features: s' first (a constant), then s,
+  // whose activations the critics' backward pass goes through.
+  const nn::Matrix* obs_in = b.obs;
+  const nn::Matrix* next_in = b.next_obs;
+  if (shared_encoder_) {
+    encoder_.ZeroGrad();
+    next_features_ = encoder_.Forward(*b.next_obs);
+    features_ = encoder_.Forward(*b.obs);
+    obs_in = &features_;
+    next_in = &next_features_;
+  }
+  const nn::Matrix& obs = *obs_in;
+  const nn::Matrix& next_obs = *next_in;
   action_ = Eigen::Map<const nn::Matrix>(b.action.data(), action_dim_, n);
   if (!action_.allFinite()) throw std::invalid_argument("action not finite");
 
@@ -183,11 +243,22 @@ UpdateResult Td3::Update(const Batch& b) {
   q1_pred_ = q1_.Forward(obs, action_).row(0).transpose();
   result.loss = nn::MseLoss(q1_pred_, y_, &loss_grad_, w);
   grad_q_ = loss_grad_.transpose();
-  q1_.BackwardParams(grad_q_);
+  if (shared_encoder_) {
+    q1_.Backward(grad_q_);
+    grad_features_ = q1_.grad_obs();
+  } else {
+    q1_.BackwardParams(grad_q_);
+  }
   q2_pred_ = q2_.Forward(obs, action_).row(0).transpose();
   result.loss += nn::MseLoss(q2_pred_, y_, &loss_grad_, w);
   grad_q_ = loss_grad_.transpose();
-  q2_.BackwardParams(grad_q_);
+  if (shared_encoder_) {
+    q2_.Backward(grad_q_);
+    grad_features_ += q2_.grad_obs();
+    encoder_.BackwardParams(grad_features_);  // the encoder learns from both critics
+  } else {
+    q2_.BackwardParams(grad_q_);
+  }
   if (config_.max_grad_norm > 0) {
     result.grad_norm = nn::ClipGradNorm(critic_params_, config_.max_grad_norm);
   }

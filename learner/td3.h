@@ -13,6 +13,12 @@
 // after a time-limit truncation: truncations are bootstrapped), and w are the importance weights
 // of prioritized replay (1 for uniform). The critics and the actor have their own Adam optimizers
 // and learning rates. Knows nothing of LCM.
+//
+// With network "drq" (DrQ-v2's practice, Yarats et al. 2021) one CNN encoder is shared: the
+// critics and the actor are heads on its features, the encoder is trained by the critics' loss
+// only (the actor and the targets see its features as constants), and s' is encoded by the same
+// online encoder. The encoder then runs forward twice and backward once per update instead of
+// three networks' encoders with their targets, about a third of the work.
 #pragma once
 
 #include <cstdint>
@@ -31,8 +37,9 @@ namespace rl::learner {
 
 struct Td3Config {
   // The networks: "mlp" (actor obs -> hidden... -> action, critics [obs, action] -> hidden... ->
-  // 1; the author's 256-256) or "car" (the TD3 CarRacing article's networks on 4 x 84 x 84 stacks:
-  // a CNN encoder of its own in the actor and in each critic).
+  // 1; the author's 256-256), "car" (the TD3 CarRacing article's networks on 4 x 84 x 84 stacks:
+  // a CNN encoder of its own in the actor and in each critic) or "drq" (the article's encoder,
+  // shared, with DrQ-v2's heads of width hidden[0]; see the top of this file).
   std::string network = "mlp";
   std::vector<int> hidden = {256, 256};
   float actor_learning_rate = 3e-4f;
@@ -63,13 +70,18 @@ class Td3 final : public Algorithm {
 
   UpdateResult Update(const Batch& batch) override;
   const std::vector<float>& last_td_errors() const override { return td_abs_; }
-  nn::Sequential& policy() override { return actor_; }
+  /// The actor; with a shared encoder, the encoder followed by the actor head (refreshed here).
+  nn::Sequential& policy() override;
   int64_t updates() const override { return updates_; }
   std::string Describe() const override;
 
   /// Actor updates so far (one per policy_delay critic updates).
   int64_t actor_updates() const { return actor_updates_; }
+  /// The actor (with a shared encoder: the head on its features).
   nn::Sequential& actor() { return actor_; }
+  /// Whether the encoder is shared (network "drq"), and the encoder then.
+  bool shared_encoder() const { return shared_encoder_; }
+  nn::Sequential& encoder() { return encoder_; }
   const nn::Sequential& actor_target() const { return actor_target_; }
   nn::ActionValueNet& critic(int i) { return i == 0 ? q1_ : q2_; }
   const nn::ActionValueNet& critic_target(int i) const { return i == 0 ? q1_target_ : q2_target_; }
@@ -84,6 +96,9 @@ class Td3 final : public Algorithm {
   envs::EnvSpec spec_;
   Td3Config config_;
   int action_dim_;
+  bool shared_encoder_ = false;
+  nn::Sequential encoder_;  // network "drq" only
+  nn::Sequential policy_;   // network "drq" only: encoder + actor head, filled by policy()
   nn::Sequential actor_, actor_target_;
   nn::ActionValueNet q1_, q2_, q1_target_, q2_target_;
   std::vector<nn::Param> actor_params_, critic_params_;
@@ -95,6 +110,8 @@ class Td3 final : public Algorithm {
 
   // Buffers reused by every update.
   nn::Matrix action_, next_action_, grad_q_, grad_actor_;
+  nn::Matrix features_, next_features_, grad_features_;  // shared encoder only
+  std::vector<float> flat_, head_flat_;
   nn::Vector y_, q1_pred_, q2_pred_, loss_grad_, weights_;
   std::vector<float> td_abs_;
 };

@@ -112,6 +112,27 @@ std::string Td3CarActorArchitecture(const std::vector<float>& low, const std::ve
          "),layernorm(" + a + ")," + bounds.Describe();
 }
 
+std::string DrqActorHeadArchitecture(int hidden, const std::vector<float>& low,
+                                     const std::vector<float>& high) {
+  const int actions = static_cast<int>(low.size());
+  if (hidden < 1 || actions < 1 || high.size() != low.size()) {
+    throw std::invalid_argument("DrqActorHead: needs hidden >= 1 and one bound pair per action");
+  }
+  const Bounded bounds(low, high);
+  const std::string h = std::to_string(hidden);
+  return "linear(512,50),layernorm(50),tanh,linear(50," + h + "),relu,linear(" + h + "," + h +
+         "),relu,linear(" + h + "," + std::to_string(actions) + ")," + bounds.Describe();
+}
+
+std::string DrqCriticHeadArchitecture(int hidden, int action_size) {
+  if (hidden < 1 || action_size < 1) {
+    throw std::invalid_argument("DrqCriticHead: needs hidden >= 1 and action_size >= 1");
+  }
+  const std::string h = std::to_string(hidden);
+  return "linear(512,50),layernorm(50),tanh||linear(" + std::to_string(50 + action_size) + "," + h +
+         "),relu,linear(" + h + "," + h + "),relu,linear(" + h + ",1)";
+}
+
 std::string Td3CarCriticArchitecture() {
   return CarEncoderArchitecture() + ",linear(512,128),relu,linear(128,3),relu|linear(3,3),relu|" +
          "linear(6,3),relu,linear(3,1)";

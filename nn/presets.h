@@ -61,6 +61,15 @@ std::string Td3MlpCriticArchitecture(int obs_size, int action_size, const std::v
 /// Critic (ActionValueNet string): encoder,linear(512,128),relu,linear(128,3),relu | linear(3,3),
 /// relu | linear(6,3),relu,linear(3,1), for 3-d actions (the article's).
 std::string CarEncoderArchitecture();
+/// DrQ-v2's heads (Yarats et al. 2021) on the car encoder's 512 features, for a TD3 whose encoder
+/// is shared and trained by the critics only. Actor head:
+///   linear(512,50),layernorm(50),tanh,linear(50,h),relu,linear(h,h),relu,linear(h,a),bounded(..)
+/// Critic (ActionValueNet string on features): linear(512,50),layernorm(50),tanh||
+///   linear(50+a,h),relu,linear(h,h),relu,linear(h,1)
+/// Throws std::invalid_argument for hidden < 1 or mismatched bounds.
+std::string DrqActorHeadArchitecture(int hidden, const std::vector<float>& low,
+                                     const std::vector<float>& high);
+std::string DrqCriticHeadArchitecture(int hidden, int action_size);
 std::string Td3CarActorArchitecture(const std::vector<float>& low, const std::vector<float>& high);
 std::string Td3CarCriticArchitecture();
 

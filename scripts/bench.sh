@@ -12,7 +12,8 @@
 #              run the peer's nature, small and latency modes; 0: skip them), KUKA_EPISODES
 #              (20: episodes of each policy in kuka_probe), KUKA_PIPELINE_SECONDS (300: length of
 #              the kuka_grasp launch that measures the whole pipeline's episodes per hour; 0 or
-#              --skip-goal: skip it), TD3_SEEDS ("1": seeds of the Pendulum and
+#              --skip-goal: skip it), CAR_PIPELINE_SECONDS (300: the same for car_racing_td3, whose
+#              env steps are agent steps of 5 frames), TD3_SEEDS ("1": seeds of the Pendulum and
 #              LunarLanderContinuous runs to their goals), PEER_TD3 (1: run the peer's td3 mode).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -116,17 +117,18 @@ if [ "$skip_goal" -eq 0 ]; then
   done
 fi
 
-# KUKA grasping, the whole pipeline (actors, replay, learner, evaluator on held-out objects) for
-# KUKA_PIPELINE_SECONDS: episodes per hour and env steps/s after the first minute (start-up,
-# replay warm-up), from the monitor's progress lines.
-kuka_seconds=${KUKA_PIPELINE_SECONDS:-300}
-if [ "$skip_goal" -eq 0 ] && [ "$kuka_seconds" -gt 90 ]; then
-  echo "bench: launch kuka_grasp for $kuka_seconds s" >&2
-  isolated "$root/scripts/launch.sh" kuka_grasp --no-setup --build-dir "$build_dir" --seed 1 \
-    --time-budget "$kuka_seconds" --out "$work/kuka" > "$work/kuka.log" 2>&1 || true
-  n_actors=$(sed -n 's/^# actors = \([0-9]*\).*/\1/p' "$work/kuka/config.ini" 2>/dev/null)
+# A whole pipeline (actors, replay, learner, evaluator) for SECONDS: episodes per hour and env
+# steps/s after the first minute (start-up, replay warm-up), from the monitor's progress lines.
+# pipeline_rate PRESET SECONDS BENCH_NAME
+pipeline_rate() {
+  local preset="$1" seconds="$2" name="$3"
+  echo "bench: launch $preset for $seconds s" >&2
+  isolated "$root/scripts/launch.sh" "$preset" --no-setup --build-dir "$build_dir" --seed 1 \
+    --goal 1000000 --time-budget "$seconds" --out "$work/$preset" > "$work/$preset.log" 2>&1 || true
+  local n_actors
+  n_actors=$(sed -n 's/^# actors = \([0-9]*\).*/\1/p' "$work/$preset/config.ini" 2>/dev/null)
   # Progress lines: "[  499.6s] steps 16,049  episodes 2,221  ...".
-  tr -d ',' < "$work/kuka/logs/monitor.log" | awk -v actors="${n_actors:-null}" '
+  tr -d ',' < "$work/$preset/logs/monitor.log" | awk -v actors="${n_actors:-null}" -v name="$name" '
     /^\[ *[0-9.]+s\] steps [0-9]+ +episodes [0-9]+/ {
       t = $0; sub(/^\[ */, "", t); sub(/s\].*/, "", t)
       match($0, /steps [0-9]+/); s = substr($0, RSTART + 6, RLENGTH - 6)
@@ -135,9 +137,20 @@ if [ "$skip_goal" -eq 0 ] && [ "$kuka_seconds" -gt 90 ]; then
       t1 = t; s1 = s; e1 = e
     }
     END {
-      if (t0 == "" || t1 - t0 < 10) { print "bench.sh: kuka_grasp ran too briefly to measure" > "/dev/stderr"; exit }
-      printf "{\"bench\": \"kuka_pipeline_episodes_per_hour\", \"value\": %.0f, \"unit\": \"episodes/h\", \"env_steps_per_s\": %.1f, \"seconds\": %.0f, \"actors\": %s, \"note\": \"whole pipeline on this machine, learner and evaluator included, after the first minute\"}\n", (e1 - e0) * 3600 / (t1 - t0), (s1 - s0) / (t1 - t0), t1 - t0, actors
+      if (t0 == "" || t1 - t0 < 10) { print "bench.sh: " name " ran too briefly to measure" > "/dev/stderr"; exit }
+      printf "{\"bench\": \"%s\", \"value\": %.0f, \"unit\": \"episodes/h\", \"env_steps_per_s\": %.1f, \"seconds\": %.0f, \"actors\": %s, \"note\": \"whole pipeline on this machine, learner and evaluator included, after the first minute\"}\n", name, (e1 - e0) * 3600 / (t1 - t0), (s1 - s0) / (t1 - t0), t1 - t0, actors
     }' >> "$ours"
+}
+
+# KUKA grasping (held-out objects in the evaluator) and CarRacing with TD3 from pixels (agent
+# steps of 5 frames; training episodes end early off the track).
+kuka_seconds=${KUKA_PIPELINE_SECONDS:-300}
+if [ "$skip_goal" -eq 0 ] && [ "$kuka_seconds" -gt 90 ]; then
+  pipeline_rate kuka_grasp "$kuka_seconds" kuka_pipeline_episodes_per_hour
+fi
+car_seconds=${CAR_PIPELINE_SECONDS:-300}
+if [ "$skip_goal" -eq 0 ] && [ "$car_seconds" -gt 90 ]; then
+  pipeline_rate car_racing_td3 "$car_seconds" car_racing_pipeline_episodes_per_hour
 fi
 
 # The PyTorch peer, in the same run.

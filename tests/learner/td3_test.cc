@@ -292,5 +292,90 @@ TEST(Td3Test, BuildsTheArticlesCarRacingNetworks) {
   EXPECT_EQ(td3.actor_updates(), 1);
 }
 
+envs::EnvSpec CarPixelSpec() {
+  envs::EnvSpec spec = envs::CarRacingSpec(true);
+  spec.observation_size = 4 * 84 * 84;
+  spec.frame_stack = 4;
+  spec.frame_height = spec.frame_width = 84;
+  return spec;
+}
+
+std::vector<float> FlatOf(const nn::Sequential& net) {
+  std::vector<float> flat;
+  net.GetFlat(&flat);
+  return flat;
+}
+
+TEST(Td3Test, SharedEncoderPolicyIsTheEncoderFollowedByTheActorHead) {
+  const envs::EnvSpec spec = CarPixelSpec();
+  Td3Config c;
+  c.network = "drq";
+  c.hidden = {64};
+  Td3 td3(spec, c);
+  ASSERT_TRUE(td3.shared_encoder());
+  nn::Sequential& policy = td3.policy();
+  EXPECT_EQ(policy.InputSize(), 4 * 84 * 84);
+  EXPECT_EQ(policy.OutputSize(), 3);
+  EXPECT_EQ(td3.actor().InputSize(), 512);
+  std::vector<float> joined = FlatOf(td3.encoder());
+  const std::vector<float> head = FlatOf(td3.actor());
+  joined.insert(joined.end(), head.begin(), head.end());
+  EXPECT_EQ(FlatOf(policy), joined);
+  // Same actions as the head on the encoder's features.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> unit(0, 1);
+  nn::Matrix x(4 * 84 * 84, 2);
+  for (Eigen::Index k = 0; k < x.size(); ++k) x.data()[k] = unit(rng);
+  const nn::Matrix direct = policy.Forward(x);
+  const nn::Matrix features = td3.encoder().Forward(x);
+  const nn::Matrix via_head = td3.actor().Forward(features);
+  EXPECT_TRUE(direct.isApprox(via_head, 1e-5f));
+  EXPECT_NE(td3.Describe().find("one encoder trained by the critics"), std::string::npos);
+}
+
+TEST(Td3Test, SharedEncoderLearnsFromTheCriticsOnly) {
+  const envs::EnvSpec spec = CarPixelSpec();
+  std::mt19937 rng(8);
+  OwnedBatch b = RandomBatch(spec, 4, &rng);
+  b.obs = b.obs.cwiseAbs().cwiseMin(1.0f);
+  b.next_obs = b.next_obs.cwiseAbs().cwiseMin(1.0f);
+  // Critic learning rate far too small to move anything in float: only the actor's step could.
+  Td3Config frozen;
+  frozen.network = "drq";
+  frozen.hidden = {32};
+  frozen.policy_delay = 1;
+  frozen.critic_learning_rate = 1e-30f;
+  frozen.actor_learning_rate = 1e-2f;
+  Td3 a(spec, frozen);
+  const std::vector<float> encoder_before = FlatOf(a.encoder());
+  const std::vector<float> head_before = FlatOf(a.actor());
+  a.Update(b.view(3));
+  EXPECT_EQ(a.actor_updates(), 1);
+  EXPECT_EQ(FlatOf(a.encoder()), encoder_before);  // The actor's loss does not reach it.
+  EXPECT_NE(FlatOf(a.actor()), head_before);
+  // With a real critic learning rate the encoder moves.
+  Td3Config learning = frozen;
+  learning.critic_learning_rate = 1e-3f;
+  Td3 c(spec, learning);
+  const std::vector<float> before = FlatOf(c.encoder());
+  c.Update(b.view(3));
+  EXPECT_NE(FlatOf(c.encoder()), before);
+  // The broadcast policy follows both parts.
+  std::vector<float> joined = FlatOf(c.encoder());
+  const std::vector<float> head = FlatOf(c.actor());
+  joined.insert(joined.end(), head.begin(), head.end());
+  EXPECT_EQ(FlatOf(c.policy()), joined);
+}
+
+TEST(Td3Test, SharedEncoderNeedsCarRacingStacks) {
+  envs::EnvSpec spec = CarPixelSpec();
+  spec.observation_size = 4 * 42 * 42;
+  Td3Config c;
+  c.network = "drq";
+  EXPECT_THROW(Td3(spec, c), std::invalid_argument);
+  c.network = "resnet";
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace rl::learner
