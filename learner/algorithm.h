@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/state_file.h"
 #include "nn/sequential.h"
 #include "nn/tensor.h"
 
@@ -52,6 +53,15 @@ class Algorithm {
   virtual int64_t updates() const = 0;
   /// A short description for the learner's ready line.
   virtual std::string Describe() const = 0;
+
+  /// Adds to `state` everything needed to continue exactly where this algorithm is: networks and
+  /// their targets (with their architecture strings), optimizer states, counters and random
+  /// generators. O(parameters); allocates the copies.
+  virtual void SaveState(StateFile* state) const = 0;
+  /// Restores what SaveState() wrote. Throws std::runtime_error naming the first section that
+  /// does not fit (missing, another architecture, another size); the algorithm is then partly
+  /// restored and must not be used.
+  virtual void LoadState(const StateFile& state) = 0;
 };
 
 }  // namespace rl::learner

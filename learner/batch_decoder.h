@@ -26,6 +26,10 @@ class BatchDecoder {
   /// into `m`, both of which must outlive its use.
   const char* Decode(const rlmsg::sample_batch_t& m, Batch* out);
 
+  /// The generator of the random shifts (a restarted learner restores it).
+  std::mt19937_64& shift_rng() { return rng_; }
+  const std::mt19937_64& shift_rng() const { return rng_; }
+
  private:
   void Shifted(const std::vector<uint8_t>& pixels, int n, nn::Matrix* out);
 

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "learner/algorithm_state.h"
 #include "nn/losses.h"
 #include "nn/pixels.h"
 #include "nn/presets.h"
@@ -180,6 +181,20 @@ UpdateResult Dqn::Update(const Batch& b) {
     }
   }
   return result;
+}
+
+void Dqn::SaveState(StateFile* state) const {
+  PutNet(state, "dqn.online", online_);
+  PutNet(state, "dqn.target", target_);
+  PutOptimizer(state, "dqn.optimizer", *optimizer_);
+  state->PutInt("dqn.updates", updates_);
+}
+
+void Dqn::LoadState(const StateFile& state) {
+  GetNet(state, "dqn.online", &online_);
+  GetNet(state, "dqn.target", &target_);
+  GetOptimizer(state, "dqn.optimizer", optimizer_.get());
+  updates_ = state.Int("dqn.updates");
 }
 
 }  // namespace rl::learner

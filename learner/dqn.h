@@ -58,6 +58,9 @@ class Dqn final : public Algorithm {
   nn::Sequential& policy() override { return online_; }
   int64_t updates() const override { return updates_; }
   std::string Describe() const override;
+  /// Sections "dqn.online", "dqn.target", "dqn.optimizer", "dqn.updates".
+  void SaveState(StateFile* state) const override;
+  void LoadState(const StateFile& state) override;
 
   nn::Sequential& online() { return online_; }
   const nn::Sequential& target() const { return target_; }

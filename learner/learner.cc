@@ -8,6 +8,7 @@
 #include "common/clock.h"
 #include "common/shutdown.h"
 #include "envs/specs.h"
+#include "learner/algorithm_state.h"
 #include "nn/checkpoint.h"
 #include "nn/parallel.h"
 #include "rlmsg/checkpoint_t.hpp"
@@ -56,6 +57,10 @@ Learner::Learner(LearnerConfig config, Bus* bus)
       sender_(bus->config().sender) {
   nn::SetNumThreads(config_.threads);
   std::filesystem::create_directories(std::filesystem::path(config_.out_dir) / "checkpoints");
+  if (config_.resume && std::filesystem::exists(StatePath())) {
+    LoadState(StateFile::Load(StatePath(), StateKind()));
+    resumed_ = true;
+  }
   bus_->Subscribe<rlmsg::sample_batch_t>(
       channels::kSamples, [this](const rlmsg::sample_batch_t& m) { OnSamples(m); }, Port::kBulk);
 }
@@ -135,6 +140,33 @@ void Learner::TrainOn(const rlmsg::sample_batch_t& m) {
   ++stat_updates_;
 }
 
+std::string Learner::StatePath() const {
+  return (std::filesystem::path(config_.out_dir) / "checkpoints" / "learner-state.bin").string();
+}
+
+std::string Learner::StateKind() const { return "learner " + config_.algorithm; }
+
+StateFile Learner::SaveState() const {
+  StateFile state(StateKind());
+  state.PutText("learner.env", config_.env_id);
+  state.PutInt("learner.env_steps", env_steps_);
+  state.PutText("learner.wall_seconds", std::to_string(MonoSeconds() - start_time_));
+  PutRng(&state, "learner.shift_rng", decoder_.shift_rng());
+  algorithm_->SaveState(&state);
+  return state;
+}
+
+void Learner::LoadState(const StateFile& state) {
+  if (state.Text("learner.env") != config_.env_id) {
+    throw std::runtime_error("the saved learner state is of env " + state.Text("learner.env") +
+                             ", this run's is " + config_.env_id);
+  }
+  algorithm_->LoadState(state);
+  env_steps_ = state.Int("learner.env_steps");
+  resumed_wall_seconds_ = std::stod(state.Text("learner.wall_seconds"));
+  GetRng(state, "learner.shift_rng", &decoder_.shift_rng());
+}
+
 std::string Learner::Checkpoint() {
   char name[64];
   std::snprintf(name, sizeof(name), "ckpt-%09lld.bin",
@@ -149,6 +181,7 @@ std::string Learner::Checkpoint() {
   ckpt.meta.note = config_.env_id;
   algorithm_->policy().GetFlat(&ckpt.params);
   nn::SaveCheckpoint(path, ckpt);
+  SaveState().Save(StatePath());
   // Keep the newest keep_checkpoints files; older ones have been scored or skipped by now.
   if (written_.empty() || written_.back() != path) written_.push_back(path);
   while (config_.keep_checkpoints > 0 &&
@@ -186,13 +219,15 @@ void Learner::PublishStats(double now) {
 }
 
 void Learner::Run() {
-  start_time_ = MonoSeconds();
+  // A resumed learner's wall time continues from its saved state.
+  start_time_ = MonoSeconds() - resumed_wall_seconds_;
   const double stats_period = 1.0 / config_.stats_hz;
   double next_stats = start_time_;
   double next_log = start_time_ + 5.0;
-  // The initial (random) network goes out at once, so actors and tools see weights flow.
+  // The initial network (random, or the resumed one) goes out at once, so actors and tools see
+  // weights flow. Versions are update counts, so a resumed learner's never go back.
   algorithm_->policy().GetFlat(&flat_);
-  weights_.Start(0, algorithm_->policy().Architecture(), flat_);
+  weights_.Start(algorithm_->updates(), algorithm_->policy().Architecture(), flat_);
   while (!StopRequested()) {
     if (config_.max_updates > 0 && algorithm_->updates() >= config_.max_updates) break;
     bus_->Handle(ready_.empty() && !weights_.busy() ? 2 : 0);

@@ -45,8 +45,11 @@ struct LearnerConfig {
   bool prioritized = false;      // publish |TD errors| as priorities after every update
   int threads = 1;               // compute threads of the network library (nn::SetNumThreads)
   std::string out_dir = ".";     // checkpoints go to <out_dir>/checkpoints/
-  int64_t max_updates = 0;       // stop after this many updates (0: until stopped)
-  double stats_hz = 4.0;         // stats messages per second
+  // Continue from <out_dir>/checkpoints/learner-state.bin when it exists (written with every
+  // checkpoint): networks, targets, optimizers, counters, generators, env steps and wall time.
+  bool resume = false;
+  int64_t max_updates = 0;  // stop after this many updates (0: until stopped)
+  double stats_hz = 4.0;    // stats messages per second
 
   void Validate() const;
 };
@@ -66,8 +69,13 @@ class Learner {
   const envs::EnvSpec& spec() const { return spec_; }
   // Sample replies that did not fit the networks (counted, dropped, logged).
   int64_t batches_refused() const { return batches_refused_; }
-  // Writes a checkpoint of the current parameters, announces it and returns its path.
+  // Writes a checkpoint of the current parameters and the learner's whole state
+  // (StatePath()), announces the checkpoint and returns its path.
   std::string Checkpoint();
+  // Where the state a restarted learner resumes from is written.
+  std::string StatePath() const;
+  // Whether the constructor resumed from a saved state.
+  bool resumed() const { return resumed_; }
 
  private:
   struct Request {
@@ -83,6 +91,10 @@ class Learner {
   void SendRequest(int64_t id);
   void TrainOn(const rlmsg::sample_batch_t& batch);
   void PublishStats(double now);
+  // The learner's whole state, and its inverse (throws std::runtime_error saying what is wrong).
+  StateFile SaveState() const;
+  void LoadState(const StateFile& state);
+  std::string StateKind() const;
 
   LearnerConfig config_;
   Bus* bus_;
@@ -92,6 +104,8 @@ class Learner {
   WeightsPublisher weights_;
   std::string sender_;
   double start_time_ = 0;
+  double resumed_wall_seconds_ = 0;  // training time before this process started
+  bool resumed_ = false;
 
   std::map<int64_t, Request> in_flight_;  // by request id
   int64_t next_request_id_ = 0;

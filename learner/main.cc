@@ -116,6 +116,10 @@ int Main(int argc, char** argv) {
       ("threads", rl::po::value(&c.threads)->default_value(c.threads),
        "compute threads for the network (convolutions and large products are split; 1 leaves "
        "the other cores to the actors)")  //
+      ("resume", rl::po::bool_switch(&c.resume),
+       "continue from <out>/checkpoints/learner-state.bin when it exists (written with every "
+       "checkpoint): networks, targets, optimizer states, update count, env steps, generators; "
+       "a state of another algorithm, network or env is refused")  //
       ("max-updates", rl::po::value(&c.max_updates)->default_value(c.max_updates),
        "stop after this many updates (0: until stopped)")  //
       ("stats-hz", rl::po::value(&c.stats_hz)->default_value(c.stats_hz),
@@ -159,7 +163,14 @@ int Main(int argc, char** argv) {
   if (const int k = c.augment_shift; k > 0) {
     shifts = ", random shifts of up to " + std::to_string(k) + " pixels";
   }
-  std::printf("learner: ready (%s)%s\n", learner.algorithm().Describe().c_str(), shifts.c_str());
+  std::string resumed;
+  if (learner.resumed()) {
+    resumed = ", resumed at update " + std::to_string(learner.updates());
+  } else if (c.resume) {
+    resumed = ", nothing to resume: starting afresh";
+  }
+  std::printf("learner: ready (%s)%s%s\n", learner.algorithm().Describe().c_str(), shifts.c_str(),
+              resumed.c_str());
   std::fflush(stdout);
   learner.Run();
   std::printf("learner: stopped after %lld updates\n", static_cast<long long>(learner.updates()));

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "learner/algorithm_state.h"
 #include "nn/losses.h"
 #include "nn/presets.h"
 
@@ -287,6 +288,39 @@ UpdateResult Td3::Update(const Batch& b) {
     q2_target_.SoftUpdateFrom(q2_, config_.tau);
   }
   return result;
+}
+
+void Td3::SaveState(StateFile* state) const {
+  PutNet(state, "td3.actor", actor_);
+  PutNet(state, "td3.actor_target", actor_target_);
+  PutNet(state, "td3.q1", q1_);
+  PutNet(state, "td3.q2", q2_);
+  PutNet(state, "td3.q1_target", q1_target_);
+  PutNet(state, "td3.q2_target", q2_target_);
+  if (shared_encoder_) PutNet(state, "td3.encoder", encoder_);
+  PutOptimizer(state, "td3.actor_optimizer", *actor_optimizer_);
+  PutOptimizer(state, "td3.critic_optimizer", *critic_optimizer_);
+  state->PutInts("td3.updates", std::vector<int64_t>{updates_, actor_updates_});
+  PutRng(state, "td3.noise_rng", noise_rng_);
+  PutRng(state, "td3.normal", normal_);
+}
+
+void Td3::LoadState(const StateFile& state) {
+  GetNet(state, "td3.actor", &actor_);
+  GetNet(state, "td3.actor_target", &actor_target_);
+  GetNet(state, "td3.q1", &q1_);
+  GetNet(state, "td3.q2", &q2_);
+  GetNet(state, "td3.q1_target", &q1_target_);
+  GetNet(state, "td3.q2_target", &q2_target_);
+  if (shared_encoder_) GetNet(state, "td3.encoder", &encoder_);
+  GetOptimizer(state, "td3.actor_optimizer", actor_optimizer_.get());
+  GetOptimizer(state, "td3.critic_optimizer", critic_optimizer_.get());
+  const std::span<const int64_t> counts = state.Ints("td3.updates");
+  if (counts.size() != 2) throw std::runtime_error("state section 'td3.updates' is malformed");
+  updates_ = counts[0];
+  actor_updates_ = counts[1];
+  GetRng(state, "td3.noise_rng", &noise_rng_);
+  GetRng(state, "td3.normal", &normal_);
 }
 
 }  // namespace rl::learner

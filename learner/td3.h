@@ -74,6 +74,10 @@ class Td3 final : public Algorithm {
   nn::Sequential& policy() override;
   int64_t updates() const override { return updates_; }
   std::string Describe() const override;
+  /// Sections "td3.*": the actor, both critics and their targets (and the shared encoder), both
+  /// optimizers, the update counters and the target-noise generator.
+  void SaveState(StateFile* state) const override;
+  void LoadState(const StateFile& state) override;
 
   /// Actor updates so far (one per policy_delay critic updates).
   int64_t actor_updates() const { return actor_updates_; }

@@ -54,6 +54,32 @@ Optimizer::Optimizer(std::vector<Param> params, float lr)
   }
 }
 
+void Optimizer::GetState(std::vector<float>* values, int64_t* steps) const {
+  values->clear();
+  for (const std::vector<Matrix>* list : state_) {
+    for (const Matrix& m : *list) values->insert(values->end(), m.data(), m.data() + m.size());
+  }
+  *steps = steps_ != nullptr ? *steps_ : 0;
+}
+
+void Optimizer::SetState(std::span<const float> values, int64_t steps) {
+  size_t total = 0;
+  for (const std::vector<Matrix>* list : state_) {
+    for (const Matrix& m : *list) total += static_cast<size_t>(m.size());
+  }
+  Require(values.size() == total, "optimizer state of " + std::to_string(values.size()) +
+                                      " values, expected " + std::to_string(total));
+  Require(steps >= 0, "optimizer state with a negative step count");
+  const float* at = values.data();
+  for (std::vector<Matrix>* list : state_) {
+    for (Matrix& m : *list) {
+      std::copy(at, at + m.size(), m.data());
+      at += m.size();
+    }
+  }
+  if (steps_ != nullptr) *steps_ = steps;
+}
+
 Adam::Adam(std::vector<Param> params, float lr, float beta1, float beta2, float eps)
     : Optimizer(std::move(params), lr), beta1_(beta1), beta2_(beta2), eps_(eps) {
   Require(beta1 >= 0.0f && beta1 < 1.0f,
@@ -63,6 +89,9 @@ Adam::Adam(std::vector<Param> params, float lr, float beta1, float beta2, float 
   Require(eps >= 0.0f, "Adam eps must be >= 0, got " + std::to_string(eps));
   m_ = ZerosLike(this->params());
   v_ = ZerosLike(this->params());
+  RegisterState(&m_);
+  RegisterState(&v_);
+  RegisterStepCounter(&step_count_);
 }
 
 void Adam::Step() {
@@ -99,6 +128,9 @@ RmsProp::RmsProp(std::vector<Param> params, float lr, float alpha, float eps, bo
   square_avg_ = ZerosLike(this->params());
   if (centered_) grad_avg_ = ZerosLike(this->params());
   if (momentum_ > 0.0f) momentum_buf_ = ZerosLike(this->params());
+  RegisterState(&square_avg_);
+  RegisterState(&grad_avg_);
+  RegisterState(&momentum_buf_);
 }
 
 void RmsProp::Step() {

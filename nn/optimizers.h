@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "nn/tensor.h"
@@ -24,14 +25,28 @@ class Optimizer {
   void set_learning_rate(float lr) { learning_rate_ = lr; }
   float learning_rate() const { return learning_rate_; }
 
+  /// The optimizer's state, so that a restarted learner continues where it stopped: every
+  /// per-parameter buffer (Adam's moments; RMSprop's averages and momentum), one after another in
+  /// parameter order, each column-major, and the number of steps taken. SetState() restores what
+  /// GetState() wrote for an optimizer of the same parameters and settings; it throws
+  /// std::invalid_argument (state unchanged) when the size does not match or steps < 0.
+  void GetState(std::vector<float>* values, int64_t* steps) const;
+  void SetState(std::span<const float> values, int64_t steps);
+
  protected:
   /// Throws std::invalid_argument if lr < 0; checks that every Param has a same-shaped grad.
   Optimizer(std::vector<Param> params, float lr);
   const std::vector<Param>& params() const { return params_; }
+  /// Subclasses name their per-parameter buffers (in GetState() order) and their step counter
+  /// once, in their constructor; both must be members of the optimizer itself.
+  void RegisterState(std::vector<Matrix>* buffers) { state_.push_back(buffers); }
+  void RegisterStepCounter(int64_t* steps) { steps_ = steps; }
 
  private:
   std::vector<Param> params_;
   float learning_rate_;
+  std::vector<std::vector<Matrix>*> state_;
+  int64_t* steps_ = nullptr;
 };
 
 /// Adam (Kingma & Ba) with bias correction, as torch.optim.Adam without weight decay/amsgrad:

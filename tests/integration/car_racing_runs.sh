@@ -17,14 +17,7 @@ set -e
 tail -6 "$dir/launch.log"
 [ "$status" -eq 1 ] || fail "launch exited with $status (expected 1: the budget ran out unsolved)"
 grep -q "TD3" "$dir/run/logs/learner.log" || fail "the learner did not run TD3"
-last=$(grep '^replay: size' "$dir/run/logs/replay.log" | tail -1)
-echo "$last"
-[ -n "$last" ] || fail "no progress line from the replay"
-field() { echo "$last" | sed -n "s/.* $1 \([0-9]*\).*/\1/p"; }
-[ "$(field frames)" -gt 0 ] || fail "the replay stored no frames"
-[ "$(field lost)" -eq 0 ] || fail "the replay lost messages"
-[ "$(field dropped)" -eq 0 ] || fail "the replay dropped messages"
-[ "$(field missing_frames)" -eq 0 ] || fail "transitions named frames that never arrived"
+expect_clean_pixel_replay "$dir/run"
 # The evaluator scored checkpoints, on the env without the training pipeline's changes.
 [ -s "$dir/run/eval.jsonl" ] || fail "the evaluator scored no checkpoint"
 grep -q 'CarRacing-v3+pixels(skip=5,max-pool=0,crop-bottom=12,crop-left=6,crop-right=6,width=0,height=0,stack=4)' \

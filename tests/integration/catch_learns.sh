@@ -15,14 +15,7 @@ tail -6 "$dir/launch.log"
 best=$(best_mean "$dir/run/eval.jsonl")
 awk -v b="$best" 'BEGIN{exit !(b >= 0.8)}' || fail "best evaluation mean $best < 0.8"
 # The replay stored pixel frames, applied the learner's priorities, and lost nothing.
-last=$(grep '^replay: size' "$dir/run/logs/replay.log" | tail -1)
-echo "$last"
-[ -n "$last" ] || fail "no progress line from the replay"
-field() { echo "$last" | sed -n "s/.* $1 \([0-9]*\).*/\1/p"; }
-[ "$(field frames)" -gt 0 ] || fail "the replay stored no frames"
-[ "$(field priorities)" -gt 0 ] || fail "the replay applied no priorities"
-[ "$(field lost)" -eq 0 ] || fail "the replay lost messages"
-[ "$(field dropped)" -eq 0 ] || fail "the replay dropped messages"
-[ "$(field missing_frames)" -eq 0 ] || fail "transitions named frames that never arrived"
+expect_clean_pixel_replay "$dir/run"
+[ "$(replay_field priorities)" -gt 0 ] || fail "the replay applied no priorities"
 [ -s "$dir/run/report/best.webm" ] || fail "no video of the greedy policy"
 echo "PASS: Catch learned from pixels to a mean of $best"

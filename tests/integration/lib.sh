@@ -56,6 +56,19 @@ expect_best_mean() {  # expect_best_mean RUN_DIR MIN [--at-least]
   echo "$best"
 }
 
+# Checks the replay's last progress line of a pixel run (kept in $replay_last and printed): it
+# stored frames, and lost, dropped and missed nothing. replay_field NAME reads a number of it.
+replay_field() { echo "$replay_last" | sed -n "s/.* $1 \([0-9]*\).*/\1/p"; }
+expect_clean_pixel_replay() {  # expect_clean_pixel_replay RUN_DIR
+  replay_last=$(grep '^replay: size' "$1/logs/replay.log" | tail -1)
+  echo "$replay_last"
+  [ -n "$replay_last" ] || fail "no progress line from the replay"
+  [ "$(replay_field frames)" -gt 0 ] || fail "the replay stored no frames"
+  [ "$(replay_field lost)" -eq 0 ] || fail "the replay lost messages"
+  [ "$(replay_field dropped)" -eq 0 ] || fail "the replay dropped messages"
+  [ "$(replay_field missing_frames)" -eq 0 ] || fail "transitions named frames that never arrived"
+}
+
 # Waits (bounded) until FILE has a line matching PATTERN.
 wait_line() {  # wait_line FILE PATTERN TIMEOUT_SECONDS
   local file=$1 pattern=$2 limit=$3

@@ -225,7 +225,9 @@ TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFiles) {
     left.push_back(e.path().filename().string());
   }
   std::sort(left.begin(), left.end());
-  EXPECT_EQ(left, (std::vector<std::string>{"ckpt-000000040.bin", "ckpt-000000050.bin"}));
+  // The learner's state (for a restart) is kept beside them.
+  EXPECT_EQ(left, (std::vector<std::string>{"ckpt-000000040.bin", "ckpt-000000050.bin",
+                                            "learner-state.bin"}));
 }
 
 TEST(LearnerConfigTest, RefusesBadSettings) {
@@ -291,6 +293,82 @@ TEST(LearnerConfigTest, RefusesAlgorithmsThatDoNotFitTheEnv) {
   EXPECT_THROW(Learner(c, &bus), std::invalid_argument);
   c.algorithm = "sac";
   EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
+// A restarted learner with --resume continues from the state written with its last checkpoint:
+// the update count, env steps and weight versions carry on, and nothing goes back. Both learners
+// live to the end of the test: the bus keeps their subscriptions.
+void ExpectResumes(LearnerConfig c, Bus* bus, std::set<int64_t>* versions,
+                   std::vector<std::string>* announced) {
+  std::vector<float> saved_policy;
+  Learner first(c, bus);
+  EXPECT_FALSE(first.resumed());
+  first.Run();
+  first.algorithm().policy().GetFlat(&saved_policy);
+  bus->Handle(0);
+  versions->clear();
+  c.resume = true;
+  c.max_updates = 45;
+  Learner second(c, bus);
+  ASSERT_TRUE(second.resumed());
+  EXPECT_EQ(second.updates(), 30);
+  std::vector<float> policy;
+  second.algorithm().policy().GetFlat(&policy);
+  EXPECT_EQ(policy, saved_policy);
+  second.Run();
+  bus->Handle(0);
+  EXPECT_EQ(second.updates(), 45);
+  ASSERT_FALSE(versions->empty());
+  EXPECT_EQ(*versions->begin(), 30) << "the first broadcast of the resumed learner";
+  const nn::Checkpoint last = nn::LoadCheckpoint(announced->back());
+  EXPECT_EQ(last.meta.update, 45);
+  EXPECT_EQ(last.meta.env_steps, 1234);
+}
+
+TEST_F(LearnerTest, DqnResumesFromItsSavedStateAndNeverGoesBack) {
+  ExpectResumes(ShortRun(16, 30, 10), bus_.get(), &versions_, &announced_);
+}
+
+TEST_F(LearnerTest, Td3ResumesFromItsSavedStateAndNeverGoesBack) {
+  obs_size_ = 3;
+  continuous_ = true;
+  LearnerConfig c = ShortRun(16, 30, 10);
+  c.env_id = "Pendulum-v1";
+  c.algorithm = "td3";
+  c.td3.hidden = {16, 16};
+  ExpectResumes(c, bus_.get(), &versions_, &announced_);
+}
+
+TEST_F(LearnerTest, RefusesAStateOfAnotherRunOrATornOne) {
+  Learner first(ShortRun(8, 10, 10), bus_.get());  // alive to the end: the bus keeps its handler
+  first.Run();
+  const std::string state = (dir_ / "checkpoints" / "learner-state.bin").string();
+  ASSERT_TRUE(fs::exists(state));
+  // Another algorithm (the state's kind) and another env (same algorithm).
+  LearnerConfig td3 = ShortRun(8, 10, 10);
+  td3.env_id = "Pendulum-v1";
+  td3.algorithm = "td3";
+  td3.resume = true;
+  EXPECT_THROW(Learner(td3, bus_.get()), std::runtime_error);
+  LearnerConfig lunar = ShortRun(8, 10, 10);
+  lunar.env_id = "LunarLander-v3";
+  lunar.resume = true;
+  EXPECT_THROW(Learner(lunar, bus_.get()), std::runtime_error);
+  // A torn file.
+  fs::resize_file(state, fs::file_size(state) / 2);
+  LearnerConfig same = ShortRun(8, 10, 10);
+  same.resume = true;
+  try {
+    Learner torn(same, bus_.get());
+    ADD_FAILURE() << "a torn state was loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("learner-state.bin"), std::string::npos) << e.what();
+  }
+  // Without --resume the state is ignored and the learner starts afresh.
+  same.resume = false;
+  Learner fresh(same, bus_.get());
+  EXPECT_FALSE(fresh.resumed());
+  EXPECT_EQ(fresh.updates(), 0);
 }
 
 }  // namespace

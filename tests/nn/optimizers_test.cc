@@ -275,5 +275,42 @@ TEST(RmsPropTest, CenteredRmsPropTrainsAConvNet) {
   }
 }
 
+// A copy of an optimizer's state (and of the parameters) continues exactly as the original.
+TEST(OptimizerStateTest, RestoredStateContinuesBitForBit) {
+  for (int kind = 0; kind < 2; ++kind) {
+    TwoFloats a, b;
+    std::unique_ptr<Optimizer> oa, ob;
+    if (kind == 0) {
+      oa = std::make_unique<Adam>(a.params(), 0.1f);
+      ob = std::make_unique<Adam>(b.params(), 0.1f);
+    } else {
+      oa = std::make_unique<RmsProp>(a.params(), 0.1f, 0.9f, 1e-8f, true, 0.5f);
+      ob = std::make_unique<RmsProp>(b.params(), 0.1f, 0.9f, 1e-8f, true, 0.5f);
+    }
+    a.SetGrad(0.5f, -0.1f);
+    oa->Step();
+    a.SetGrad(0.2f, 0.3f);
+    oa->Step();
+    std::vector<float> state;
+    int64_t steps = -1;
+    oa->GetState(&state, &steps);
+    EXPECT_EQ(state.size(), kind == 0 ? 4U : 6U);  // Adam: m, v; centred RMSprop with momentum: 3
+    EXPECT_EQ(steps, kind == 0 ? 2 : 0);
+    ob->SetState(state, steps);
+    b.value = a.value;
+    a.SetGrad(-0.4f, 0.7f);
+    b.SetGrad(-0.4f, 0.7f);
+    oa->Step();
+    ob->Step();
+    EXPECT_EQ(a.value(0), b.value(0));
+    EXPECT_EQ(a.value(1), b.value(1));
+    // A state of another size is refused.
+    state.push_back(1.0f);
+    EXPECT_THROW(ob->SetState(state, steps), std::invalid_argument);
+    state.pop_back();
+    EXPECT_THROW(ob->SetState(state, -1), std::invalid_argument);
+  }
+}
+
 }  // namespace
 }  // namespace rl::nn
