@@ -27,6 +27,7 @@ packages=(
   libeigen3-dev libboost-program-options-dev libgtest-dev
   libbox2d-dev libbullet-dev libopencv-dev libosmesa6-dev
   iproute2 util-linux procps
+  chromium  # headless: the integration test that renders the report and compare pages
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <string>
@@ -68,7 +69,16 @@ std::string Score(double v) {
   return buf;
 }
 
-std::string ProgressLine(const View& v, double elapsed, double now) {
+// Lines of the launch script's restarts file (one per restarted process); 0 when there is none.
+int64_t CountRestarts(const std::string& path) {
+  if (path.empty()) return 0;
+  std::ifstream in(path);
+  int64_t n = 0;
+  for (std::string line; std::getline(in, line);) n += !line.empty();
+  return n;
+}
+
+std::string ProgressLine(const View& v, double elapsed, double now, int64_t restarts = 0) {
   int64_t steps = 0, episodes = 0, lost = 0, dropped = 0;
   double ret = 0;
   int live = 0, paused = 0;
@@ -101,6 +111,7 @@ std::string ProgressLine(const View& v, double elapsed, double now) {
                 v.learner.updates_per_second, Thousands(v.learner.updates).c_str(),
                 Thousands(v.replay.size).c_str(), live, paused > 0 ? " (paused)" : "",
                 static_cast<long long>(lost), static_cast<long long>(dropped));
+  if (restarts > 0) return std::string(line) + "  restarts " + std::to_string(restarts);
   return line;
 }
 
@@ -111,6 +122,7 @@ int Main(int argc, char** argv) {
   double stale_seconds = 20;
   double print_seconds = 1;
   std::string metrics_path;
+  std::string restarts_path;
   rl::po::options_description desc("Options");
   rl::AddCommonOptions(&desc, &common);
   desc.add_options()                                                                            //
@@ -123,7 +135,10 @@ int Main(int argc, char** argv) {
        "seconds between progress lines")  //
       ("metrics", rl::po::value(&metrics_path),
        "append every process's stats to this file as JSON lines (a row a second for the first "
-       "hour, then every 10 s)");
+       "hour, then every 10 s)")  //
+      ("restarts", rl::po::value(&restarts_path),
+       "the launch script's file of restarted processes (a line each): their count joins the "
+       "progress line");
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "monitor",
                         "Usage: monitor [options]\n"
@@ -206,13 +221,16 @@ int Main(int argc, char** argv) {
       if (!row.empty()) metrics->AppendRow(elapsed, row);
     }
     if (now >= next_print) {
-      std::printf(tty ? "\r%s\033[K" : "%s\n", ProgressLine(v, elapsed, now).c_str());
+      std::printf(tty ? "\r%s\033[K" : "%s\n",
+                  ProgressLine(v, elapsed, now, CountRestarts(restarts_path)).c_str());
       std::fflush(stdout);
       next_print = now + print_seconds;
     }
   }
-  std::printf("%s%s\n", tty ? "\r" : "",
-              ProgressLine(v, rl::MonoSeconds() - start, rl::MonoSeconds()).c_str());
+  std::printf(
+      "%s%s\n", tty ? "\r" : "",
+      ProgressLine(v, rl::MonoSeconds() - start, rl::MonoSeconds(), CountRestarts(restarts_path))
+          .c_str());
   return status;
 }
 

@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# SIGKILL of the learner, the replay, the evaluator and an actor at once, mid-run: the launch
+# script's supervisors restart each of them, the learner resumes from the state it saved with its
+# last checkpoint (its update count carries on from there), weight versions never go back, and
+# the run still reaches the CartPole goal.
+source "$(dirname "$0")/lib.sh"
+isolate "$@"
+scratch
+launch cartpole --out "$dir/run" --actors 2 --seed 3 --time-budget 240 > "$dir/launch.log" 2>&1 &
+launch_pid=$!
+# Mid-run: the learner has written its state with its first checkpoint.
+wait_line "$dir/launch.log" "running; logs in" 60
+timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$dir/run/checkpoints/learner-state.bin" ||
+  fail "no learner state after 60 s"
+for role in learner replay evaluator actor-1; do
+  victim=$(awk -v r="$role" '$1 == r {p = $2} END {print p}' "$dir/run/pids")
+  [ -n "$victim" ] || fail "no pid for $role"
+  kill -KILL "$victim"
+  echo "killed $role (pid $victim)"
+done
+set +e
+wait "$launch_pid"
+status=$?
+set -e
+tail -8 "$dir/launch.log"
+[ "$status" -eq 0 ] || fail "launch exited with $status after the kills"
+for role in learner replay evaluator actor-1; do
+  grep -q " $role status 137 restart 1$" "$dir/run/restarts" || fail "$role was not restarted"
+done
+grep -q "restarts 4" "$dir/run/logs/monitor.log" || fail "the progress line does not count 4 restarts"
+# The learner resumed from its saved state, and counted on from there.
+resumed=$(sed -n 's/.*resumed at update \([0-9]*\).*/\1/p' "$dir/run/logs/learner.log" | head -1)
+[ -n "$resumed" ] && [ "$resumed" -gt 0 ] || fail "the restarted learner did not resume"
+last=$(sed -n 's/^learner: stopped after \([0-9]*\) updates/\1/p' "$dir/run/logs/learner.log" | tail -1)
+[ "${last:-0}" -gt "$resumed" ] || fail "the resumed learner did not train on (stopped at $last)"
+# Weight versions never went back in any actor.
+awk '/"role": "actor-/ {
+    role = $0; sub(/.*"role": "/, "", role); sub(/".*/, "", role)
+    v = $0; sub(/.*"weights_version": /, "", v); sub(/[,}].*/, "", v)
+    if ((role in last) && v + 0 < last[role]) { print role " went from " last[role] " to " v; bad = 1 }
+    last[role] = v + 0 }
+  END { exit bad }' "$dir/run/metrics.jsonl" || fail "a weights version went back"
+echo "PASS: 4 processes killed and restarted, the learner resumed at update $resumed, goal reached"

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# A run stopped with a signal (as Ctrl-C stops it) and continued with `launch.sh --resume`: the
+# same folder, run id and config; the learner resumes from its saved state; update counts, env
+# steps and the evaluation history carry on; and the resumed run reaches the CartPole goal.
+source "$(dirname "$0")/lib.sh"
+isolate "$@"
+scratch
+# First part: an unreachable goal, stopped by a signal once an evaluation has been written.
+# (launch.sh itself in the background, not lib.sh's function: its pid is the one to signal.)
+"$root/scripts/launch.sh" cartpole --no-setup --build-dir "$build_dir" --out "$dir/run" \
+  --actors 2 --seed 4 --goal 100000 --time-budget 240 > "$dir/first.log" 2>&1 &
+launch_pid=$!
+wait_line "$dir/first.log" "running; logs in" 60
+wait_line "$dir/run/eval.jsonl" '"update"' 120
+timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$dir/run/checkpoints/learner-state.bin" ||
+  fail "no learner state after 60 s"
+kill -TERM "$launch_pid"
+set +e
+wait "$launch_pid"
+status=$?
+set -e
+[ "$status" -eq 130 ] || fail "the stopped launch exited with $status, not 130"
+run_id=$(run_setting "$dir/run" run-id)
+evals_before=$(wc -l < "$dir/run/eval.jsonl")
+last_update_before=$(sed -n 's/.*"update": \([0-9]*\).*/\1/p' "$dir/run/eval.jsonl" | tail -1)
+# Second part: resumed, with the preset's goal.
+set +e
+"$root/scripts/launch.sh" --resume "$dir/run" --no-setup --build-dir "$build_dir" --time-budget 240 \
+  > "$dir/second.log" 2>&1
+status=$?
+set -e
+tail -5 "$dir/second.log"
+[ "$status" -eq 0 ] || fail "the resumed run exited with $status"
+grep -q "run $run_id of 'cartpole'" "$dir/second.log" || fail "the resumed run has another id"
+grep -q '^# resumed ' "$dir/run/config.ini" || fail "config.ini does not record the resumption"
+resumed=$(sed -n 's/.*resumed at update \([0-9]*\).*/\1/p' "$dir/run/logs/learner.log" | tail -1)
+[ -n "$resumed" ] && [ "$resumed" -gt 0 ] || fail "the learner did not resume"
+# The history carries on: earlier evaluations kept, later ones at higher updates.
+[ "$(wc -l < "$dir/run/eval.jsonl")" -gt "$evals_before" ] || fail "no new evaluation"
+head -n "$evals_before" "$dir/run/eval.jsonl" | tail -1 | grep -q "\"update\": $last_update_before," ||
+  fail "the earlier evaluations were not kept"
+awk -F'"update": ' '{split($2, a, ","); u = a[1] + 0; if (u < prev) { print "update " u " after " prev; exit 1 } prev = u}' \
+  "$dir/run/eval.jsonl" || fail "evaluation updates went back"
+awk -F'"env_steps": ' '{split($2, a, ","); s = a[1] + 0; if (s < prev) { print "env steps " s " after " prev; exit 1 } prev = s}' \
+  "$dir/run/eval.jsonl" || fail "evaluation env steps went back"
+echo "PASS: stopped at update $last_update_before, resumed at $resumed, goal reached"
