@@ -2,6 +2,7 @@
 
 #include "envs/specs.h"
 #include "evaluator/frame_grid.h"
+#include "evaluator/tsne_map.h"
 #include "evaluator/video.h"
 
 #include <algorithm>
@@ -65,6 +66,11 @@ void EvaluatorConfig::Validate() const {
     throw std::invalid_argument("stats period must be positive");
   }
   if (std::isinf(goal)) throw std::invalid_argument("goal must be finite");
+  if (tsne != 0 && (tsne < kTsneMapMinStates || tsne > kTsneMapMaxStates)) {
+    throw std::invalid_argument("tsne must be 0 (no map) or " + std::to_string(kTsneMapMinStates) +
+                                " to " + std::to_string(kTsneMapMaxStates) + " states, got " +
+                                std::to_string(tsne));
+  }
 }
 
 nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env_id,
@@ -124,6 +130,11 @@ EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* 
   const envs::EnvSpec spec = envs::LookupSpec(config_.env_id);
   goal_ = std::isnan(config_.goal) ? spec.reward_threshold : config_.goal;
   has_frames_ = spec.frame_height > 0;
+  if (config_.tsne > 0 && !has_frames_) {
+    throw std::invalid_argument("tsne needs a pixel env (its maps show camera frames); " +
+                                config_.env_id + " has none");
+  }
+  start_time_ = MonoSeconds();
   char epsilon[32], gamma[32];
   std::snprintf(epsilon, sizeof(epsilon), "%g", config_.epsilon);
   std::snprintf(gamma, sizeof(gamma), "%g", config_.gamma);
@@ -209,6 +220,8 @@ bool EvaluatorService::Poll(int timeout_ms) {
   const int stats_ms = until_stats <= 0 ? 0 : static_cast<int>(std::ceil(until_stats * 1000.0));
   bus_->Handle(std::clamp(stats_ms, 0, std::max(timeout_ms, 0)));
   const bool reached = ScorePending();
+  // A map left due by the time share is made when the time allows, between checkpoints.
+  if (!reached && !pending_) MakeDueTsneMap();
   if (MonoSeconds() >= next_stats_time_) PublishStats();
   return reached && config_.stop_at_goal;
 }
@@ -268,6 +281,19 @@ bool EvaluatorService::ScorePending() {
   if (config_.videos && !report_dir_.empty() && record.mean > best_video_mean_) {
     RecordVideo(announced.path, record);
   }
+  // A new best checkpoint's t-SNE map becomes due (replacing an older best's that was not made).
+  if (config_.tsne > 0 && !report_dir_.empty() && record.mean > best_tsne_mean_) {
+    try {
+      tsne_net_ = LoadPolicyNetwork(announced.path, config_.env_id);
+      tsne_record_ = record;
+      best_tsne_mean_ = record.mean;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "evaluator: no t-SNE map: %s\n", e.what());
+      std::fflush(stderr);
+    }
+  }
+  // At the goal the run may end as soon as the result is out: a quick map goes first.
+  if (reached && tsne_net_ && ExpectedTsneSeconds() <= kTsneGoalSeconds) MakeTsneMap();
 
   // Persist: the line first (the history), then the report.
   if (!jsonl_path_.empty()) {
@@ -295,7 +321,108 @@ bool EvaluatorService::ScorePending() {
       static_cast<long long>(record.update), static_cast<long long>(record.env_steps),
       record.wall_seconds, record.mean, record.std, record.min, record.max, record.episodes,
       record.eval_seconds, reached ? ", goal reached" : "");
+  MakeDueTsneMap();
   return reached;
+}
+
+void EvaluatorService::MakeDueTsneMap() {
+  if (!tsne_net_ || report_dir_.empty() || StopRequested()) return;
+  if (tsne_seconds_ + ExpectedTsneSeconds() > kTsneTimeShare * (MonoSeconds() - start_time_)) {
+    return;
+  }
+  if (MakeTsneMap()) WriteReportNow();
+}
+
+double EvaluatorService::ExpectedTsneSeconds() const {
+  return last_tsne_seconds_ > 0 ? last_tsne_seconds_ : kTsneFirstGuessSeconds;
+}
+
+bool EvaluatorService::MakeTsneMap() {
+  if (!tsne_net_) return false;
+  const EvalRecord record = tsne_record_;
+  const double start = MonoSeconds();
+  double next_line = start + 2.0;  // progress lines only for a map that takes a while
+  busy_ = true;
+  PublishStats();
+  struct Stopped {};
+  // Between episodes and every 50 iterations: stop requests, stats, and a line every 5 s.
+  auto tick = [&](const std::string& line) {
+    if (StopRequested()) throw Stopped{};
+    if (MonoSeconds() >= next_stats_time_) PublishStats();
+    if (MonoSeconds() >= next_line) {
+      Log("evaluator: t-SNE map of %s: %s (%.0f s)\n", record.checkpoint.c_str(), line.c_str(),
+          MonoSeconds() - start);
+      next_line = MonoSeconds() + 5.0;
+    }
+  };
+  bool written = false;
+  try {
+    const StateSamples samples = CollectStates(
+        &*tsne_net_, config_.env_id, config_.tsne, config_.seed_base, config_.gamma,
+        [&](int states) {
+          tick(std::to_string(states) + " of " + std::to_string(config_.tsne) + " states");
+        });
+    const double collected = MonoSeconds();
+    TsneConfig tsne;
+    const TsneMapResult map = WriteTsneMap(
+        samples, tsne, (std::filesystem::path(report_dir_) / kTsneMap).string(),
+        [&](const TsneProgress& p) {
+          char line[96];
+          std::snprintf(line, sizeof(line), "t-SNE iteration %d of %d, KL divergence %.3f",
+                        p.iteration, p.iterations, p.kl_divergence);
+          tick(line);
+        });
+    const double seconds = MonoSeconds() - start;
+    char gamma[32];
+    std::snprintf(gamma, sizeof(gamma), "%g", config_.gamma);
+    const std::string colour =
+        samples.value_is_return
+            ? std::string("the discounted return (gamma ") + gamma +
+                  ") that followed the state in its episode, as the checkpoint holds the actor "
+                  "network only, which has no value estimate (in an episode cut by its time "
+                  "limit, the return up to the cut: short of the truth near the cut)"
+            : std::string("the network's value estimate of the state, max_a Q(s, a)");
+    char distinct[96] = "";
+    if (map.distinct < map.states) {
+      std::snprintf(distinct, sizeof(distinct),
+                    " (%d distinct: a state seen k times is a disc of up to 9 times the area)",
+                    map.distinct);
+    }
+    char caption[1536];
+    std::snprintf(
+        caption, sizeof(caption),
+        "The last hidden layer of %s (update %lld, evaluation mean %.2f) as in Mnih et al. 2015, "
+        "Figure 4: the %d activations (the input of its %s layer) in %d states%s of %d greedy "
+        "episodes (epsilon 0, seeds from %llu), embedded in 2-D with t-SNE (van der Maaten and "
+        "Hinton 2008; perplexity %.3g, %d iterations, KL divergence %.2f). States the network "
+        "represents alike lie close together. Colour: %s, from %.3g to %.3g. Beside the map, "
+        "the newest input frame of %zu states from the lowest to the highest value, each joined "
+        "to its point (ringed).",
+        record.checkpoint.c_str(), static_cast<long long>(record.update), record.mean, map.features,
+        samples.layer_description.c_str(), map.states, distinct, map.episodes,
+        static_cast<unsigned long long>(config_.seed_base), map.perplexity, tsne.iterations,
+        map.kl_divergence, colour.c_str(), map.value_min, map.value_max, map.thumbnails.size());
+    tsne_caption_ = caption;
+    Log("evaluator: t-SNE map of %s (update %lld): %d states of %d greedy episodes (%d "
+        "distinct), %d features, KL divergence %.2f (%.1f s: %.1f s playing, %.1f s "
+        "embedding)\n",
+        record.checkpoint.c_str(), static_cast<long long>(record.update), map.states, map.episodes,
+        map.distinct, map.features, map.kl_divergence, seconds, collected - start,
+        MonoSeconds() - collected);
+    written = true;
+    tsne_net_.reset();
+  } catch (const Stopped&) {
+    Log("evaluator: stopped during the t-SNE map of %s\n", record.checkpoint.c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "evaluator: no t-SNE map: %s\n", e.what());
+    std::fflush(stderr);
+    tsne_net_.reset();
+  }
+  busy_ = false;
+  const double seconds = MonoSeconds() - start;
+  tsne_seconds_ += seconds;
+  if (written) last_tsne_seconds_ = seconds;
+  return written;
 }
 
 void EvaluatorService::RecordVideo(const std::string& path, const EvalRecord& record) {
@@ -358,6 +485,10 @@ void EvaluatorService::WriteReportNow() {
   if (!frames_caption_.empty()) {
     info.frames_file = kFrameGrid;
     info.frames_caption = frames_caption_;
+  }
+  if (!tsne_caption_.empty()) {
+    info.tsne_file = kTsneMap;
+    info.tsne_caption = tsne_caption_;
   }
   info.run_config = config_.run_config_text;
   info.eval_settings = eval_settings_;

@@ -50,10 +50,25 @@ struct EvaluatorConfig {
   int video_width = 360;  // video frame size in pixels
   int video_height = 240;
   double video_fps = 30;  // frames per second of the videos
+  // Pixel envs: states of greedy episodes in report/tsne.png, the t-SNE map of the last hidden
+  // layer of a new best checkpoint (tsne_map.h; when: kTsneTimeShare below); 0: no map.
+  int tsne = 0;
 
   /// Throws std::invalid_argument saying what is wrong.
   void Validate() const;
 };
+
+/// When the t-SNE map of a new best checkpoint (EvaluatorConfig::tsne) is made. Maps are made
+/// after the checkpoint's result is published, and only while all maps, this one's expected
+/// duration included, take at most kTsneTimeShare of the evaluator's time since it started; until
+/// then the report keeps the last map and the newest best's map stays due (made between later
+/// checkpoints when the share allows). A map's expected duration is the last one's, or
+/// kTsneFirstGuessSeconds before the first. A checkpoint that reaches the goal, after which the run
+/// usually ends, gets its map before its result is published when it is expected to take at most
+/// kTsneGoalSeconds: that delays the end of the run by as much, once.
+inline constexpr double kTsneTimeShare = 0.2;
+inline constexpr double kTsneFirstGuessSeconds = 5.0;
+inline constexpr double kTsneGoalSeconds = 15.0;
 
 /// Loads a checkpoint file and builds its network; fills *meta when not null. Throws
 /// std::runtime_error with the reason when the file is refused (see ScoreCheckpointFile).
@@ -102,6 +117,10 @@ class EvaluatorService {
   /// Records report/best.webm, a greedy episode of the checkpoint at `path`, and for pixel envs
   /// report/frames.png, its grid of camera frames.
   void RecordVideo(const std::string& path, const EvalRecord& record);
+  /// Whether a t-SNE map is due (a new best checkpoint not mapped yet, with config.tsne > 0).
+  bool tsne_map_due() const { return tsne_net_.has_value(); }
+  /// Seconds spent on t-SNE maps so far.
+  double tsne_seconds() const { return tsne_seconds_; }
 
   /// Publishes stats_evaluator_t now.
   void PublishStats();
@@ -126,6 +145,13 @@ class EvaluatorService {
 
  private:
   void OnCheckpoint(const rlmsg::checkpoint_t& msg);
+  // Makes report/tsne.png for the due network now, with progress lines and stats; logs failures.
+  // Returns true when the map was written. A stop request during it leaves the map due.
+  bool MakeTsneMap();
+  // MakeTsneMap() when a map is due and the time share allows it; rewrites the report after it.
+  void MakeDueTsneMap();
+  // The expected duration of the next map.
+  double ExpectedTsneSeconds() const;
   void Log(const char* fmt, ...) const __attribute__((format(printf, 2, 3)));
 
   EvaluatorConfig config_;
@@ -147,6 +173,14 @@ class EvaluatorService {
   std::string video_caption_;   // empty until a video was recorded
   bool has_frames_ = false;     // a pixel env: the report gets a grid of camera frames
   std::string frames_caption_;  // empty until a frame grid was written
+  // The t-SNE map: the network and record of the best checkpoint whose map is due.
+  std::optional<nn::Sequential> tsne_net_;
+  EvalRecord tsne_record_;
+  double best_tsne_mean_ = -std::numeric_limits<double>::infinity();
+  double tsne_seconds_ = 0;       // spent on maps, aborted ones included
+  double last_tsne_seconds_ = 0;  // the last map written took this long (0: none yet)
+  std::string tsne_caption_;      // empty until a map was written
+  double start_time_ = 0;         // MonoSeconds() at construction
   int64_t duplicates_ = 0;
   double last_mean_ = 0;
   bool busy_ = false;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/clock.h"
 #include "common/lcm_bus.h"
 #include "common/options.h"
 #include "common/shutdown.h"
@@ -14,6 +15,7 @@
 #include "evaluator/evaluator_service.h"
 #include "evaluator/frame_grid.h"
 #include "evaluator/report.h"
+#include "evaluator/tsne_map.h"
 
 namespace {
 
@@ -27,16 +29,27 @@ constexpr char kUsage[] =
     "      SIGTERM, or with --stop-at-goal once a checkpoint reaches the goal, and then prints\n"
     "      'evaluator: goal reached' or 'evaluator: goal not reached (best X)'; exit status 0.\n"
     "  evaluator --checkpoint FILE [--env ID] [--episodes N] [--epsilon E] [--seed-base S]\n"
-    "            [--gamma G] [--frames PNG]\n"
+    "            [--gamma G] [--frames PNG] [--tsne-map PNG [--tsne N]]\n"
     "      Standalone mode: scores one checkpoint file and prints one JSON object (checkpoint,\n"
     "      update, env_steps, wall_seconds, mean, std, min, max, episodes, eval_seconds, and\n"
     "      value_steps, value_estimate, value_return, value_correlation: the network's value\n"
     "      estimates of the actions taken against the discounted returns that followed).\n"
-    "      --frames also writes the grid of camera frames the report shows (pixel envs).\n"
+    "      --frames also writes the grid of camera frames the report shows (pixel envs),\n"
+    "      --tsne-map the t-SNE map of its last hidden layer (pixel envs; N states, 2000 by\n"
+    "      default).\n"
     "      A refused file prints 'evaluator: error: <reason>' and exits with status 2.\n"
     "\n"
     "Episode i of an evaluation is reset with seed seed-base + i; the default seed base is far\n"
-    "above the seeds actors train with, so evaluation never replays a training seed.";
+    "above the seeds actors train with, so evaluation never replays a training seed.\n"
+    "\n"
+    "--tsne N (pixel envs): the report gets a t-SNE map of the network's last hidden layer, as in\n"
+    "Mnih et al. 2015, Figure 4 (report/tsne.png): N states of greedy episodes of a new best\n"
+    "checkpoint placed by a 2-D t-SNE embedding of the activations, coloured by value (DQN:\n"
+    "max_a Q(s, a); TD3: the discounted return that followed), with some of their frames. A map\n"
+    "costs N greedy steps and an O(N^2) embedding (under 1 s of CPU for 2000 states). Maps are\n"
+    "made after a checkpoint's result, within a fifth of the evaluator's time, so not every new\n"
+    "best gets one at once; a checkpoint that reaches the goal gets its map before its result\n"
+    "when that is expected to take at most 15 s.";
 
 std::string ReadTextFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -46,6 +59,29 @@ std::string ReadTextFile(const std::string& path) {
   return text.str();
 }
 
+// Standalone mode's --tsne-map: the map of one checkpoint, with progress lines on stderr.
+void WriteTsneMapOfCheckpoint(const std::string& checkpoint, rl::evaluator::EvaluatorConfig config,
+                              const rl::po::variables_map& vm, const std::string& path) {
+  if (vm["tsne"].defaulted()) config.tsne = 2000;
+  if (config.tsne == 0) throw std::invalid_argument("--tsne-map needs --tsne N above 0");
+  config.Validate();
+  rl::nn::Sequential net = rl::evaluator::LoadPolicyNetwork(checkpoint, config.env_id);
+  const double start = rl::MonoSeconds();
+  const rl::evaluator::StateSamples samples = rl::evaluator::CollectStates(
+      &net, config.env_id, config.tsne, config.seed_base, config.gamma);
+  std::fprintf(stderr, "evaluator: t-SNE map: %d states of %d greedy episodes (%.1f s)\n",
+               config.tsne, samples.episodes, rl::MonoSeconds() - start);
+  const rl::evaluator::TsneMapResult map = rl::evaluator::WriteTsneMap(
+      samples, rl::evaluator::TsneConfig(), path, [](const rl::evaluator::TsneProgress& p) {
+        if (p.iteration % 250 == 0) {
+          std::fprintf(stderr, "evaluator: t-SNE iteration %d of %d, KL divergence %.3f\n",
+                       p.iteration, p.iterations, p.kl_divergence);
+        }
+      });
+  std::fprintf(stderr, "evaluator: t-SNE map written to %s (%d features, %.1f s)\n", path.c_str(),
+               map.features, rl::MonoSeconds() - start);
+}
+
 int Main(int argc, char** argv) {
   rl::CommonOptions common;
   rl::evaluator::EvaluatorConfig config;
@@ -53,6 +89,7 @@ int Main(int argc, char** argv) {
   std::string run_config_file;
   std::string eval_env;
   std::string frames_file;
+  std::string tsne_file;
   double goal = 0;
 
   rl::po::options_description desc("Options");
@@ -94,6 +131,13 @@ int Main(int argc, char** argv) {
       ("frames", rl::po::value(&frames_file),
        "standalone mode, pixel envs: also write a grid of camera frames and network inputs of "
        "greedy episodes to this PNG file")  //
+      ("tsne", rl::po::value(&config.tsne)->default_value(config.tsne),
+       "pixel envs: states in the t-SNE map of the last hidden layer of new best checkpoints "
+       "(report/tsne.png; 100 to 5000, 2000 is the presets' choice); 0: no map. Standalone mode: "
+       "the states of the --tsne-map picture (default 2000)")  //
+      ("tsne-map", rl::po::value(&tsne_file),
+       "standalone mode, pixel envs: also write the t-SNE map of the checkpoint's last hidden "
+       "layer (greedy episodes from the first evaluation seed) to this PNG file")  //
       ("run-config", rl::po::value(&run_config_file),
        "text file shown in the report as the run's config (default: the --config file)");
 
@@ -118,6 +162,7 @@ int Main(int argc, char** argv) {
                                     rl::evaluator::kFrameGridEpisodes,
                                     rl::evaluator::kFrameGridColumns, frames_file);
     }
+    if (!tsne_file.empty()) WriteTsneMapOfCheckpoint(checkpoint, config, vm, tsne_file);
     return 0;
   }
 

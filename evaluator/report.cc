@@ -16,6 +16,7 @@
 #include <system_error>
 
 #include "common/atomic_file.h"
+#include "common/text_format.h"
 #include "evaluator/flat_json.h"
 #include "evaluator/learning_curve.h"
 #include "evaluator/training_curves.h"
@@ -31,41 +32,7 @@ namespace {
 
 // ---- HTML pieces ----
 
-std::string Format(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), fmt, v);
-  return buf;
-}
-
-// A return or a value: two decimals below 10 (success rates such as 0.36), else one.
-std::string Score(double v) { return Format(std::fabs(v) < 10 ? "%.2f" : "%.1f", v); }
-
-// 1234567 -> "1,234,567".
-std::string Thousands(int64_t v) {
-  std::string digits = std::to_string(v < 0 ? -v : v);
-  std::string out;
-  for (size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
-    out += digits[i];
-  }
-  return v < 0 ? "-" + out : out;
-}
-
-// 42 -> "42 s", 725 -> "12 min 05 s", 7300 -> "2 h 01 min".
-std::string Duration(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0) return "-";
-  if (seconds < 60) return Format(seconds < 10 ? "%.1f s" : "%.0f s", seconds);
-  const auto total = static_cast<int64_t>(std::llround(seconds));
-  char buf[64];
-  if (total < 3600) {
-    std::snprintf(buf, sizeof(buf), "%lld min %02lld s", static_cast<long long>(total / 60),
-                  static_cast<long long>(total % 60));
-  } else {
-    std::snprintf(buf, sizeof(buf), "%lld h %02lld min", static_cast<long long>(total / 3600),
-                  static_cast<long long>((total % 3600) / 60));
-  }
-  return buf;
-}
+std::string Format(const char* fmt, double v) { return FormatDouble(fmt, v); }
 
 std::string UtcNow() {
   const std::time_t now = std::time(nullptr);
@@ -382,6 +349,15 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
          "\" alt=\"a grid of camera frames and network inputs, one row per greedy "
          "episode\"><figcaption>" +
          HtmlEscape(info.frames_caption) + "</figcaption></figure>\n</section>\n";
+  }
+
+  // How the network tells states apart.
+  if (!info.tsne_file.empty()) {
+    h += "<section>\n<h2>Last hidden layer (t-SNE)</h2>\n<figure><img src=\"" +
+         HtmlEscape(info.tsne_file) +
+         "\" alt=\"a t-SNE map of the network's last hidden layer in states of greedy episodes, "
+         "coloured by value, with some of their frames\"><figcaption>" +
+         HtmlEscape(info.tsne_caption) + "</figcaption></figure>\n</section>\n";
   }
 
   // Table of every checkpoint, newest first.

@@ -66,6 +66,8 @@ struct ReportInfo {
   std::string video_caption;        // what the video shows
   std::string frames_file;          // a grid of camera frames (PNG) in the report folder, or empty
   std::string frames_caption;       // what the grid shows
+  std::string tsne_file;            // a t-SNE map (PNG) in the report folder, or empty
+  std::string tsne_caption;         // what the map shows
   // The run's metrics.jsonl (tools/metrics_log.h), drawn as training curves; empty or missing:
   // no training section.
   std::string metrics_file;
@@ -77,6 +79,7 @@ inline constexpr char kCurveEnvSteps[] = "curve_env_steps.svg";
 inline constexpr char kCurveWallTime[] = "curve_wall_time.svg";
 inline constexpr char kBestVideo[] = "best.webm";
 inline constexpr char kFrameGrid[] = "frames.png";
+inline constexpr char kTsneMap[] = "tsne.png";
 /// Greedy episodes (rows) and cells per row of the frame grid of a pixel env's report.
 inline constexpr int kFrameGridEpisodes = 4;
 inline constexpr int kFrameGridColumns = 8;

@@ -56,6 +56,7 @@ void Sequential::Add(std::unique_ptr<Layer> layer) {
   auto* relu = dynamic_cast<ReLU*>(layer.get());
   fused_forward_.push_back(nullptr);
   fused_backward_.push_back(false);
+  inputs_.push_back(nullptr);
   if (relu != nullptr && prev != nullptr && dynamic_cast<ReLU*>(prev) == nullptr &&
       prev->FuseOutputRelu()) {
     fused_forward_.back() = relu;
@@ -91,10 +92,21 @@ void Sequential::set_training(bool training) {
 const Matrix& Sequential::Forward(const Matrix& x) {
   const Matrix* h = &x;
   for (size_t i = 0; i < layers_.size(); ++i) {
+    inputs_[i] = h;
     h = fused_forward_[i] != nullptr ? &fused_forward_[i]->AdoptOutput(*h)
                                      : &layers_[i]->Forward(*h);
   }
   return *h;
+}
+
+const Matrix& Sequential::LayerInput(int i) const {
+  if (i < 0 || i >= num_layers()) {
+    throw std::out_of_range("LayerInput(" + std::to_string(i) + ") of a network of " +
+                            std::to_string(num_layers()) + " layers");
+  }
+  const Matrix* input = inputs_[static_cast<size_t>(i)];
+  if (input == nullptr) throw std::logic_error("LayerInput before the first forward pass");
+  return *input;
 }
 
 const Matrix& Sequential::Backward(const Matrix& grad_out) {

@@ -110,6 +110,15 @@ class Sequential {
   /// Index of the largest output for one observation (the first on ties); as Predict().
   int Argmax(const float* obs, int obs_size);
 
+  /// The input of layer `i` in the last Forward(), Predict() or Argmax(): for i = 0 the batch
+  /// given (Predict()'s own copy of the observation), else what layer i - 1 returned, a fused ReLU
+  /// included (the input of a layer after a ReLU is the ReLU's output). Reads the activations of
+  /// a hidden layer without another pass, e.g. LayerInput(num_layers() - 1), the features the
+  /// last layer sees. The reference is valid until the next forward pass and only while the
+  /// network is not moved or assigned. Throws std::out_of_range unless 0 <= i < num_layers(), and
+  /// std::logic_error before the first forward pass. O(1).
+  const Matrix& LayerInput(int i) const;
+
   int num_layers() const { return static_cast<int>(layers_.size()); }
   Layer& layer(int i) { return *layers_[static_cast<size_t>(i)]; }
   const Layer& layer(int i) const { return *layers_[static_cast<size_t>(i)]; }
@@ -131,6 +140,8 @@ class Sequential {
   // null; and whether the following layer does its Backward().
   std::vector<ReLU*> fused_forward_;
   std::vector<bool> fused_backward_;
+  // Per layer: its input in the last Forward() (LayerInput()); null before the first.
+  std::vector<const Matrix*> inputs_;
 };
 
 /// Builds a network from an architecture string, the inverse of Sequential::Architecture():

@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "common/atomic_file.h"
+#include "common/text_format.h"
 #include "evaluator/learning_curve.h"
 
 namespace rl::tools {
@@ -55,40 +56,12 @@ std::string Trim(const std::string& s) {
 
 // ---- Numbers on the page ----
 
-std::string Format(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), fmt, v);
-  return buf;
-}
+std::string Format(const char* fmt, double v) { return FormatDouble(fmt, v); }
 
-// A return: two decimals below 10 (success rates such as 0.36), else one (as the report).
-std::string Score(double v) { return Format(std::fabs(v) < 10 ? "%.2f" : "%.1f", v); }
-
-// 1234567 -> "1,234,567".
-std::string Thousands(double value) {
-  const auto v = static_cast<long long>(std::llround(value));
-  const std::string digits = std::to_string(v < 0 ? -v : v);
-  std::string out = v < 0 ? "-" : "";
-  for (size_t i = 0; i < digits.size(); ++i) {
-    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
-    out += digits[i];
-  }
-  return out;
-}
-
-// 42 -> "42 s", 725 -> "12 min 05 s", 7300 -> "2 h 01 min" (as the report).
-std::string Duration(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0) return "\xE2\x80\x94";
-  if (seconds < 60) return Format(seconds < 10 ? "%.1f s" : "%.0f s", seconds);
-  const auto total = static_cast<long long>(std::llround(seconds));
-  char buf[64];
-  if (total < 3600) {
-    std::snprintf(buf, sizeof(buf), "%lld min %02lld s", total / 60, total % 60);
-  } else {
-    std::snprintf(buf, sizeof(buf), "%lld h %02lld min", total / 3600, (total % 3600) / 60);
-  }
-  return buf;
-}
+// The page's counts, durations and scores are the report's (common/text_format.h); a missing
+// duration is a dash.
+std::string Thousands(double value) { return rl::Thousands(std::llround(value)); }
+std::string Duration(double seconds) { return rl::Duration(seconds, "\xE2\x80\x94"); }
 
 // A tick value: whole numbers in full, others with at most three significant digits.
 std::string Plain(double v) {

@@ -18,6 +18,7 @@
 #include "common/clock.h"
 #include "common/options.h"
 #include "common/shutdown.h"
+#include "common/text_format.h"
 #include "rlmsg/eval_result_t.hpp"
 #include "rlmsg/stats_actor_t.hpp"
 #include "rlmsg/stats_evaluator_t.hpp"
@@ -26,6 +27,9 @@
 #include "tools/metrics_log.h"
 
 namespace {
+
+using rl::Score;
+using rl::Thousands;
 
 struct View {
   std::map<std::string, rlmsg::stats_actor_t> actors;  // by sender
@@ -48,25 +52,6 @@ std::string MetricsRow(const View& v, double t) {
   if (v.learner_seen > 0) lines += rl::tools::MetricsLine(t, v.learner);
   if (v.evaluator_seen > 0) lines += rl::tools::MetricsLine(t, v.evaluator);
   return lines;
-}
-
-// 1234567 -> "1,234,567" (appending: GCC 12 warns falsely about string::insert here).
-std::string Thousands(int64_t v) {
-  const std::string digits = std::to_string(v);
-  const std::size_t first = v < 0 ? 1 : 0;  // after the sign
-  std::string out = digits.substr(0, first);
-  for (std::size_t i = first; i < digits.size(); ++i) {
-    if (i > first && (digits.size() - i) % 3 == 0) out += ',';
-    out += digits[i];
-  }
-  return out;
-}
-
-// A return: two decimals below 10 (grasp success rates such as 0.36), else one.
-std::string Score(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), std::abs(v) < 10 ? "%.2f" : "%.1f", v);
-  return buf;
 }
 
 // Lines of the launch script's restarts file (one per restarted process); 0 when there is none.

@@ -183,6 +183,74 @@ TEST_F(EvaluatorServiceTest, ShowsAGridOfCameraFramesForAPixelEnv) {
   EXPECT_NE(html.find("4 greedy episodes"), std::string::npos);
 }
 
+// A Catch checkpoint of a random MLP (a hidden layer of 8).
+std::string WriteCatchCheckpoint(const TempDir& dir, int64_t update) {
+  std::mt19937 rng(5);
+  nn::Sequential net = nn::MakeMlp(2 * 10 * 5, {8}, 3, &rng);
+  nn::Checkpoint ckpt;
+  ckpt.architecture = net.Architecture();
+  net.GetFlat(&ckpt.params);
+  ckpt.meta.update = update;
+  ckpt.meta.run_id = 77;
+  const std::string path = dir / ("ckpt_" + std::to_string(update) + ".bin");
+  nn::SaveCheckpoint(path, ckpt);
+  return path;
+}
+
+TEST_F(EvaluatorServiceTest, DrawsATsneMapOfACheckpointAtTheGoalBeforeItsResult) {
+  EvaluatorConfig c = Config();
+  c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2)";
+  c.tsne = 100;
+  c.goal = -10;  // every checkpoint reaches it
+  std::FILE* log = std::tmpfile();
+  ASSERT_NE(log, nullptr);
+  EvaluatorService service(c, &bus_, log);
+  Announce(WriteCatchCheckpoint(dir_, 50), 50);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  EXPECT_FALSE(service.tsne_map_due());
+  EXPECT_GT(service.tsne_seconds(), 0.0);
+  const std::string map = service.report_dir() + "/tsne.png";
+  ASSERT_TRUE(std::filesystem::exists(map));
+  EXPECT_GT(std::filesystem::file_size(map), 1000U);
+  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  EXPECT_NE(html.find("<img src=\"tsne.png\""), std::string::npos);
+  EXPECT_NE(html.find("in 100 states ("), std::string::npos);
+  EXPECT_NE(html.find("of 12 greedy episodes"), std::string::npos);
+  EXPECT_NE(html.find("max_a Q(s, a)"), std::string::npos);
+  EXPECT_NE(html.find("ckpt_50.bin (update 50"), std::string::npos);
+  // One line says what the map took.
+  std::rewind(log);
+  std::string text(4096, '\0');
+  text.resize(std::fread(text.data(), 1, text.size(), log));
+  std::fclose(log);
+  EXPECT_NE(text.find("evaluator: t-SNE map of ckpt_50.bin (update 50): 100 states of 12 greedy "
+                      "episodes ("),
+            std::string::npos)
+      << text;
+}
+
+TEST_F(EvaluatorServiceTest, KeepsTheTsneMapOfANewBestDueWhileTheTimeShareIsSpent) {
+  EvaluatorConfig c = Config();
+  c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2)";
+  c.tsne = 100;
+  c.goal = 10;  // never reached
+  EvaluatorService service(c, &bus_, nullptr);
+  Announce(WriteCatchCheckpoint(dir_, 50), 50);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  // Its first map is expected to take kTsneFirstGuessSeconds, more than a fifth of the time the
+  // service has run: due, not made.
+  EXPECT_TRUE(service.tsne_map_due());
+  EXPECT_EQ(service.tsne_seconds(), 0.0);
+  EXPECT_FALSE(std::filesystem::exists(service.report_dir() + "/tsne.png"));
+  EXPECT_EQ(ReadFile(service.report_dir() + "/index.html").find("tsne.png"), std::string::npos);
+}
+
+TEST_F(EvaluatorServiceTest, RefusesATsneMapForAFlatEnv) {
+  EvaluatorConfig c = Config();
+  c.tsne = 2000;
+  EXPECT_THROW(EvaluatorService(c, &bus_, nullptr), std::invalid_argument);
+}
+
 TEST_F(EvaluatorServiceTest, RefusesACorruptedCheckpointAndStillScoresTheNextGoodOne) {
   EvaluatorService service(Config(), &bus_, nullptr);
   // Flip one byte in the middle of a real checkpoint.
@@ -329,6 +397,13 @@ TEST(EvaluatorConfigTest, RejectsBadSettings) {
   c = EvaluatorConfig();
   c.gamma = 1.01;
   EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = EvaluatorConfig();
+  c.tsne = 99;  // a map needs at least 100 states
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.tsne = 5001;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.tsne = 2000;
+  EXPECT_NO_THROW(c.Validate());
 }
 
 TEST(ScoreCheckpointFileTest, ReadsTheMetadataAndRefusesATruncatedFile) {

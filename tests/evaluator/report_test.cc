@@ -221,6 +221,20 @@ TEST(ReportTest, EscapesTheConfigAndCheckpointNames) {
   EXPECT_EQ(HtmlEscape("'&'"), "&#39;&amp;&#39;");
 }
 
+TEST(ReportTest, ShowsTheTsneMapWithItsCaptionOnlyWhenGiven) {
+  TempDir dir;
+  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, Info(475));
+  EXPECT_EQ(ReadFile(dir / "index.html").find("t-SNE"), std::string::npos);
+  ReportInfo info = Info(475);
+  info.tsne_file = kTsneMap;
+  info.tsne_caption = "Colour: max_a Q(s, a) <of> the state.";
+  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, info);
+  const std::string html = ReadFile(dir / "index.html");
+  EXPECT_NE(html.find("<h2>Last hidden layer (t-SNE)</h2>"), std::string::npos);
+  EXPECT_NE(html.find("<img src=\"tsne.png\""), std::string::npos);
+  EXPECT_NE(html.find("Colour: max_a Q(s, a) &lt;of&gt; the state."), std::string::npos);
+}
+
 TEST(ReportTest, AnEmptyHistoryStillGivesAReportAndCurves) {
   TempDir dir;
   WriteReport(dir / "report", {}, Info(475));

@@ -172,6 +172,44 @@ TEST(SequentialTest, PredictAndArgmaxMatchTheBatchedForward) {
   }
 }
 
+TEST(SequentialTest, LayerInputGivesTheActivationsOfTheLastForwardPass) {
+  // linear(2,3),relu,linear(3,2): the input of layer 2 is relu(W x + b), the ReLU fused.
+  Sequential net;
+  Matrix w(3, 2);
+  w << 1, 0, 0, 1, 1, -1;
+  net.Add(std::make_unique<Linear>(w, (Matrix(3, 1) << 0.5f, -4, 0).finished()));
+  net.Add(std::make_unique<ReLU>());
+  net.Add(std::make_unique<Linear>(Matrix::Ones(2, 3), Matrix::Zero(2, 1)));
+  EXPECT_THROW(net.LayerInput(0), std::logic_error);  // no forward pass yet
+  EXPECT_THROW(net.LayerInput(3), std::out_of_range);
+  EXPECT_THROW(net.LayerInput(-1), std::out_of_range);
+
+  const float obs[2] = {1.0f, 3.0f};
+  const Matrix& q = net.Predict(obs, 2);
+  const Matrix& hidden = net.LayerInput(2);
+  ASSERT_EQ(hidden.rows(), 3);
+  ASSERT_EQ(hidden.cols(), 1);
+  EXPECT_FLOAT_EQ(hidden(0, 0), 1.5f);  // 1 + 0.5
+  EXPECT_FLOAT_EQ(hidden(1, 0), 0.0f);  // relu(3 - 4)
+  EXPECT_FLOAT_EQ(hidden(2, 0), 0.0f);  // relu(1 - 3)
+  EXPECT_FLOAT_EQ(q(0, 0), 1.5f);
+  // Layer 1 (the fused ReLU) sees the same activations; layer 0 the observation.
+  EXPECT_EQ(net.LayerInput(1), hidden);
+  EXPECT_FLOAT_EQ(net.LayerInput(0)(0, 0), 1.0f);
+  EXPECT_FLOAT_EQ(net.LayerInput(0)(1, 0), 3.0f);
+
+  // A batched forward pass replaces them.
+  Matrix x(2, 2);
+  x << 2, 0, 0, 5;
+  net.Forward(x);
+  const Matrix& batch = net.LayerInput(2);
+  ASSERT_EQ(batch.cols(), 2);
+  EXPECT_FLOAT_EQ(batch(0, 0), 2.5f);
+  EXPECT_FLOAT_EQ(batch(2, 0), 2.0f);
+  EXPECT_FLOAT_EQ(batch(1, 1), 1.0f);  // 5 - 4
+  EXPECT_FLOAT_EQ(batch(2, 1), 0.0f);  // relu(-5)
+}
+
 TEST(SequentialTest, ArgmaxPicksTheFirstOfTiedMaxima) {
   Sequential net;
   net.Add(std::make_unique<Linear>(Matrix::Zero(3, 2), (Matrix(3, 1) << 1, 3, 3).finished()));

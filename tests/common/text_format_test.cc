@@ -1,0 +1,37 @@
+#include "common/text_format.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace rl {
+namespace {
+
+TEST(TextFormatTest, ScoresKeepTwoDecimalsBelowTen) {
+  EXPECT_EQ(Score(0.356), "0.36");
+  EXPECT_EQ(Score(-9.994), "-9.99");
+  EXPECT_EQ(Score(475.04), "475.0");
+  EXPECT_EQ(Score(-12.25), "-12.2");
+}
+
+TEST(TextFormatTest, ThousandsAreSeparated) {
+  EXPECT_EQ(Thousands(0), "0");
+  EXPECT_EQ(Thousands(999), "999");
+  EXPECT_EQ(Thousands(1000), "1,000");
+  EXPECT_EQ(Thousands(1234567), "1,234,567");
+  EXPECT_EQ(Thousands(-45678), "-45,678");
+}
+
+TEST(TextFormatTest, DurationsReadAsSecondsMinutesOrHours) {
+  EXPECT_EQ(Duration(4.25), "4.2 s");
+  EXPECT_EQ(Duration(42), "42 s");
+  EXPECT_EQ(Duration(725), "12 min 05 s");
+  EXPECT_EQ(Duration(7300), "2 h 01 min");
+  EXPECT_EQ(Duration(-1), "-");
+  EXPECT_EQ(Duration(std::nan(""), "n/a"), "n/a");
+}
+
+}  // namespace
+}  // namespace rl
