@@ -145,7 +145,13 @@ std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveSt
 
   const double w = style.width, h = style.height;
   const Scale sx{x_ticks.front(), x_ticks.back(), kLeft, w - kRight};
-  const Scale sy{y_ticks.front(), y_ticks.back(), h - kBottom, kTop};
+  // The legend sits right of the title when both fit on one line (about 7.5 px per character of
+  // the 14 px title), else on a line of its own below it.
+  const double legend_width = 250;
+  const bool legend_below =
+      kLeft + 7.5 * static_cast<double>(style.title.size()) + 16 > w - kRight - legend_width;
+  const double top = legend_below ? kTop + 18 : kTop;
+  const Scale sy{y_ticks.front(), y_ticks.back(), h - kBottom, top};
 
   std::string s;
   s += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(style.width) +
@@ -161,8 +167,8 @@ std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveSt
 
   // Legend, top right.
   {
-    const double y = 18;
-    double x = w - kRight - 250;
+    const double y = legend_below ? 40 : 18;
+    double x = w - kRight - legend_width;
     s += "<g font-size=\"11\">";
     s += "<line x1=\"" + Num(x) + "\" y1=\"" + Num(y) + "\" x2=\"" + Num(x + 18) + "\" y2=\"" +
          Num(y) + "\" stroke=\"" + kLineColor + "\" stroke-width=\"2\"/>";
