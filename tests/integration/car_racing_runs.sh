@@ -8,9 +8,10 @@ source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
 set +e
-# Checkpoints every 30 updates and 3 evaluation episodes, so that the evaluator scores some.
+# Checkpoints every 150 updates and 3 evaluation episodes, so that the evaluator scores a few;
+# the learner on one thread, so that the run does not oversubscribe the two cores of CI.
 launch car_racing_td3 --out "$dir/run" --seed 1 --goal 100000 --time-budget 150 \
-  --learner-args "--checkpoint-every 30" --evaluator-args "--episodes 3 --videos 1" \
+  --learner-args "--checkpoint-every 150 --threads 1" --evaluator-args "--episodes 3 --videos 1" \
   > "$dir/launch.log" 2>&1
 status=$?
 set -e
