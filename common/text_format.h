@@ -16,6 +16,9 @@ std::string Score(double v);
 /// 1234567 -> "1,234,567" (negative values keep their sign).
 std::string Thousands(int64_t v);
 
+/// The current time as "2026-11-25 10:26:02 UTC", the stamp of written pages.
+std::string UtcNow();
+
 /// 42 -> "42 s", 725 -> "12 min 05 s", 7300 -> "2 h 01 min"; below 10 s one decimal;
 /// `missing` for a negative or non-finite value.
 std::string Duration(double seconds, const char* missing = "-");

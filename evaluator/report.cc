@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -33,15 +32,6 @@ namespace {
 // ---- HTML pieces ----
 
 std::string Format(const char* fmt, double v) { return FormatDouble(fmt, v); }
-
-std::string UtcNow() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[64];
-  std::strftime(buf, sizeof(buf), "%Y-%m-%d %H:%M:%S UTC", &tm);
-  return buf;
-}
 
 constexpr char kCss[] = R"css(
 :root { --fg: #24292f; --muted: #57606a; --line: #d0d7de; --soft: #f6f8fa;

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -399,15 +398,6 @@ td, th { vertical-align: top; }
 .k.goal { border-top: 1.5px dashed #d1242f; }
 a { color: inherit; }
 )css";
-
-std::string UtcNow() {
-  const std::time_t now = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  char buf[64];
-  std::strftime(buf, sizeof(buf), "%Y-%m-%d %H:%M:%S UTC", &tm);
-  return buf;
-}
 
 std::string Swatch(const std::string& color) {
   return "<span class=\"swatch\" style=\"background:" + color + "\"></span>";

@@ -17,7 +17,8 @@ double WrapAngle(double a) {
 
 }  // namespace
 
-void CarRacingPilot::Plan(const CarRacing& env, double* bearing, double* target_speed) {
+void CarRacingPilot::Plan(const CarRacing& env, double* bearing, double* target_speed,
+                          double* speed) {
   const CarRacingTrack& track = env.track();
   const CarRacingCar car = env.car();
   const int n = track.size();
@@ -36,8 +37,8 @@ void CarRacingPilot::Plan(const CarRacing& env, double* bearing, double* target_
   }
   node_ = ((best % n) + n) % n;
 
-  const double speed = car.speed();
-  const int lookahead = std::max(3, static_cast<int>(speed * config_.lookahead_time / 3.5));
+  *speed = car.speed();
+  const int lookahead = std::max(3, static_cast<int>(*speed * config_.lookahead_time / 3.5));
   const CarRacingTrack::Node& target = track.nodes[(node_ + lookahead) % n];
   // The car faces (-sin angle, cos angle); its right is (cos angle, sin angle).
   const double dx = target.x - car.position.x;
@@ -63,10 +64,8 @@ void CarRacingPilot::Plan(const CarRacing& env, double* bearing, double* target_
 }
 
 std::array<float, 3> CarRacingPilot::Act(const CarRacing& env) {
-  double bearing = 0;
-  double target_speed = 0;
-  Plan(env, &bearing, &target_speed);
-  const double speed = env.car().speed();
+  double bearing = 0, target_speed = 0, speed = 0;
+  Plan(env, &bearing, &target_speed, &speed);
   const double steer = std::clamp(config_.steer_gain * bearing, -1.0, 1.0);
   const double gas = speed < target_speed ? 1.0 : 0.0;
   const double brake = speed > target_speed + 10 ? 0.6 : 0.0;
@@ -74,10 +73,8 @@ std::array<float, 3> CarRacingPilot::Act(const CarRacing& env) {
 }
 
 int CarRacingPilot::ActDiscrete(const CarRacing& env) {
-  double bearing = 0;
-  double target_speed = 0;
-  Plan(env, &bearing, &target_speed);
-  const double speed = env.car().speed();
+  double bearing = 0, target_speed = 0, speed = 0;
+  Plan(env, &bearing, &target_speed, &speed);
   if (bearing > 0.15) return 1;   // Steer right.
   if (bearing < -0.15) return 2;  // Steer left.
   if (speed > target_speed + 10) return 4;

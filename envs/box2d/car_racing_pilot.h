@@ -38,8 +38,8 @@ class CarRacingPilot {
 
  private:
   // Updates node_ to the node nearest the car (searching near the last one) and returns the
-  // bearing to the target (radians, positive to the right) and the speed aimed for.
-  void Plan(const CarRacing& env, double* bearing, double* target_speed);
+  // bearing to the target (radians, positive to the right), the speed aimed for and the car's.
+  void Plan(const CarRacing& env, double* bearing, double* target_speed, double* speed);
 
   CarRacingPilotConfig config_;
   int node_ = -1;
