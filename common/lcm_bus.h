@@ -148,20 +148,9 @@ void Bus::Subscribe(const std::string& channel, std::function<void(const Msg&)> 
       channel, port,
       [this, channel, handler = std::move(handler), decoded](const uint8_t* data, size_t size) {
         Msg& msg = *decoded;
-        if (const char* why = Prescan(&msg, data, size)) {
+        if (const char* why = Decode(data, size, &msg)) {
           ++counters_.malformed;
           LogDrop(channel, "malformed", why);
-          return;
-        }
-        int used = -1;
-        try {
-          used = msg.decode(data, 0, static_cast<int>(size));
-        } catch (const std::exception&) {
-          used = -1;
-        }
-        if (used < 0 || static_cast<size_t>(used) != size) {
-          ++counters_.malformed;
-          LogDrop(channel, "malformed", "does not decode as the channel's type");
           return;
         }
         if (!AcceptHeader(channel, msg.header)) return;

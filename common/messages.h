@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 
 #include "common/lcm_schema.h"
 #include "rlmsg/checkpoint_t.hpp"
@@ -34,6 +35,22 @@ inline constexpr int32_t kMaxActionWidth = 64;
 template <class Msg>
 const char* Prescan(const Msg*, const uint8_t* data, size_t size) {
   return PrescanEncoded(Msg::getTypeName(), data, size);
+}
+
+/// Prescan(), then lcm-gen's decoder, which must use every byte: nullptr, or why the bytes are
+/// not a message of type Msg. What the bus does with every message it receives (and what the
+/// fuzz targets exercise). Allocates what the message's arrays hold.
+template <class Msg>
+const char* Decode(const uint8_t* data, size_t size, Msg* msg) {
+  if (const char* why = Prescan(msg, data, size)) return why;
+  int used = -1;
+  try {
+    used = msg->decode(data, 0, static_cast<int>(size));
+  } catch (const std::exception&) {
+    used = -1;
+  }
+  if (used < 0 || static_cast<size_t>(used) != size) return "does not decode as the channel's type";
+  return nullptr;
 }
 
 const char* Validate(const rlmsg::transition_batch_t& m);
