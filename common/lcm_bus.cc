@@ -23,7 +23,8 @@ bool ShouldLog(int64_t n) { return n < 10 || n % 1000 == 0; }
 
 }  // namespace
 
-Bus::Bus(BusConfig config) : config_(std::move(config)) {
+Bus::Bus(BusConfig config) : config_(std::move(config)), incarnation_(WallMicros()) {
+  if (!config_.key.empty()) auth_ = std::make_unique<MessageAuthenticator>(config_.key);
   main_ = OpenLcm(config_.url);
   bulk_ = OpenLcm(config_.bulk_url);
 }
@@ -50,18 +51,43 @@ void Bus::OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/,
   }
 }
 
-bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header) {
+bool Bus::Sign(uint8_t* data, size_t size, const rlmsg::header_t& header) {
+  return auth_ == nullptr || auth_->Sign(data, size, MacOffset(header.sender.size()));
+}
+
+bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header,
+                       const uint8_t* data, size_t size) {
   if (header.run_id != config_.run_id) {
     ++counters_.foreign;
     LogDrop(channel, "foreign", "another run's id");
     return false;
   }
-  // Count gaps in the sender's sequence; a sequence that goes back means the sender restarted.
-  auto [it, inserted] = last_seq_.try_emplace({channel, header.sender}, header.seq);
-  if (!inserted) {
-    if (header.seq > it->second + 1) counters_.lost += header.seq - it->second - 1;
-    it->second = header.seq;
+  if (auth_ != nullptr) {
+    if (const char* why = auth_->Verify(data, size, MacOffset(header.sender.size()))) {
+      ++counters_.unauthenticated;
+      LogDrop(channel, "unauthenticated", why);
+      return false;
+    }
   }
+  // Only what comes after what we heard from this incarnation is fresh; a newer incarnation is
+  // the sender restarted, and its sequence starts again.
+  auto [it, inserted] =
+      heard_.try_emplace({channel, header.sender}, SenderPosition{header.incarnation, header.seq});
+  SenderPosition& last = it->second;
+  if (inserted) return true;
+  if (header.incarnation > last.incarnation) {
+    last = {header.incarnation, header.seq};
+    return true;
+  }
+  if (header.incarnation < last.incarnation || header.seq <= last.seq) {
+    ++counters_.replayed;
+    LogDrop(channel, "replayed",
+            header.incarnation < last.incarnation ? "an older incarnation of its sender"
+                                                  : "a sequence number already passed");
+    return false;
+  }
+  counters_.lost += header.seq - last.seq - 1;
+  last.seq = header.seq;
   return true;
 }
 

@@ -2,11 +2,18 @@
 //
 // It owns two LCM instances, one for the main port (small, high-rate messages) and one for the
 // bulk port (weights, sample replies), so that bulk traffic never starves the rest. Publish()
-// fills the header (run id, sender, per-channel sequence number, time). Subscribe() installs a
-// typed handler behind a checking decoder: a message that does not decode (foreign type, torn or
-// forged lengths) is counted as malformed, one of another run as foreign, one that fails
-// Validate() as invalid, and none of them reaches the handler. Sequence gaps per sender and
-// channel are counted as lost. Handlers must not throw; if one does, the exception is caught,
+// fills the header (run id, sender, incarnation, per-channel sequence number, time) and, when the
+// run has a key, the MAC (common/message_auth.h). Subscribe() installs a typed handler behind a
+// checking decoder, and a message reaches the handler only when it passes every check, in this
+// order, each drop counted by its reason:
+//   malformed        does not decode as the channel's type (foreign type, torn or forged lengths)
+//   foreign          another run's id
+//   unauthenticated  no MAC or a wrong one (with a key; a bus without one checks none)
+//   replayed         an incarnation of its sender older than one already heard, or a sequence
+//                    number of the sender's incarnation on this channel already passed
+//   invalid          fails Validate() (or the handler threw)
+// Gaps in a sender incarnation's sequence are counted as lost; a newer incarnation (a restarted
+// sender) starts a new sequence. Handlers must not throw; if one does, the exception is caught,
 // logged and counted as invalid.
 //
 // Not thread-safe: one thread constructs, publishes and calls Handle().
@@ -14,8 +21,10 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <string>
@@ -23,6 +32,7 @@
 #include <vector>
 
 #include "common/clock.h"
+#include "common/message_auth.h"
 #include "common/messages.h"
 
 namespace rl {
@@ -37,7 +47,8 @@ struct BusConfig {
   std::string bulk_url = kDefaultLcmBulkUrl;  // bulk port
   int64_t run_id = 0;                         // messages of other runs are dropped
   std::string sender;                         // header.sender of what we publish
-  int queue_capacity = 10000;                 // per-subscription LCM queue (LCM's default: 30)
+  std::string key;  // the run's secret key (kKeyBytes), or empty: no MACs written or checked
+  int queue_capacity = 10000;  // per-subscription LCM queue (LCM's default: 30)
 };
 
 /// An in-process bus (LCM's memq:// provider on both ports): only this process receives what it
@@ -52,11 +63,15 @@ inline BusConfig InProcessBusConfig(int64_t run_id, std::string sender) {
 
 // What the bus dropped or lost, for the stats messages.
 struct BusCounters {
-  int64_t received = 0;   // messages handed to handlers
-  int64_t malformed = 0;  // did not decode (foreign type, truncated, bad lengths)
-  int64_t foreign = 0;    // another run's messages
-  int64_t invalid = 0;    // decoded but failed Validate(), or the handler threw
-  int64_t lost = 0;       // sequence gaps
+  int64_t received = 0;         // messages handed to handlers
+  int64_t malformed = 0;        // did not decode (foreign type, truncated, bad lengths)
+  int64_t foreign = 0;          // another run's messages
+  int64_t invalid = 0;          // decoded but failed Validate(), or the handler threw
+  int64_t unauthenticated = 0;  // no MAC, or a wrong one
+  int64_t replayed = 0;         // an older incarnation, or a sequence number already passed
+  int64_t lost = 0;             // sequence gaps
+
+  int64_t dropped() const { return malformed + foreign + invalid + unauthenticated + replayed; }
 };
 
 enum class Port { kMain, kBulk };
@@ -91,6 +106,8 @@ class Bus {
 
   const BusCounters& counters() const { return counters_; }
   const BusConfig& config() const { return config_; }
+  // This bus's incarnation: when it started, in microseconds since the Unix epoch.
+  int64_t incarnation() const { return incarnation_; }
 
   // Copies the counters into a stats message's dropped_* and lost fields.
   template <class Stats>
@@ -98,6 +115,8 @@ class Bus {
     s->dropped_malformed = counters_.malformed;
     s->dropped_foreign = counters_.foreign;
     s->dropped_invalid = counters_.invalid;
+    s->dropped_unauthenticated = counters_.unauthenticated;
+    s->dropped_replayed = counters_.replayed;
     s->lost = counters_.lost;
   }
 
@@ -113,16 +132,27 @@ class Bus {
                     std::function<void(const uint8_t*, size_t)> on_bytes);
   static void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                     RawSubscription* sub);
-  // Checks run id and sequence; returns false (and counts) when the message is to be dropped.
-  bool AcceptHeader(const std::string& channel, const rlmsg::header_t& header);
+  // Signs an encoded message of ours (no-op without a key).
+  bool Sign(uint8_t* data, size_t size, const rlmsg::header_t& header);
+  // Checks run id, MAC and freshness of a decoded message; returns false (and counts) when the
+  // message is to be dropped.
+  bool AcceptHeader(const std::string& channel, const rlmsg::header_t& header, const uint8_t* data,
+                    size_t size);
   void LogDrop(const std::string& channel, const char* kind, const char* reason);
 
+  struct SenderPosition {
+    int64_t incarnation;
+    int64_t seq;
+  };
+
   BusConfig config_;
+  int64_t incarnation_;
+  std::unique_ptr<MessageAuthenticator> auth_;  // null without a key
   std::unique_ptr<lcm::LCM> main_;
   std::unique_ptr<lcm::LCM> bulk_;
   std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
-  std::map<std::string, int64_t> publish_seq_;                       // by channel
-  std::map<std::pair<std::string, std::string>, int64_t> last_seq_;  // by channel and sender
+  std::map<std::string, int64_t> publish_seq_;                           // by channel
+  std::map<std::pair<std::string, std::string>, SenderPosition> heard_;  // by channel, sender
   std::vector<uint8_t> encode_buffer_;
   BusCounters counters_;
   int64_t drops_logged_ = 0;
@@ -134,9 +164,12 @@ bool Bus::Publish(const std::string& channel, Msg* msg, Port port) {
   msg->header.sender = config_.sender;
   msg->header.seq = publish_seq_[channel]++;
   msg->header.utime = WallMicros();
+  msg->header.incarnation = incarnation_;
+  std::fill(std::begin(msg->header.mac), std::end(msg->header.mac), 0);
   const int size = msg->getEncodedSize();
   encode_buffer_.resize(static_cast<size_t>(size));
   if (msg->encode(encode_buffer_.data(), 0, size) != size) return false;
+  if (!Sign(encode_buffer_.data(), encode_buffer_.size(), msg->header)) return false;
   return lcm(port).publish(channel, encode_buffer_.data(), static_cast<unsigned>(size)) == 0;
 }
 
@@ -153,7 +186,7 @@ void Bus::Subscribe(const std::string& channel, std::function<void(const Msg&)> 
           LogDrop(channel, "malformed", why);
           return;
         }
-        if (!AcceptHeader(channel, msg.header)) return;
+        if (!AcceptHeader(channel, msg.header, data, size)) return;
         if (const char* why = Validate(msg)) {
           ++counters_.invalid;
           LogDrop(channel, "invalid", why);

@@ -53,6 +53,13 @@ const char* Decode(const uint8_t* data, size_t size, Msg* msg) {
   return nullptr;
 }
 
+/// Messages a process dropped, all reasons together, from its stats message (stats_*_t).
+template <class Stats>
+int64_t Dropped(const Stats& s) {
+  return s.dropped_malformed + s.dropped_foreign + s.dropped_invalid + s.dropped_unauthenticated +
+         s.dropped_replayed;
+}
+
 const char* Validate(const rlmsg::transition_batch_t& m);
 const char* Validate(const rlmsg::sample_request_t& m);
 const char* Validate(const rlmsg::sample_batch_t& m);

@@ -15,6 +15,7 @@ BusConfig CommonOptions::MakeBusConfig(const std::string& sender) const {
   c.bulk_url = lcm_bulk_url;
   c.run_id = run_id;
   c.sender = sender;
+  if (!key_file.empty()) c.key = ReadKeyFile(key_file);
   return c;
 }
 
@@ -25,6 +26,9 @@ void AddCommonOptions(po::options_description* desc, CommonOptions* common) {
        "INI preset (top-level keys and the keys of this process's section)")  //
       ("run-id", po::value(&common->run_id)->default_value(common->run_id),
        "id of the run; messages of other runs are dropped")  //
+      ("key-file", po::value(&common->key_file),
+       "the run's secret key (32 bytes, mode 600): every message is signed with it, and "
+       "received ones without its MAC are dropped")  //
       ("lcm-url", po::value(&common->lcm_url)->default_value(common->lcm_url),
        "LCM URL of the main port (small, high-rate messages)")  //
       ("lcm-bulk-url", po::value(&common->lcm_bulk_url)->default_value(common->lcm_bulk_url),

@@ -18,13 +18,15 @@ namespace rl {
 
 namespace po = boost::program_options;
 
-// Options every process has: --config, --run-id, --lcm-url, --lcm-bulk-url.
+// Options every process has: --config, --run-id, --key-file, --lcm-url, --lcm-bulk-url.
 struct CommonOptions {
   std::string config_file;
   int64_t run_id = 0;
+  std::string key_file;  // the run's secret key (common/message_auth.h); empty: no MACs
   std::string lcm_url = kDefaultLcmUrl;
   std::string lcm_bulk_url = kDefaultLcmBulkUrl;
 
+  // Reads the key file, if any (throws std::runtime_error when it is unfit).
   BusConfig MakeBusConfig(const std::string& sender) const;
 };
 

@@ -7,17 +7,18 @@
 # is started again after 1, 2, 4, ... 30 s, at most --max-restarts times (one that fails with an
 # error status within 3 s of its start is not: that is a startup error, and the run stops with
 # its log; one killed by a signal always is). The learner always starts with --resume, so a
-# restarted learner continues from the state it saved with its last checkpoint; a restarted
-# replay starts empty and refills. Restarts are lines of RUN/restarts, in the process's log and
-# on the progress line.
+# restarted learner continues from the state it saved with its last checkpoint; the replay always
+# starts with --snapshot RUN/replay-snapshot.bin, which it writes every 60 s (--snapshot-every)
+# and when it stops, so a restarted replay continues from its last snapshot. Restarts are lines
+# of RUN/restarts, in the process's log and on the progress line.
 #
 # Usage: scripts/launch.sh PRESET [options]
 #        scripts/launch.sh --resume RUN_DIR [options]
 #   PRESET                 a preset in configs/ (cartpole, ...)
 #   --resume RUN_DIR       continue a stopped or crashed run in its folder: its copy of the
 #                          preset, run id and seed; the learner from its saved state, the
-#                          evaluator's history and the metrics kept (options as below, except
-#                          --out, --seed and --run-id)
+#                          replay from its snapshot, the evaluator's history and the metrics
+#                          kept (options as below, except --out, --seed and --run-id)
 #   --out DIR              run folder (default runs/<preset>-<timestamp>)
 #   --actors N             actor processes on this host (default: the preset's top-level
 #                          "actors = N", else 4)
@@ -167,7 +168,15 @@ else {
 } > "$out/config.ini"
 fi
 
-common=(--config "$out/config.ini" --run-id "$run_id" --lcm-url "$url" --lcm-bulk-url "$bulk_url")
+# The run's secret key: every message carries a MAC made with it (common/message_auth.h). Only
+# the owner may read it; processes on other hosts get a copy of the file (README: "Actors on
+# other hosts"), never the key on a command line. A resumed run keeps its key.
+if [ ! -s "$out/key" ]; then
+  (umask 077 && head -c 32 /dev/urandom > "$out/key.tmp" && mv "$out/key.tmp" "$out/key") ||
+    die "cannot write the run's key file $out/key"
+fi
+common=(--config "$out/config.ini" --run-id "$run_id" --key-file "$out/key" --lcm-url "$url"
+  --lcm-bulk-url "$bulk_url")
 pids=()
 roles=()
 : > "$out/pids"
@@ -322,7 +331,8 @@ if [ "$record" -eq 1 ]; then
   recording || { stop_recorder; die "lcm-logger did not open its file in 10 s (log: $out/logs/recorder.log)"; }
 fi
 # shellcheck disable=SC2086
-start replay "$out/logs/replay.log" "$bin/replay" "${common[@]}" --seed "$seed" $replay_args
+start replay "$out/logs/replay.log" "$bin/replay" "${common[@]}" --seed "$seed" \
+  --snapshot "$out/replay-snapshot.bin" $replay_args
 wait_ready replay "$out/logs/replay.log" "replay: ready"
 # shellcheck disable=SC2086
 start learner "$out/logs/learner.log" "$bin/learner" "${common[@]}" --out "$out" --seed "$seed" \
@@ -349,7 +359,7 @@ fi
 {
   echo "monitor $BASHPID" >> "$out/pids"
   exec "$bin/monitor" --lcm-url "$url" --lcm-bulk-url "$bulk_url" --run-id "$run_id" \
-    --goal "$goal" --time-budget "$time_budget" --metrics "$out/metrics.jsonl" \
+    --key-file "$out/key" --goal "$goal" --time-budget "$time_budget" --metrics "$out/metrics.jsonl" \
     --restarts "$out/restarts"
 } | tee "$out/logs/monitor.log" &
 monitor_pid=$!

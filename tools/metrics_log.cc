@@ -9,6 +9,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "common/messages.h"
+
 namespace rl::tools {
 namespace {
 
@@ -40,8 +42,9 @@ class Line {
 template <class Stats>
 Line& AddDrops(Line& line, const Stats& s) {
   return line.Add("lost", static_cast<double>(s.lost))
-      .Add("dropped",
-           static_cast<double>(s.dropped_malformed + s.dropped_foreign + s.dropped_invalid));
+      .Add("dropped", static_cast<double>(Dropped(s)))
+      .Add("replayed", static_cast<double>(s.dropped_replayed))
+      .Add("unauthenticated", static_cast<double>(s.dropped_unauthenticated));
 }
 
 }  // namespace

@@ -71,7 +71,7 @@ std::string ProgressLine(const View& v, double elapsed, double now, int64_t rest
     steps += a.env_steps;
     episodes += a.episodes;
     lost += a.lost;
-    dropped += a.dropped_malformed + a.dropped_foreign + a.dropped_invalid;
+    dropped += rl::Dropped(a);
     if (now - v.actor_seen.at(name) < 3.0) {
       ++live;
       ret += a.mean_return;
@@ -79,10 +79,7 @@ std::string ProgressLine(const View& v, double elapsed, double now, int64_t rest
     }
   }
   lost += v.replay.lost + v.learner.lost + v.evaluator.lost;
-  dropped += v.replay.dropped_malformed + v.replay.dropped_foreign + v.replay.dropped_invalid +
-             v.learner.dropped_malformed + v.learner.dropped_foreign + v.learner.dropped_invalid +
-             v.evaluator.dropped_malformed + v.evaluator.dropped_foreign +
-             v.evaluator.dropped_invalid;
+  dropped += rl::Dropped(v.replay) + rl::Dropped(v.learner) + rl::Dropped(v.evaluator);
   std::string eval = "eval -";
   if (v.have_eval) {
     eval = "eval " + Score(v.last_eval.mean) + " (best " + Score(v.best_eval) + ")";

@@ -1,8 +1,11 @@
 // The schemas read from the .lcm files: the parser's grammar and errors, and the prescan they
 // drive against real encodings of every message type.
 #include "common/lcm_schema.h"
+#include "common/message_auth.h"
 
+#include <algorithm>
 #include <cstdint>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -158,8 +161,8 @@ TEST(LcmSchemaTest, PrescanRefusesForgedLengths) {
   p.index = {1};
   p.priority = {0.5f};
   std::vector<uint8_t> bytes = Encode(p);
-  // count sits after the fingerprint (8), run_id (8), the sender (4 + 8), seq and utime (16).
-  const size_t at = 8 + 8 + 4 + p.header.sender.size() + 1 + 16;
+  // count sits right after the header.
+  const size_t at = MacOffset(p.header.sender.size()) + kMacBytes;
   ASSERT_EQ(bytes[at + 3], 1);
   for (const uint32_t forged : {0x7fffffffu, 0x80000000u, 2u, 0u}) {
     for (int k = 0; k < 4; ++k)
@@ -170,12 +173,36 @@ TEST(LcmSchemaTest, PrescanRefusesForgedLengths) {
   rlmsg::checkpoint_t c{};
   c.path = "abc";
   bytes = Encode(c);
-  const size_t path_at = 8 + 8 + 4 + 1 + 16;
+  const size_t path_at = MacOffset(0) + kMacBytes;  // after a header with an empty sender
   ASSERT_EQ(bytes[path_at + 3], 4);
   bytes[path_at + 3] = 0;
   EXPECT_NE(PrescanEncoded("checkpoint_t", bytes.data(), bytes.size()), nullptr);
   bytes[path_at + 3] = 200;
   EXPECT_NE(PrescanEncoded("checkpoint_t", bytes.data(), bytes.size()), nullptr);
+}
+
+// A string with a NUL inside decodes (lcm-gen keeps every byte) but re-encodes shorter (the
+// encoder stops at the first NUL), so a reply that echoes it would be sent with stale bytes at
+// its end: refused, as is a string without its terminating NUL. Found by fuzz/fuzz_messages.
+TEST(LcmSchemaTest, PrescanRefusesStringsWithANulInside) {
+  rlmsg::checkpoint_t c{};
+  c.header.sender = "learner";
+  c.path = "abc";
+  std::vector<uint8_t> bytes = Encode(c);
+  ASSERT_EQ(PrescanEncoded("checkpoint_t", bytes.data(), bytes.size()), nullptr);
+  const uint8_t path[] = {0, 0, 0, 4, 'a', 'b', 'c', 0};
+  const size_t at = static_cast<size_t>(
+      std::search(bytes.begin(), bytes.end(), std::begin(path), std::end(path)) - bytes.begin());
+  ASSERT_LT(at, bytes.size());
+  bytes[at + 5] = 0;  // "a\0c"
+  EXPECT_STREQ(PrescanEncoded("checkpoint_t", bytes.data(), bytes.size()),
+               "string with a NUL inside");
+  rlmsg::checkpoint_t decoded{};
+  EXPECT_STREQ(Decode(bytes.data(), bytes.size(), &decoded), "string with a NUL inside");
+  bytes[at + 5] = 'b';
+  bytes[at + 7] = 'd';  // no terminating NUL
+  EXPECT_STREQ(PrescanEncoded("checkpoint_t", bytes.data(), bytes.size()),
+               "string with a NUL inside");
 }
 
 }  // namespace

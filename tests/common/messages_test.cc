@@ -1,4 +1,5 @@
 #include "common/messages.h"
+#include "common/message_auth.h"
 
 #include <algorithm>
 #include <cmath>
@@ -140,10 +141,9 @@ rlmsg::transition_batch_t PixelBatch() {
 TEST(PrescanTest, RefusesAPixelBatchWithAForgedFrameLength) {
   rlmsg::transition_batch_t m = PixelBatch();
   auto bytes = Encode(m);
-  // num_bytes sits after the fingerprint, the header (8 + 4 + len("test") + 1 + 16), actor_id,
-  // count, obs_size, num_values (and no obs), height, width, stack, num_frames and two int64
-  // frame ids.
-  const size_t at = 8 + 8 + 4 + 5 + 16 + 16 + 12 + 4 + 16;
+  // num_bytes sits after the header (sender "test"), actor_id, count, obs_size, num_values (and
+  // no obs), height, width, stack, num_frames and two int64 frame ids.
+  const size_t at = MacOffset(4) + kMacBytes + 16 + 12 + 4 + 16;
   ASSERT_EQ(bytes[at + 3], 12);  // the encoded num_bytes, big-endian
   bytes[at] = 0x7f;              // about 2^31 bytes claimed
   EXPECT_NE(Prescan(&m, bytes.data(), bytes.size()), nullptr);

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Malformed, truncated, foreign-run and invalid messages on every channel are counted and dropped
-# by every process, and no process crashes. Usage: bad_messages.sh [PRESET] (default cartpole; the
+# Malformed, truncated, foreign-run, invalid, replayed and unauthenticated (no MAC, another key's
+# MAC, a bit flipped after signing) messages on every channel are counted and dropped by every
+# process, and no process crashes. Usage: bad_messages.sh [PRESET] (default cartpole; the
 # pendulum preset makes it a continuous run, where the action fields carry a NaN torque, a torque
 # far outside the bounds and one torque too many).
 source "$(dirname "$0")/lib.sh"
@@ -17,7 +18,7 @@ set +m
 wait_line "$dir/launch.log" "running; logs in" 60
 run="$dir/run"
 env_id=$(sed -n 's/^env = //p' "$run/config.ini" | head -1)
-"$bin/inject" --env "$env_id" --run-id "$(run_setting "$run" run-id)" --lcm-url "$(run_setting "$run" lcm-url)" \
+"$bin/inject" --env "$env_id" --run-id "$(run_setting "$run" run-id)" --key-file "$run/key" --lcm-url "$(run_setting "$run" lcm-url)" \
   --lcm-bulk-url "$(run_setting "$run" lcm-bulk-url)" --count 20 --timeout 30 \
   --roles replay,learner,actor,evaluator || fail "the processes did not count every bad message"
 # Every process is still alive and still working.

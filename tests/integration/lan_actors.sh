@@ -34,8 +34,10 @@ ip netns exec "$a" "$root/scripts/launch.sh" cartpole --no-setup --build-dir "$b
 launch_pid=$!
 wait_line "$dir/launch.log" "running; logs in" 60
 run="$dir/run"
+# Host B's copy of the run's key file, owner-only as scp -p would keep it.
+install -m 600 "$run/key" "$dir/host-b.key"
 ip netns exec "$b" "$bin/actor" --config "$root/configs/cartpole.ini" \
-  --run-id "$(run_setting "$run" run-id)" --num-actors 2 --actor-id 1 --seed 6 \
+  --run-id "$(run_setting "$run" run-id)" --key-file "$dir/host-b.key" --num-actors 2 --actor-id 1 --seed 6 \
   --lcm-url "$(run_setting "$run" lcm-url)" --lcm-bulk-url "$(run_setting "$run" lcm-bulk-url)" \
   > "$dir/remote-actor.log" 2>&1 &
 remote_pid=$!
