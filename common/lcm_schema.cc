@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cctype>
+#include <cstring>
 #include <functional>
 #include <stdexcept>
 #include <utility>
@@ -96,11 +97,20 @@ class Walker {
     const int shift = 64 - 8 * bytes;  // sign-extend
     return static_cast<int64_t>(v << shift) >> shift;
   }
-  // A string: int32 length including the terminating NUL, then the bytes.
+  // A string: int32 length including the terminating NUL, then the bytes. lcm-gen's encoder
+  // writes a string up to its first NUL, so one with a NUL inside (or none at its end) would not
+  // re-encode as received: refused.
   void String() {
     const int64_t len = ReadInt(4);
     if (len < 1) ok_ = false;
+    const size_t at = pos_;
     Skip(len);
+    if (!ok_) return;
+    const size_t n = static_cast<size_t>(len) - 1;
+    if (data_[at + n] != 0 || std::memchr(data_ + at, 0, n) != nullptr) {
+      ok_ = false;
+      bad_string_ = true;
+    }
   }
   void Struct(const Program& p) {
     std::array<int64_t, kMaxFields> values{};
@@ -130,6 +140,7 @@ class Walker {
     }
   }
   const char* Finish() const {
+    if (bad_string_) return "string with a NUL inside";
     if (!ok_) return "truncated or bad length";
     if (pos_ != size_) return "trailing bytes";
     return nullptr;
@@ -140,6 +151,7 @@ class Walker {
   size_t size_;
   size_t pos_ = 0;
   bool ok_ = true;
+  bool bad_string_ = false;  // a string with a NUL inside or no terminating NUL
 };
 
 struct Compiled {

@@ -48,7 +48,8 @@ const std::map<std::string, LcmStruct>& LcmSchemas();
 /// fields; nested structs without their own fingerprint, as LCM encodes them). Returns nullptr
 /// when every length fits and the message ends exactly at the end of the buffer, else a short
 /// reason: "truncated or bad length" (a length past the end, negative, or above
-/// kMaxArrayElements elements), "trailing bytes", or "no schema" for an unknown type.
+/// kMaxArrayElements elements), "string with a NUL inside" (or without its terminating NUL: it
+/// would not re-encode as received), "trailing bytes", or "no schema" for an unknown type.
 /// O(size + fields); allocates nothing after the first call.
 const char* PrescanEncoded(std::string_view type, const uint8_t* data, size_t size);
 

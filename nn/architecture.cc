@@ -197,7 +197,7 @@ Sequential BuildFromArchitecture(const std::string& arch, std::mt19937* rng) {
       if (spec.args.empty()) ArchError(arch, where + " needs bounded(n,low_1,high_1,...)");
       const int n = ParseInt(arch, spec.name, spec.args[0], false);
       if (spec.args.size() != 1 + 2 * static_cast<size_t>(n)) {
-        ArchError(arch, where + " needs " + std::to_string(2 * n) + " bounds after n");
+        ArchError(arch, where + " needs " + std::to_string(2 * int64_t{n}) + " bounds after n");
       }
       std::vector<float> low, high;
       for (int k = 0; k < n; ++k) {

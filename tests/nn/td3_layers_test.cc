@@ -4,6 +4,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -51,6 +52,18 @@ TEST(BoundedTest, GradientMatchesFiniteDifferencesAndTheStringRoundTrips) {
   EXPECT_THROW(BuildFromArchitecture("linear(3,2),bounded(2,-1,1,0)", &rng), std::invalid_argument);
   EXPECT_THROW(BuildFromArchitecture("linear(3,2),bounded(2,-1,1,x,2)", &rng),
                std::invalid_argument);
+}
+
+// A bounds count above INT_MAX / 2 is refused with its count, without a signed overflow (the
+// string comes from checkpoints and weight messages). Found by fuzz/fuzz_checkpoint.
+TEST(BoundedTest, RefusesAHugeBoundsCount) {
+  std::mt19937 rng(1);
+  try {
+    BuildFromArchitecture("linear(3,2),bounded(1924571982)", &rng);
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("needs 3849143964 bounds"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Pool2dTest, PoolsWindowsOfKByKWithFloorMode) {

@@ -1,0 +1,382 @@
+// Writes the generated seed corpora of the fuzz targets: valid messages of every type
+// (fuzz_messages), learner state files (fuzz_state_file) and policy checkpoints
+// (fuzz_checkpoint), made with the project's own encoders and writers, so that they follow the
+// current formats. Run by `scripts/fuzz.sh --seeds` after a change to lcmtypes/ or to a file
+// format. Every message written is checked to decode and validate.
+//
+// Usage: fuzz_seeds CORPUS_DIR   (rewrites CORPUS_DIR/{messages,state_file,checkpoint,snapshot}/,
+// keeping the reproducers of fixed bugs, named "repro-*")
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "common/messages.h"
+#include "fuzz/learner_state.h"
+#include "fuzz/message_types.h"
+#include "nn/checkpoint.h"
+#include "nn/sequential.h"
+#ifdef RL_FUZZ_SNAPSHOT
+#include "fuzz/replay_setup.h"
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+
+void WriteFile(const fs::path& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!out) {
+    std::fprintf(stderr, "fuzz_seeds: cannot write %s\n", path.c_str());
+    std::exit(1);
+  }
+}
+
+// ---- Messages ----
+
+template <class Msg>
+constexpr int TypeIndex() {
+  int i = 0, found = -1;
+#define RL_FUZZ_INDEX(type)                        \
+  if (std::is_same_v<Msg, rlmsg::type>) found = i; \
+  ++i;
+  RL_FUZZ_MESSAGE_TYPES(RL_FUZZ_INDEX)
+#undef RL_FUZZ_INDEX
+  return found;
+}
+
+rlmsg::header_t Header(const char* sender, int64_t seq) {
+  rlmsg::header_t h{};
+  h.run_id = 0x5eed1234abcdLL;
+  h.sender = sender;
+  h.seq = seq;
+  h.utime = 1764072000000000LL;
+  return h;
+}
+
+// Writes `msg` as "<dir>/<type>-<variant>": its type index (message_types.h), then its encoding.
+template <class Msg>
+void WriteMessage(const fs::path& dir, const Msg& msg, const std::string& variant) {
+  const int size = msg.getEncodedSize();
+  std::string bytes(static_cast<size_t>(size) + 1, '\0');
+  bytes[0] = static_cast<char>(TypeIndex<Msg>());
+  if (msg.encode(bytes.data() + 1, 0, size) != size) {
+    std::fprintf(stderr, "fuzz_seeds: %s does not encode\n", Msg::getTypeName());
+    std::exit(1);
+  }
+  Msg decoded{};
+  const auto* data = reinterpret_cast<const uint8_t*>(bytes.data() + 1);
+  const char* why = rl::Decode(data, static_cast<size_t>(size), &decoded);
+  if (why == nullptr) why = rl::Validate(decoded);
+  if (why != nullptr) {
+    std::fprintf(stderr, "fuzz_seeds: %s %s is refused: %s\n", Msg::getTypeName(), variant.c_str(),
+                 why);
+    std::exit(1);
+  }
+  std::string name = Msg::getTypeName();
+  if (name.rfind("rlmsg.", 0) == 0) name = name.substr(6);
+  WriteFile(dir / (name + "-" + variant), bytes);
+}
+
+void WriteMessages(const fs::path& dir) {
+  {
+    rlmsg::checkpoint_t m{};
+    m.header = Header("learner", 7);
+    m.path = "runs/cartpole/checkpoints/ckpt-000005000.bin";
+    m.update = 5000;
+    m.env_steps = 40000;
+    m.wall_seconds = 61.5;
+    WriteMessage(dir, m, "a");
+  }
+  {
+    rlmsg::eval_result_t m{};
+    m.header = Header("evaluator", 3);
+    m.checkpoint = "runs/cartpole/checkpoints/ckpt-000005000.bin";
+    m.update = 5000;
+    m.env_steps = 40000;
+    m.wall_seconds = 75.25;
+    m.episodes = 100;
+    m.mean = 487.5;
+    m.std = 12.0;
+    m.min = 410;
+    m.max = 500;
+    m.goal_reached = 1;
+    WriteMessage(dir, m, "a");
+  }
+  {
+    rlmsg::flow_control_t m{};
+    m.header = Header("replay", 120);
+    m.insert_allowed = 1;
+    m.samples_per_insert = 7.5;
+    m.target_samples_per_insert = 8;
+    m.error_buffer = 100;
+    m.insert_credit = 64;
+    m.num_actors = 2;
+    m.actor_id = {0, 1};
+    m.actor_inserts = {1000, 998};
+    WriteMessage(dir, m, "a");
+    m.num_actors = 0;
+    m.actor_id.clear();
+    m.actor_inserts.clear();
+    m.insert_credit = -1;
+    WriteMessage(dir, m, "no-actors");
+  }
+  {
+    rlmsg::priority_update_t m{};
+    m.header = Header("learner", 9);
+    m.count = 3;
+    m.index = {5, 17, 99999};
+    m.priority = {0.5f, 1.25f, 0.0f};
+    WriteMessage(dir, m, "a");
+  }
+  {
+    rlmsg::sample_batch_t m{};
+    m.header = Header("replay", 44);
+    m.requester = "learner";
+    m.request_id = 12;
+    m.count = 2;
+    m.obs_size = 4;
+    m.num_values = 8;
+    m.obs = {0.1f, -0.2f, 0.3f, -0.4f, 0.5f, 0.6f, -0.7f, 0.8f};
+    m.next_obs = {0.2f, -0.3f, 0.4f, -0.5f, 0.6f, 0.7f, -0.8f, 0.9f};
+    m.action_width = 1;
+    m.num_action_values = 2;
+    m.action = {0, 1};
+    m.reward = {1, 1};
+    m.discount = {0.99f, 0};
+    m.index = {3, 8};
+    m.weight = {1, 0.5f};
+    m.replay_size = 1000;
+    m.total_inserts = 1200;
+    WriteMessage(dir, m, "flat");
+
+    rlmsg::sample_batch_t p{};
+    p.header = Header("replay", 45);
+    p.requester = "learner";
+    p.request_id = 13;
+    p.count = 1;
+    p.height = 4;
+    p.width = 3;
+    p.stack = 2;
+    p.num_bytes = 24;
+    p.obs_pixels.assign(24, 17);
+    p.next_obs_pixels.assign(24, 200);
+    p.action_width = 3;
+    p.num_action_values = 3;
+    p.action = {-0.5f, 1, 0};
+    p.reward = {-0.1f};
+    p.discount = {0.97f};
+    p.index = {0};
+    p.weight = {1};
+    p.replay_size = 1;
+    p.total_inserts = 1;
+    WriteMessage(dir, p, "pixels");
+  }
+  {
+    rlmsg::sample_request_t m{};
+    m.header = Header("learner", 12);
+    m.request_id = 12;
+    m.batch_size = 64;
+    WriteMessage(dir, m, "a");
+  }
+  {
+    rlmsg::stats_actor_t m{};
+    m.header = Header("actor-0", 30);
+    m.env_steps = 4000;
+    m.episodes = 50;
+    m.steps_per_second = 2000;
+    m.mean_return = 85.5;
+    m.epsilon = 0.4;
+    m.weights_version = 12;
+    m.transitions_published = 3990;
+    WriteMessage(dir, m, "a");
+  }
+  {
+    rlmsg::stats_evaluator_t m{};
+    m.header = Header("evaluator", 4);
+    m.checkpoints_scored = 3;
+    m.last_mean = 200;
+    m.best_mean = 250;
+    m.best_update = 4000;
+    m.busy = 1;
+    WriteMessage(dir, m, "a");
+  }
+  {
+    rlmsg::stats_learner_t m{};
+    m.header = Header("learner", 31);
+    m.updates = 5000;
+    m.updates_per_second = 150;
+    m.samples_per_second = 9600;
+    m.loss = 0.02;
+    m.mean_q = 30;
+    m.weights_version = 50;
+    m.env_steps = 40000;
+    WriteMessage(dir, m, "a");
+  }
+  {
+    rlmsg::stats_replay_t m{};
+    m.header = Header("replay", 32);
+    m.size = 40000;
+    m.capacity = 100000;
+    m.total_inserts = 40000;
+    m.total_samples = 320000;
+    m.inserts_per_second = 2000;
+    m.samples_per_second = 16000;
+    m.samples_per_insert = 8;
+    m.insert_allowed = 1;
+    m.prioritized = 1;
+    m.beta = 0.4;
+    m.memory_bytes = 1 << 20;
+    WriteMessage(dir, m, "a");
+  }
+  {
+    rlmsg::transition_batch_t m{};
+    m.header = Header("actor-1", 77);
+    m.actor_id = 1;
+    m.count = 2;
+    m.obs_size = 3;
+    m.num_values = 6;
+    m.obs = {0.5f, -1, 2, 0.25f, 0, 1};
+    m.next_obs = {0.4f, -1, 2, 0.2f, 0, 1};
+    m.action_width = 1;
+    m.num_action_values = 2;
+    m.action = {0.75f, -2};
+    m.reward = {-3.5f, -1};
+    m.discount = {0.99f, 0.99f};
+    m.episode_id = {4, 4};
+    m.priority = {0, 2};
+    WriteMessage(dir, m, "flat");
+
+    rlmsg::transition_batch_t p{};
+    p.header = Header("actor-0", 78);
+    p.count = 1;
+    p.height = 2;
+    p.width = 3;
+    p.stack = 2;
+    p.num_frames = 2;
+    p.frame_id = {10, 11};
+    p.num_bytes = 12;
+    p.frames = {0, 1, 2, 3, 4, 5, 250, 251, 252, 253, 254, 255};
+    p.num_refs = 2;
+    p.obs_frames = {9, 10};
+    p.next_obs_frames = {10, 11};
+    p.action_width = 1;
+    p.num_action_values = 1;
+    p.action = {3};
+    p.reward = {1};
+    p.discount = {0};
+    p.episode_id = {2};
+    p.priority = {0};
+    WriteMessage(dir, p, "pixels");
+  }
+  {
+    rlmsg::weights_chunk_t m{};
+    m.header = Header("learner", 5);
+    m.version = 3;
+    m.architecture = "linear(4,8),relu,linear(8,2)";
+    m.total_size = 58;
+    m.num_chunks = 2;
+    m.chunk_index = 1;
+    m.offset = 40;
+    m.count = 18;
+    for (int i = 0; i < m.count; ++i) m.data.push_back(0.01f * static_cast<float>(i - 9));
+    m.crc32 = 0xCBF43926LL;
+    WriteMessage(dir, m, "a");
+  }
+}
+
+// ---- Learner state files ----
+
+void WriteStateFiles(const fs::path& dir) {
+  for (const rl::fuzz::FuzzLearner& l : rl::fuzz::FuzzLearners()) {
+    const std::string name = l.kind.substr(l.kind.find(' ') + 1);
+    WriteFile(dir / (name + "-full"), SaveLearnerState(l, 40000).Serialize());
+  }
+  // Small files that reach every section type quickly.
+  rl::StateFile small("learner dqn");
+  small.PutText("learner.env", "CartPole-v1");
+  small.PutInt("learner.env_steps", 5);
+  const float floats[] = {1.5f, -2};
+  small.PutFloats("dqn.online", floats);
+  WriteFile(dir / "dqn-partial", small.Serialize());
+  WriteFile(dir / "empty-td3", rl::StateFile("learner td3").Serialize());
+}
+
+// ---- Policy checkpoints ----
+
+void WriteCheckpoints(const fs::path& dir) {
+  const char* archs[][2] = {
+      {"mlp", "linear(4,8),relu,linear(8,2)"},
+      {"bounded", "linear(3,8),tanh,linear(8,2),bounded(2,-1,1,0,2.5)"},
+      {"dueling", "linear(6,8),relu,layernorm(8),dueling(8,4,3)"},
+      {"cnn",
+       "conv2d(1,2,3,1,0,6,6),batchnorm2d(2,4,4),relu,maxpool2d(2,2,4,4),flatten,linear(8,2)"},
+      {"avgpool", "conv2d(2,1,2,2,1,4,4),avgpool2d(1,3,3,3),flatten,linear(1,1)"},
+  };
+  int64_t update = 100;
+  for (const auto& [name, arch] : archs) {
+    std::mt19937 rng(7);
+    const rl::nn::Sequential net = rl::nn::BuildFromArchitecture(arch, &rng);
+    rl::nn::Checkpoint ckpt;
+    ckpt.architecture = arch;
+    net.GetFlat(&ckpt.params);
+    ckpt.meta.update = update;
+    ckpt.meta.env_steps = 8 * update;
+    ckpt.meta.wall_seconds = 1.5;
+    ckpt.meta.run_id = 42;
+    ckpt.meta.note = "env = CartPole-v1";
+    update *= 10;
+    rl::nn::SaveCheckpoint((dir / name).string(), ckpt);
+  }
+}
+
+// ---- Replay snapshots ----
+
+#ifdef RL_FUZZ_SNAPSHOT
+// "<dir>/<kind>-<fill>": the configuration byte (replay_setup.h), then the snapshot file.
+void WriteSnapshots(const fs::path& dir) {
+  const char* kinds[] = {"flat", "prioritized", "pixels"};
+  for (int config = 0; config < rl::fuzz::kNumReplayConfigs; ++config) {
+    for (const auto& [name, batches, samples] :
+         {std::tuple{"empty", 0, 0}, std::tuple{"some", 3, 2}, std::tuple{"full", 14, 4}}) {
+      rl::fuzz::Replica replica(config);
+      replica.Fill(batches, samples);
+      rl::StateStream out(rl::replay::ReplayService::kSnapshotKind);
+      replica.service().SaveSnapshot(&out);
+      WriteFile(dir / (std::string(kinds[config]) + "-" + name),
+                std::string(1, static_cast<char>(config)) + out.Serialize());
+    }
+  }
+}
+#endif
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: fuzz_seeds CORPUS_DIR\n");
+    return 2;
+  }
+  const fs::path root = argv[1];
+  // Replaces the generated seeds; reproducers of fixed bugs ("repro-*") stay.
+  for (const char* target : {"messages", "state_file", "checkpoint", "snapshot"}) {
+    fs::create_directories(root / target);
+    for (const fs::directory_entry& e : fs::directory_iterator(root / target)) {
+      if (e.path().filename().string().rfind("repro-", 0) != 0) fs::remove(e.path());
+    }
+  }
+  WriteMessages(root / "messages");
+  WriteStateFiles(root / "state_file");
+  WriteCheckpoints(root / "checkpoint");
+#ifdef RL_FUZZ_SNAPSHOT
+  WriteSnapshots(root / "snapshot");
+#endif
+  std::printf("fuzz_seeds: wrote the seeds in %s\n", root.c_str());
+  return 0;
+}

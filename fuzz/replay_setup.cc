@@ -1,0 +1,129 @@
+#include "fuzz/replay_setup.h"
+
+#include <algorithm>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "common/channels.h"
+#include "rlmsg/priority_update_t.hpp"
+#include "rlmsg/sample_batch_t.hpp"
+#include "rlmsg/sample_request_t.hpp"
+#include "rlmsg/transition_batch_t.hpp"
+
+namespace rl::fuzz {
+namespace {
+
+constexpr int64_t kRunId = 42;
+
+rlmsg::transition_batch_t FlatBatch(int first, int count, int32_t actor) {
+  rlmsg::transition_batch_t m{};
+  m.actor_id = actor;
+  m.obs_size = 2;
+  m.count = count;
+  m.num_values = 2 * count;
+  m.action_width = 1;
+  m.num_action_values = count;
+  for (int v = first; v < first + count; ++v) {
+    m.obs.insert(m.obs.end(), {static_cast<float>(v), 0.5f});
+    m.next_obs.insert(m.next_obs.end(), {static_cast<float>(v + 1), 0.5f});
+    m.action.push_back(static_cast<float>(v % 2));
+    m.reward.push_back(1.0f);
+    m.discount.push_back(v % 9 == 8 ? 0.0f : 0.99f);
+    m.episode_id.push_back(v / 9);
+    m.priority.push_back(static_cast<float>(v % 4) / 2.0f);
+  }
+  return m;
+}
+
+// Frames first .. first + count (2 x 2 bytes) and transitions naming frames {t - 1, t}, {t, t + 1}.
+rlmsg::transition_batch_t PixelBatch(int first, int count, int32_t actor) {
+  rlmsg::transition_batch_t m{};
+  m.actor_id = actor;
+  m.action_width = 1;
+  m.num_action_values = count;
+  m.height = 2;
+  m.width = 2;
+  m.stack = 2;
+  m.num_frames = count + 1;
+  for (int f = first; f <= first + count; ++f) {
+    m.frame_id.push_back(f);
+    m.frames.insert(m.frames.end(), 4, static_cast<uint8_t>(f + actor));
+  }
+  m.num_bytes = static_cast<int32_t>(m.frames.size());
+  m.count = count;
+  m.num_refs = 2 * count;
+  for (int t = first; t < first + count; ++t) {
+    m.obs_frames.insert(m.obs_frames.end(), {std::max(t - 1, first), t});
+    m.next_obs_frames.insert(m.next_obs_frames.end(), {t, t + 1});
+    m.action.push_back(static_cast<float>(t % 3));
+    m.reward.push_back(0.5f);
+    m.discount.push_back(0.99f);
+    m.episode_id.push_back(0);
+    m.priority.push_back(0.0f);
+  }
+  return m;
+}
+
+replay::ReplayServiceOptions Options(int config) {
+  replay::ReplayServiceOptions o;
+  o.table.capacity = 48;
+  o.frame_capacity = 64;
+  o.limiter.samples_per_insert = 4;
+  o.limiter.min_size_to_sample = 8;
+  o.limiter.error_buffer = 400;
+  o.prioritized = config != 0;
+  o.beta_anneal_samples = 1000;
+  o.seed = 7;
+  return o;
+}
+
+}  // namespace
+
+Replica::Replica(int config) : config_(config), bus_(InProcessBusConfig(kRunId, "replay")) {
+  bus_.Subscribe<rlmsg::sample_batch_t>(
+      channels::kSamples, [this](const rlmsg::sample_batch_t& m) { replies_.push_back(m); },
+      Port::kBulk);
+  service_ = std::make_unique<replay::ReplayService>(&bus_, Options(config));
+}
+
+template <class Msg>
+void Replica::Publish(const std::string& channel, Msg m, const std::string& sender) {
+  m.header.run_id = kRunId;
+  m.header.sender = sender;
+  m.header.seq = seq_[sender]++;
+  m.header.utime = 1;
+  std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  bus_.PublishRaw(channel, bytes.data(), bytes.size());
+  bus_.Handle(0);
+}
+
+void Replica::Fill(int batches, int samples) {
+  int next = 0;
+  for (int k = 0; k < batches; ++k) {
+    const int actor = k % 3;
+    const rlmsg::transition_batch_t m =
+        config_ == 2 ? PixelBatch(next, 5, actor) : FlatBatch(next, 5, actor);
+    Publish(channels::kTransitions, m, "actor-" + std::to_string(actor));
+    next += 6;
+  }
+  for (int k = 0; k < samples; ++k) {
+    rlmsg::sample_request_t r{};
+    r.request_id = k;
+    r.batch_size = 4;
+    Publish(channels::kSampleRequest, r, "learner-0");
+    service_->Serve();
+    bus_.Handle(0);
+    if (replies_.empty()) continue;
+    const rlmsg::sample_batch_t reply = replies_.back();
+    replies_.clear();
+    rlmsg::priority_update_t u{};
+    u.count = reply.count;
+    u.index = reply.index;
+    for (int64_t i : reply.index) u.priority.push_back(static_cast<float>(i % 5) + 0.25f);
+    Publish(channels::kPriorities, u, "learner-0");
+  }
+}
+
+}  // namespace rl::fuzz
