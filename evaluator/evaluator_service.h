@@ -53,6 +53,12 @@ struct EvaluatorConfig {
   // Pixel envs: states of greedy episodes in report/tsne.png, the t-SNE map of the last hidden
   // layer of a new best checkpoint (tsne_map.h; when: kTsneTimeShare below); 0: no map.
   int tsne = 0;
+  // A second metric beside the standard one: new best checkpoints are also scored on this env
+  // (the same observations and actions; e.g. the rules a paper trained and tested with), over
+  // second_episodes episodes from seed_base, and the report shows both. Empty: none.
+  std::string second_env;
+  int second_episodes = 100;
+  std::string second_name;  // what the report calls it (default: the env id)
 
   /// Throws std::invalid_argument saying what is wrong.
   void Validate() const;
@@ -170,6 +176,7 @@ class EvaluatorService {
   int64_t skipped_ = 0;
   int64_t refused_ = 0;
   double best_video_mean_ = -std::numeric_limits<double>::infinity();
+  double best_second_mean_ = -std::numeric_limits<double>::infinity();  // standard metric
   std::string video_caption_;   // empty until a video was recorded
   bool has_frames_ = false;     // a pixel env: the report gets a grid of camera frames
   std::string frames_caption_;  // empty until a frame grid was written

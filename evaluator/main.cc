@@ -138,6 +138,15 @@ int Main(int argc, char** argv) {
       ("tsne-map", rl::po::value(&tsne_file),
        "standalone mode, pixel envs: also write the t-SNE map of the checkpoint's last hidden "
        "layer (greedy episodes from the first evaluation seed) to this PNG file")  //
+      ("second-env", rl::po::value(&config.second_env),
+       "service mode: also score every new best checkpoint on this env (the same observations "
+       "and actions), a second metric beside the standard one in eval.jsonl and the report (e.g. "
+       "the rules a paper trained and tested with)")  //
+      ("second-episodes",
+       rl::po::value(&config.second_episodes)->default_value(config.second_episodes),
+       "episodes of the second metric")  //
+      ("second-name", rl::po::value(&config.second_name),
+       "what the report calls the second metric (default: its env id)")  //
       ("run-config", rl::po::value(&run_config_file),
        "text file shown in the report as the run's config (default: the --config file)");
 

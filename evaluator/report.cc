@@ -95,6 +95,11 @@ std::string ToJson(const EvalRecord& r) {
     s += ", \"value_correlation\": " +
          (r.value_correlation ? JsonNumber(*r.value_correlation) : std::string("null"));
   }
+  if (r.second_episodes > 0) {
+    s += ", \"second_mean\": " + JsonNumber(r.second_mean);
+    s += ", \"second_std\": " + JsonNumber(r.second_std);
+    s += ", \"second_episodes\": " + std::to_string(r.second_episodes);
+  }
   s += "}";
   return s;
 }
@@ -124,6 +129,11 @@ bool ParseJson(const std::string& line, EvalRecord* record) {
     r.value_return = GetJsonDouble(obj, "value_return").value_or(0);
     const std::optional<double> c = GetJsonDouble(obj, "value_correlation");
     if (c && std::isfinite(*c)) r.value_correlation = *c;
+  }
+  r.second_episodes = static_cast<int>(GetJsonInt(obj, "second_episodes").value_or(0));
+  if (r.second_episodes > 0) {
+    r.second_mean = GetJsonDouble(obj, "second_mean").value_or(0);
+    r.second_std = GetJsonDouble(obj, "second_std").value_or(0);
   }
   *record = std::move(r);
   return true;
@@ -290,6 +300,17 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
     h += "<div class=\"value\">" + Score(best->mean) + " <small>\xC2\xB1 " + Score(best->std) +
          "</small></div><div class=\"detail\">update " + Thousands(best->update) + ", " +
          Thousands(best->env_steps) + " env steps, " + Duration(best->wall_seconds) + "</div>";
+    // The second metric of the best checkpoint that has one (a tie with a later checkpoint
+    // leaves the later one without).
+    const EvalRecord* second = nullptr;
+    for (const EvalRecord& r : records) {
+      if (r.second_episodes > 0 && (second == nullptr || r.mean > second->mean)) second = &r;
+    }
+    if (second != nullptr) {
+      h += "<div class=\"detail\">second metric (update " + Thousands(second->update) +
+           "): " + Score(second->second_mean) + " \xC2\xB1 " + Score(second->second_std) +
+           " over " + std::to_string(second->second_episodes) + " episodes</div>";
+    }
   } else {
     h += "<div class=\"value\">\xE2\x80\x94</div><div class=\"detail\">no checkpoint scored "
          "yet</div>";
@@ -370,10 +391,16 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
            "2016: Q well above G is overestimation); r is the correlation of the two across the "
            "steps (near 0: the network cannot tell good states from bad ones).</p>\n";
     }
+    const bool has_second = !info.second_name.empty();
+    if (has_second) {
+      h += "<p>Second metric (new best checkpoints only): " + HtmlEscape(info.second_name) +
+           ".</p>\n";
+    }
     h += "<div class=\"scroll\"><table>\n<thead><tr><th>checkpoint</th><th>update</th>"
          "<th>env steps</th><th>wall time</th><th>mean</th><th>std</th><th>min</th><th>max</th>"
          "<th>episodes</th><th>eval time</th>";
     if (has_values) h += "<th>Q</th><th>G</th><th>r</th>";
+    if (has_second) h += "<th>second metric</th>";
     h += "</tr></thead>\n<tbody>\n";
     for (const EvalRecord* r : rows) {
       std::string cls;
@@ -399,6 +426,13 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
              "</td>";
       } else if (has_values) {
         h += "<td></td><td></td><td></td>";
+      }
+      if (has_second) {
+        h += "<td>" +
+             (r->second_episodes > 0 ? Score(r->second_mean) + " \xC2\xB1 " + Score(r->second_std) +
+                                           " (" + std::to_string(r->second_episodes) + ")"
+                                     : std::string()) +
+             "</td>";
       }
       h += "</tr>\n";
     }

@@ -28,6 +28,11 @@ struct EvalRecord {
   double value_estimate = 0;                // mean Q(s_t, a_t) of the actions taken
   double value_return = 0;                  // mean discounted return that followed them
   std::optional<double> value_correlation;  // unset when undefined (a constant series)
+  // The checkpoint on the second metric (EvaluatorConfig::second_env), scored for new best
+  // checkpoints only; second_episodes 0: not scored.
+  int second_episodes = 0;
+  double second_mean = 0;
+  double second_std = 0;
 
   bool operator==(const EvalRecord&) const = default;
 };
@@ -35,7 +40,8 @@ struct EvalRecord {
 /// One line of eval.jsonl, without the newline: {"checkpoint": ..., "update": ..., "env_steps":
 /// ..., "wall_seconds": ..., "mean": ..., "std": ..., "min": ..., "max": ..., "episodes": ...,
 /// "eval_seconds": ...}, and when value_steps > 0 also "value_steps", "value_estimate",
-/// "value_return" and "value_correlation" (null when unset). Numbers are written in their
+/// "value_return" and "value_correlation" (null when unset), and when second_episodes > 0
+/// "second_mean", "second_std" and "second_episodes". Numbers are written in their
 /// shortest form that reads back exactly; a non-finite number is written as null.
 std::string ToJson(const EvalRecord& record);
 
@@ -60,6 +66,7 @@ struct ReportInfo {
   double goal = 0;            // mean return that counts as solved; dashed line in the curves
   std::string run_config;     // the run's config text, shown verbatim (escaped) in a <pre>
   std::string eval_settings;  // one line on how checkpoints were scored (episodes, epsilon, seeds)
+  std::string second_name;    // what the records' second metric is (empty: none)
   int64_t checkpoints_skipped = 0;  // announced but superseded before scoring
   int64_t checkpoints_refused = 0;  // files that failed to load or did not fit the env
   std::string video_file;           // a video in the report folder to show (empty: none)

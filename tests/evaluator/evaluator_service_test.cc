@@ -133,6 +133,33 @@ TEST_F(EvaluatorServiceTest, ScoresAnAnnouncedCheckpointAndPublishesTheResult) {
   EXPECT_EQ(service.FinalLine().rfind("evaluator: goal not reached (best ", 0), 0U);
 }
 
+TEST_F(EvaluatorServiceTest, ScoresNewBestCheckpointsOnTheSecondMetricToo) {
+  EvaluatorConfig c = Config();
+  c.second_env = "CartPole-v1";  // the same env, for a test: the seeds differ in count only
+  c.second_episodes = 3;
+  c.second_name = "three episodes";
+  EvaluatorService service(c, &bus_, nullptr);
+  Announce(WriteCheckpoint(100), 100);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  // The same policy again: not a new best, so not scored on the second metric.
+  Announce(WriteCheckpoint(200), 200);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 2; }));
+  const std::vector<std::string> lines = JsonLines(service);
+  ASSERT_EQ(lines.size(), 2U);
+  EvalRecord first, second;
+  ASSERT_TRUE(ParseJson(lines[0], &first));
+  ASSERT_TRUE(ParseJson(lines[1], &second));
+  EXPECT_EQ(first.second_episodes, 3);
+  EXPECT_GT(first.second_mean, 0.0);
+  EXPECT_LT(first.second_mean, 20.0);
+  EXPECT_EQ(second.second_episodes, 0);
+  EXPECT_EQ(lines[1].find("second_mean"), std::string::npos);
+  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  EXPECT_NE(html.find("Second metric (new best checkpoints only): three episodes, 3 episodes"),
+            std::string::npos);
+  EXPECT_NE(html.find("second metric (update 100): "), std::string::npos);
+}
+
 TEST_F(EvaluatorServiceTest, RecordsAVideoOfEachNewBestCheckpointAndShowsItInTheReport) {
   EvaluatorConfig c = Config();
   c.videos = true;
@@ -404,6 +431,13 @@ TEST(EvaluatorConfigTest, RejectsBadSettings) {
   EXPECT_THROW(c.Validate(), std::invalid_argument);
   c.tsne = 2000;
   EXPECT_NO_THROW(c.Validate());
+  c = EvaluatorConfig();
+  c.second_env = "LunarLander-v3";  // other observations and actions than CartPole-v1's
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.second_env = "CartPole-v1";
+  EXPECT_NO_THROW(c.Validate());
+  c.second_episodes = 0;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
 }
 
 TEST(ScoreCheckpointFileTest, ReadsTheMetadataAndRefusesATruncatedFile) {

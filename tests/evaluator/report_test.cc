@@ -56,10 +56,15 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   c.value_correlation = -0.125;
   EvalRecord d = c;
   d.value_correlation.reset();
+  // With a second metric.
+  d.second_episodes = 100;
+  d.second_mean = 642.125;
+  d.second_std = -0.5;
   for (const EvalRecord& r : {a, b, c, d}) AppendJsonLine(path, r);
 
   const std::string text = ReadFile(path);
   EXPECT_EQ(CountOccurrences(text, "\n"), 4);
+  EXPECT_EQ(CountOccurrences(text, "\"second_mean\": 642.125"), 1);
   EXPECT_EQ(CountOccurrences(text, "\"value_correlation\": null"), 1);
   int skipped = -1;
   const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);

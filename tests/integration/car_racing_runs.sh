@@ -3,7 +3,8 @@
 # article's image pipeline with its off-track rule in training, its CNNs, float actions of three
 # dimensions over LCM) for a bounded time: frames stored, nothing lost or dropped, and the
 # evaluator scoring checkpoints on the unmodified environment (no no-op start, no off-track rule,
-# every frame's reward). Learning CarRacing takes hours; this test checks the plumbing.
+# every frame's reward) and new best ones on the article's rules as well. Learning CarRacing takes
+# hours; this test checks the plumbing.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
@@ -11,7 +12,7 @@ set +e
 # Checkpoints every 150 updates and 3 evaluation episodes, so that the evaluator scores a few;
 # the learner on one thread, so that the run does not oversubscribe the two cores of CI.
 launch car_racing_td3 --out "$dir/run" --seed 1 --goal 100000 --time-budget 150 \
-  --learner-args "--checkpoint-every 150 --threads 1" --evaluator-args "--episodes 3 --videos 1" \
+  --learner-args "--checkpoint-every 150 --threads 1" --evaluator-args "--episodes 3 --second-episodes 2 --videos 1" \
   > "$dir/launch.log" 2>&1
 status=$?
 set -e
@@ -25,4 +26,8 @@ grep -q 'CarRacing-v3+pixels(skip=5,max-pool=0,crop-bottom=12,crop-left=6,crop-r
   "$dir/run/logs/evaluator.log" "$dir/run/report/index.html" ||
   fail "the evaluator did not name the unmodified env"
 if grep -q 'off-track=1' "$dir/run/logs/evaluator.log"; then fail "the evaluator used the off-track rule"; fi
+# And its first checkpoint (a new best) on the article's rules too, the second metric.
+grep -q '"second_episodes": 2' "$dir/run/eval.jsonl" || fail "no second metric in eval.jsonl"
+grep -q "the TD3 article&#39;s rules\|the TD3 article's rules" "$dir/run/report/index.html" ||
+  fail "the report does not name the second metric"
 echo "PASS: CarRacing TD3 pipeline ran; $(wc -l < "$dir/run/eval.jsonl") evaluations on the unmodified env"
