@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -44,7 +45,7 @@ std::vector<uint8_t> Encode(rlmsg::transition_batch_t m) {
 
 class BusTest : public ::testing::Test {
  protected:
-  BusTest() : bus_(MemqConfig(42, "actor-1")) {
+  explicit BusTest(BusConfig config = MemqConfig(42, "actor-1")) : bus_(std::move(config)) {
     bus_.Subscribe<rlmsg::transition_batch_t>(
         channels::kTransitions, [this](const rlmsg::transition_batch_t& m) { got_.push_back(m); });
   }
@@ -172,12 +173,9 @@ std::vector<uint8_t> Stamped(int64_t incarnation, int64_t seq, const std::string
   return bytes;
 }
 
-class KeyedBusTest : public ::testing::Test {
+class KeyedBusTest : public BusTest {
  protected:
-  KeyedBusTest() : bus_(Keyed()) {
-    bus_.Subscribe<rlmsg::transition_batch_t>(
-        channels::kTransitions, [this](const rlmsg::transition_batch_t& m) { got_.push_back(m); });
-  }
+  KeyedBusTest() : BusTest(Keyed()) {}
   static BusConfig Keyed() {
     BusConfig c = MemqConfig(42, "replay");
     c.key = kKey;
@@ -187,8 +185,6 @@ class KeyedBusTest : public ::testing::Test {
     bus_.PublishRaw(channels::kTransitions, bytes.data(), bytes.size());
     bus_.Handle(100);
   }
-  Bus bus_;
-  std::vector<rlmsg::transition_batch_t> got_;
 };
 
 TEST_F(KeyedBusTest, DeliversItsOwnSignedMessages) {
