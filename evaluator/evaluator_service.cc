@@ -539,6 +539,7 @@ void EvaluatorService::WriteReportNow() {
   info.checkpoints_refused = refused_;
   if (!config_.out_dir.empty()) {
     info.metrics_file = (std::filesystem::path(config_.out_dir) / "metrics.jsonl").string();
+    info.restarts_file = (std::filesystem::path(config_.out_dir) / "restarts").string();
   }
   try {
     WriteReport(report_dir_, records_, info);

@@ -10,7 +10,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
+#include <sstream>
 #include <stdexcept>
 #include <system_error>
 
@@ -439,6 +441,35 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
     h += "</tbody>\n</table></div>\n";
   }
   h += "</section>\n";
+
+  // Processes the launch script restarted (crashes, kills).
+  if (!info.restarts_file.empty()) {
+    std::ifstream in(info.restarts_file);
+    std::string rows;
+    std::map<std::string, int> by_role;
+    int n = 0;
+    for (std::string line; std::getline(in, line);) {
+      std::istringstream fields(line);
+      std::string time, role, status_word, code, restart_word, count;
+      if (!(fields >> time >> role >> status_word >> code >> restart_word >> count)) continue;
+      ++n;
+      ++by_role[role];
+      rows += "<tr><td>" + HtmlEscape(time) + "</td><td>" + HtmlEscape(role) + "</td><td>" +
+              HtmlEscape(code) + "</td><td>" + HtmlEscape(count) + "</td></tr>\n";
+    }
+    if (n > 0) {
+      std::string summary;
+      for (const auto& [role, k] : by_role) {
+        summary += (summary.empty() ? "" : ", ") + role + " " + std::to_string(k);
+      }
+      h += "<section>\n<h2>Restarts</h2>\n<p>" + std::to_string(n) + " process restart" +
+           (n == 1 ? "" : "s") + " (" + HtmlEscape(summary) +
+           "): the launch script restarted each after it exited (status above 128: killed by "
+           "signal status - 128).</p>\n<div class=\"scroll\"><table>\n<thead><tr><th>time</th>"
+           "<th>process</th><th>exit status</th><th>restart</th></tr></thead>\n<tbody>\n" +
+           rows + "</tbody>\n</table></div>\n</section>\n";
+    }
+  }
 
   // The run's config.
   h += "<section>\n<h2>Run config</h2>\n<pre>" +

@@ -78,6 +78,9 @@ struct ReportInfo {
   // The run's metrics.jsonl (tools/metrics_log.h), drawn as training curves; empty or missing:
   // no training section.
   std::string metrics_file;
+  // The launch script's restarts file (lines "<time> <role> status <code> restart <n>"), shown as
+  // a table of the run's process restarts; empty or missing: none shown.
+  std::string restarts_file;
 };
 
 /// Names of the files WriteReport writes into `dir`.

@@ -240,6 +240,23 @@ TEST(ReportTest, ShowsTheTsneMapWithItsCaptionOnlyWhenGiven) {
   EXPECT_NE(html.find("Colour: max_a Q(s, a) &lt;of&gt; the state."), std::string::npos);
 }
 
+TEST(ReportTest, ListsTheRestartsOfTheRunsProcesses) {
+  TempDir dir;
+  ReportInfo info = Info(475);
+  info.restarts_file = dir / "restarts";
+  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, info);  // no file yet: no section
+  EXPECT_EQ(ReadFile(dir / "index.html").find("Restarts"), std::string::npos);
+  std::ofstream(info.restarts_file) << "2026-11-25T12:00:01+00:00 learner status 137 restart 1\n"
+                                       "torn line\n"
+                                       "2026-11-25T12:00:09+00:00 replay status 137 restart 1\n"
+                                       "2026-11-25T12:01:00+00:00 learner status 134 restart 2\n";
+  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, info);
+  const std::string html = ReadFile(dir / "index.html");
+  EXPECT_NE(html.find("<h2>Restarts</h2>"), std::string::npos);
+  EXPECT_NE(html.find("3 process restarts (learner 2, replay 1)"), std::string::npos);
+  EXPECT_NE(html.find("<td>learner</td><td>134</td><td>2</td>"), std::string::npos);
+}
+
 TEST(ReportTest, AnEmptyHistoryStillGivesAReportAndCurves) {
   TempDir dir;
   WriteReport(dir / "report", {}, Info(475));

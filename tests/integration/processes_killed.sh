@@ -28,6 +28,7 @@ for role in learner replay evaluator actor-1; do
   grep -q " $role status 137 restart 1$" "$dir/run/restarts" || fail "$role was not restarted"
 done
 grep -q "restarts 4" "$dir/run/logs/monitor.log" || fail "the progress line does not count 4 restarts"
+grep -q "4 process restarts" "$dir/run/report/index.html" || fail "the report does not list the 4 restarts"
 # The learner resumed from its saved state, and counted on from there.
 resumed=$(sed -n 's/.*resumed at update \([0-9]*\).*/\1/p' "$dir/run/logs/learner.log" | head -1)
 [ -n "$resumed" ] && [ "$resumed" -gt 0 ] || fail "the restarted learner did not resume"
