@@ -1,9 +1,13 @@
 // Writing a file so that a reader (or a crash) sees the old file or the whole new one, never a
-// part of it: the one way every process of a run writes checkpoints, reports and pictures.
+// part of it: the one way every process of a run writes checkpoints, reports, pictures and
+// snapshots.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace rl {
 
@@ -20,7 +24,55 @@ void WriteFileAtomically(const std::string& path, std::string_view bytes,
 void RenameIntoPlace(const std::string& tmp, const std::string& path,
                      const std::string& what = "file");
 
-/// The temporary name WriteFileAtomically uses for `path`.
+/// The temporary name WriteFileAtomically uses for `path` (with the caller's pid).
 std::string TemporaryPathFor(const std::string& path);
+
+/// The same atomic write, streamed: for files too large to build in memory, and for writers that
+/// must not allocate, lock or throw (the child of fork() in a process with other threads, which
+/// writes a copy-on-write snapshot). The constructor prepares every name (it allocates); Open(),
+/// Write(), Commit() and the destructor make system calls only: no allocation, no lock, no
+/// exception. A failure returns false and leaves its step and errno in the stream; the temporary
+/// file is then removed. Not thread-safe.
+class AtomicFileStream {
+ public:
+  explicit AtomicFileStream(std::string path);
+  AtomicFileStream(const AtomicFileStream&) = delete;
+  AtomicFileStream& operator=(const AtomicFileStream&) = delete;
+  /// Closes and removes a temporary file that was not committed.
+  ~AtomicFileStream();
+
+  /// Creates the temporary file path + ".tmp.<pid>", with the pid of the process calling Open
+  /// (a fork()ed child gets a name of its own). One Open per stream.
+  bool Open();
+  /// Appends `size` bytes (retrying short writes and EINTR).
+  bool Write(const void* data, size_t size);
+  /// Fsyncs and closes the temporary file, renames it over the path and fsyncs the directory.
+  bool Commit();
+
+  const std::string& path() const { return path_; }
+  /// The temporary file's name (valid after Open()).
+  const char* temporary_path() const { return tmp_.data(); }
+  int64_t bytes_written() const { return bytes_; }
+  /// The failed step ("create", "write", "sync", "close", "rename", "open directory", "sync
+  /// directory"), or nullptr; and its errno.
+  const char* failed_step() const { return step_; }
+  int error() const { return error_; }
+  /// "cannot write <what> <path>: <step> <file>: <strerror>" for the failure (allocates).
+  std::string ErrorMessage(const std::string& what) const;
+
+ private:
+  // Records a failure, closes and removes the temporary file; returns false.
+  bool Fail(const char* step, int err, bool remove);
+
+  std::string path_;
+  std::vector<char> tmp_;  // NUL-terminated temporary name, room for any pid
+  std::string dir_;
+  size_t tmp_stem_ = 0;  // length of path + ".tmp."
+  int fd_ = -1;
+  bool open_ = false;  // a temporary file exists and is not committed
+  int64_t bytes_ = 0;
+  const char* step_ = nullptr;
+  int error_ = 0;
+};
 
 }  // namespace rl

@@ -72,5 +72,38 @@ TEST_F(AtomicFileTest, RenameIntoPlaceCommitsAFileWrittenElsewhere) {
   EXPECT_THROW(RenameIntoPlace(tmp.string(), path, "video"), std::runtime_error);  // gone
 }
 
+TEST_F(AtomicFileTest, AStreamCommitsWholeOrLeavesTheOldFile) {
+  const std::string path = (dir_ / "s.bin").string();
+  WriteFileAtomically(path, "old");
+  {
+    AtomicFileStream out(path);
+    ASSERT_TRUE(out.Open());
+    EXPECT_STREQ(out.temporary_path(), TemporaryPathFor(path).c_str());
+    ASSERT_TRUE(out.Write("new ", 4));
+    ASSERT_TRUE(out.Write("bytes", 5));
+    EXPECT_EQ(Read(path), "old");  // not yet
+    ASSERT_TRUE(out.Commit());
+    EXPECT_EQ(out.bytes_written(), 9);
+  }
+  EXPECT_EQ(Read(path), "new bytes");
+  {
+    // Abandoned: the temporary file goes, the file stays.
+    AtomicFileStream out(path);
+    ASSERT_TRUE(out.Open());
+    ASSERT_TRUE(out.Write("partial", 7));
+  }
+  EXPECT_EQ(Read(path), "new bytes");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator{}), 1);
+  // A failure names the step, the file and the reason.
+  const std::string missing = (dir_ / "no_such_dir" / "s.bin").string();
+  AtomicFileStream bad(missing);
+  EXPECT_FALSE(bad.Open());
+  EXPECT_STREQ(bad.failed_step(), "create");
+  const std::string what = bad.ErrorMessage("snapshot");
+  EXPECT_EQ(what.rfind("cannot write snapshot " + missing + ": create " + missing + ".tmp.", 0), 0u)
+      << what;
+  EXPECT_NE(what.find("No such file or directory"), std::string::npos) << what;
+}
+
 }  // namespace
 }  // namespace rl

@@ -21,5 +21,26 @@ TEST(Crc32Test, ContinuesAcrossSplits) {
   EXPECT_EQ(Crc32(nullptr, 0), 0U);
 }
 
+TEST(Crc32Test, EightBytesAtATimeMatchesTheBytewiseDefinition) {
+  // The reflected polynomial, one bit at a time.
+  const auto reference = [](const std::string& s) {
+    uint32_t crc = ~0U;
+    for (unsigned char c : s) {
+      crc ^= c;
+      for (int k = 0; k < 8; ++k) crc = (crc & 1U) ? 0xEDB88320U ^ (crc >> 1) : crc >> 1;
+    }
+    return ~crc;
+  };
+  std::string s;
+  for (int n = 0; n < 100; ++n) {
+    EXPECT_EQ(Crc32(s.data(), s.size()), reference(s)) << n;
+    // Any split, aligned or not.
+    if (n > 3) {
+      EXPECT_EQ(Crc32(s.data() + 3, s.size() - 3, Crc32(s.data(), 3)), reference(s));
+    }
+    s.push_back(static_cast<char>(n * 37 + 11));
+  }
+}
+
 }  // namespace
 }  // namespace rl

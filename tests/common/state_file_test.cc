@@ -1,6 +1,10 @@
 #include "common/state_file.h"
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
+
+#include "common/atomic_file.h"
 
 #include <filesystem>
 #include <fstream>
@@ -76,6 +80,72 @@ TEST(StateFileTest, NamesMissingAndMistypedSections) {
   StateFile twice("x");
   twice.PutInt("a", 1);
   EXPECT_THROW(twice.PutInt("a", 2), std::invalid_argument);
+}
+
+TEST(StateStreamTest, WritesTheSameFormatWithoutCopyingAndParsesInPlace) {
+  const std::vector<float> floats = {1.5f, -2.0f, 3.25f};
+  const std::vector<uint8_t> first = {1, 2, 3};
+  const std::vector<uint8_t> second = {4, 5};
+  const std::vector<double> doubles = {0.25, 1e300};
+  StateStream out("replay snapshot");
+  out.AddFloats("net", floats);
+  out.PutInt("updates", 42);
+  out.PutText("net.arch", "linear(3,1)");
+  out.AddBytes("frames", first);
+  out.AddPiece(second.data(), second.size());
+  out.AddDoubles("values", doubles);
+  EXPECT_THROW(out.PutInt("net", 1), std::invalid_argument);
+  const std::string bytes = out.Serialize();
+  EXPECT_EQ(static_cast<int64_t>(bytes.size()), out.size());
+
+  const StateView view = StateView::Parse(bytes, "replay snapshot");
+  std::vector<uint8_t> frames(5);
+  view.Copy<uint8_t>("frames", frames);
+  EXPECT_EQ(frames, (std::vector<uint8_t>{1, 2, 3, 4, 5}));
+  std::vector<double> values(2);
+  view.Copy<double>("values", values);
+  EXPECT_EQ(values, doubles);
+  EXPECT_EQ(view.Int("updates"), 42);
+  EXPECT_EQ(view.Text("net.arch"), "linear(3,1)");
+  EXPECT_EQ(view.Count<float>("net"), 3);
+  std::vector<float> four(4);
+  EXPECT_NE(ErrorOf([&] { view.Copy<float>("net", four); }).find("expected 4"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { view.Count<int64_t>("net"); }).find("another type"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { view.Ints("updates", 0); }).find("at most 0"), std::string::npos);
+  // StateFile reads the sections it holds, and names the ones it does not.
+  EXPECT_NE(ErrorOf([&] { StateFile::Parse(bytes, "replay snapshot"); }).find("'frames'"),
+            std::string::npos);
+  StateStream small("learner td3");
+  small.AddFloats("net", floats);
+  EXPECT_EQ(StateFile::Parse(small.Serialize(), "learner td3").Floats("net", 3)[2], 3.25f);
+}
+
+TEST(StateStreamTest, AMappedFileIsCheckedAsBytesAre) {
+  const fs::path path =
+      fs::temp_directory_path() / ("state_stream_test_" + std::to_string(getpid()));
+  StateStream out("replay snapshot");
+  out.PutInt("size", 7);
+  AtomicFileStream file(path.string());
+  ASSERT_TRUE(file.Open() && out.Write(&file) && file.Commit()) << file.ErrorMessage("state");
+  EXPECT_EQ(file.bytes_written(), out.size());
+  EXPECT_EQ(StateView::Map(path.string(), "replay snapshot").Int("size"), 7);
+  EXPECT_NE(
+      ErrorOf([&] { StateView::Map(path.string(), "other"); }).find(path.string() + " refused"),
+      std::string::npos);
+  std::ofstream(path, std::ios::trunc) << "";
+  EXPECT_NE(ErrorOf([&] { StateView::Map(path.string(), "x"); }).find("bad magic or too short"),
+            std::string::npos);
+  fs::remove(path);
+  EXPECT_NE(ErrorOf([&] { StateView::Map(path.string(), "x"); }).find("cannot read state"),
+            std::string::npos);
+  // Every prefix and every flipped byte of a file is refused, never read past its end.
+  const std::string bytes = out.Serialize();
+  for (size_t n = 0; n < bytes.size(); ++n) {
+    EXPECT_THROW(StateView::Parse(bytes.substr(0, n), "replay snapshot"), std::runtime_error);
+    std::string flipped = bytes;
+    flipped[n] = static_cast<char>(flipped[n] ^ 1);
+    EXPECT_THROW(StateView::Parse(flipped, "replay snapshot"), std::runtime_error);
+  }
 }
 
 }  // namespace
