@@ -183,12 +183,53 @@ std::string Signature(const LayerKind& kind) {
   return s;
 }
 
+// Refuses a layer beyond the limits of sequential.h, before it is built; adds its parameters
+// to *params. Products in double: the arguments are checked one by one first, so they are exact
+// enough to compare with the limits.
+void CheckLimits(const std::string& arch, const std::string& where, const std::string& name,
+                 const std::vector<int>& a, double* params) {
+  for (const int v : a) {
+    if (v > kMaxArchitectureInteger) {
+      ArchError(arch, where + ": " + std::to_string(v) + " is above the limit of " +
+                          std::to_string(kMaxArchitectureInteger));
+    }
+  }
+  const auto image = [&](double channels, double height, double width) {
+    if (channels * height * width > static_cast<double>(kMaxArchitectureImage)) {
+      ArchError(arch, where + ": an image of more than " + std::to_string(kMaxArchitectureImage) +
+                          " values");
+    }
+  };
+  const auto d = [&](size_t i) { return static_cast<double>(a[i]); };
+  if (name == "linear") {
+    *params += d(0) * d(1) + d(1);
+  } else if (name == "conv2d") {
+    image(d(0), d(5) + 2 * d(4), d(6) + 2 * d(4));
+    image(d(1), d(5) + 2 * d(4), d(6) + 2 * d(4));  // bounds the output
+    *params += d(1) * d(0) * d(2) * d(2) + d(1);
+  } else if (name == "batchnorm2d") {
+    image(d(0), d(1), d(2));
+    *params += 2 * d(0);
+  } else if (name == "layernorm") {
+    *params += 2 * d(0);
+  } else if (name == "dueling") {
+    *params += 2 * (d(0) + 1) * d(1) + (d(1) + 1) * (d(2) + 1);
+  } else if (name == "maxpool2d" || name == "avgpool2d") {
+    image(d(0), d(2), d(3));
+  }
+  if (*params > static_cast<double>(kMaxArchitectureParameters)) {
+    ArchError(arch, where + ": the network would hold more than " +
+                        std::to_string(kMaxArchitectureParameters) + " parameters");
+  }
+}
+
 }  // namespace
 
 Sequential BuildFromArchitecture(const std::string& arch, std::mt19937* rng) {
   if (Trim(arch).empty()) ArchError(arch, "no layers");
   Sequential net;
   const std::vector<LayerSpec> specs = ParseArchitecture(arch);
+  double params = 0;
   for (size_t i = 0; i < specs.size(); ++i) {
     const LayerSpec& spec = specs[i];
     const std::string where = "layer " + std::to_string(i) + " '" + spec.name + "'";
@@ -199,6 +240,7 @@ Sequential BuildFromArchitecture(const std::string& arch, std::mt19937* rng) {
       if (spec.args.size() != 1 + 2 * static_cast<size_t>(n)) {
         ArchError(arch, where + " needs " + std::to_string(2 * int64_t{n}) + " bounds after n");
       }
+      CheckLimits(arch, where, spec.name, {n}, &params);
       std::vector<float> low, high;
       for (int k = 0; k < n; ++k) {
         low.push_back(ParseFloat(arch, spec.name, spec.args[1 + 2 * static_cast<size_t>(k)]));
@@ -232,6 +274,7 @@ Sequential BuildFromArchitecture(const std::string& arch, std::mt19937* rng) {
       const bool may_be_zero = spec.name == "conv2d" && a == 4;  // The padding.
       values.push_back(ParseInt(arch, spec.name, spec.args[a], may_be_zero));
     }
+    CheckLimits(arch, where, spec.name, values, &params);
     try {
       net.Add(kind->make(values, rng));
     } catch (const std::invalid_argument& e) {

@@ -157,8 +157,17 @@ class Sequential {
 /// e.g. "conv2d(4,32,8,4,0,84,84),relu,conv2d(32,64,4,2,0,20,20),relu,flatten,linear(6400,7)".
 /// Parameters are drawn from `rng` as in PyTorch's defaults, layer by layer. Throws
 /// std::invalid_argument naming the offending layer if the string is empty, malformed, names an
-/// unknown layer, gives a wrong number of arguments or chains mismatched sizes or image shapes.
+/// unknown layer, gives a wrong number of arguments, chains mismatched sizes or image shapes, or
+/// exceeds a limit below (checked before anything is allocated).
 Sequential BuildFromArchitecture(const std::string& arch, std::mt19937* rng);
+
+/// Limits of BuildFromArchitecture, whose strings come from checkpoint files and weight messages:
+/// far above any network of ours, and low enough that no size computation overflows and no
+/// string makes a process allocate gigabytes. Any integer argument; the values of an image
+/// (channels x height x width, padding included); the parameters of the whole network.
+inline constexpr int kMaxArchitectureInteger = 1 << 16;
+inline constexpr int64_t kMaxArchitectureImage = int64_t{1} << 26;
+inline constexpr int64_t kMaxArchitectureParameters = int64_t{1} << 26;
 
 /// A multi-layer perceptron in -> hidden[0] -> ... -> out with ReLU after every hidden layer,
 /// e.g. MakeMlp(4, {120, 84}, 2, &rng). Throws std::invalid_argument on a non-positive size.

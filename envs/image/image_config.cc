@@ -22,6 +22,13 @@ void CheckAtLeast(int value, int minimum, const char* field) {
                               std::to_string(minimum) + ", got " + std::to_string(value));
 }
 
+// Throws std::invalid_argument naming `field` unless value <= maximum.
+void CheckAtMost(int value, int maximum, const char* field) {
+  if (value <= maximum) return;
+  throw std::invalid_argument(std::string("ImagePipelineConfig: ") + field + " must be <= " +
+                              std::to_string(maximum) + ", got " + std::to_string(value));
+}
+
 // Throws std::invalid_argument unless the two crops of one axis leave at least one of its `size`
 // pixels (a 64-bit sum: the crops can be large).
 void CheckCropLeavesPixels(int crop_a, int crop_b, int size, const char* crops,
@@ -53,6 +60,11 @@ void ImagePipelineConfig::Validate() const {
                 "width and height must both be 0 (keep the cropped size) or both positive");
   CheckAtLeast(stack, 1, "stack");
   CheckAtLeast(noop_start, 0, "noop_start");
+  CheckAtMost(render_width, kMaxFrameSide, "render_width");
+  CheckAtMost(render_height, kMaxFrameSide, "render_height");
+  CheckAtMost(width, kMaxFrameSide, "width");
+  CheckAtMost(height, kMaxFrameSide, "height");
+  CheckAtMost(stack, kMaxFrameStack, "stack");
 }
 
 }  // namespace rl::envs

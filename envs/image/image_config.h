@@ -4,6 +4,11 @@
 
 namespace rl::envs {
 
+/// Largest frame side (render and output sizes, pixels) and stack: those of the largest frames
+/// the messages carry (common/messages.cc), so that a frame and a stack fit an int.
+inline constexpr int kMaxFrameSide = 4096;
+inline constexpr int kMaxFrameStack = 64;
+
 /// Options of the image pipeline. Every wrapper takes the whole struct and reads its own fields.
 struct ImagePipelineConfig {
   // Raw frames come from inner->RenderSized(render_width, render_height), or from inner->Render()
@@ -42,7 +47,8 @@ struct ImagePipelineConfig {
   /// Throws std::invalid_argument naming the field unless: render_width and render_height are
   /// both 0 or both positive, frame_skip >= 1, the crops are >= 0 (and, with an explicit render
   /// size, leave at least one pixel each way), width and height are both 0 or both positive,
-  /// stack >= 1 and noop_start >= 0.
+  /// stack >= 1 and noop_start >= 0; and the sizes are at most kMaxFrameSide, the stack at most
+  /// kMaxFrameStack.
   void Validate() const;
 };
 

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "envs/registry.h"
+#include "envs/specs.h"
 
 namespace rl::envs {
 namespace {
@@ -67,6 +68,18 @@ TEST(PixelSpecTest, RefusesBadSpecsWithTheReason) {
   EXPECT_NE(message("Catch-v0+pixels(stack=0)").find("stack"), std::string::npos);
   EXPECT_NE(message("Catch-v0+pixels(off-track=3)").find("off-track is 0 or 1"), std::string::npos);
   EXPECT_NE(message("Catch-v0+pixels(noop-start=-1)").find("noop_start"), std::string::npos);
+}
+
+// Frames larger than the messages carry are refused, before their sizes overflow an int (the
+// observation size of 2 x 333333310 x 5 did). Found by fuzz/fuzz_env_id.
+TEST(PixelSpecTest, RefusesFramesLargerThanTheMessagesCarry) {
+  for (const char* id : {"Catch-v0+pixels(width=5,height=333333310,stack=2,max-pool=0)",
+                         "Catch-v0+pixels(width=4097,height=5)", "Catch-v0+pixels(stack=65)",
+                         "Catch-v0+pixels(render-width=5000,render-height=10,width=0,height=0)"}) {
+    EXPECT_THROW(LookupSpec(id), std::invalid_argument) << id;
+  }
+  EXPECT_EQ(LookupSpec("Catch-v0+pixels(width=4096,height=4096,stack=64)").observation_size,
+            64 * 4096 * 4096);
 }
 
 TEST(PixelSpecTest, MakeEnvBuildsThePipelineTheIdDescribes) {

@@ -4,6 +4,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -84,6 +85,35 @@ TEST(SequentialTest, MalformedArchitecturesThrowWithTheOffendingLayer) {
           << "'" << arch << "' gave: " << e.what();
     }
   }
+}
+
+// Strings from checkpoint files and weight messages: sizes that would overflow an int or
+// allocate gigabytes are refused before anything is built (each one was undefined behaviour or a
+// 16 GB allocation). Found by fuzz/fuzz_checkpoint.
+TEST(SequentialTest, BuildFromArchitectureRefusesSizesBeyondItsLimits) {
+  std::mt19937 rng(1);
+  const std::pair<const char*, const char*> cases[] = {
+      {"linear(65535,65535)", "more than 67108864 parameters"},
+      {"linear(4,8),relu,linear(8,70000)", "70000 is above the limit of 65536"},
+      {"conv2d(1,1,1,1,60000,4,4)", "an image of more than 67108864 values"},
+      {"conv2d(1,1,3,1,0,60000,60000)", "an image of more than 67108864 values"},
+      {"batchnorm2d(1,50000,50000)", "an image of more than 67108864 values"},
+      {"maxpool2d(1,1,50000,50000),flatten,linear(1,1)", "an image of more than 67108864 values"},
+  };
+  for (const auto& [arch, message] : cases) {
+    try {
+      BuildFromArchitecture(arch, &rng);
+      ADD_FAILURE() << "no exception for '" << arch << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos)
+          << "'" << arch << "' gave: " << e.what();
+    }
+  }
+  // The largest network of ours is far below the limits.
+  EXPECT_NO_THROW(BuildFromArchitecture(
+      "conv2d(4,32,8,4,0,84,84),relu,conv2d(32,64,4,2,0,20,20),relu,conv2d(64,64,3,1,0,9,9),relu,"
+      "flatten,linear(3136,512),relu,linear(512,18)",
+      &rng));
 }
 
 TEST(SequentialTest, GetFlatSetFlatRoundTrip) {
