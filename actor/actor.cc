@@ -87,9 +87,13 @@ void Actor::OnFlow(const rlmsg::flow_control_t& f) {
   for (size_t i = 0; i < f.actor_id.size(); ++i) {
     if (f.actor_id[i] == config_.actor_id) stored = f.actor_inserts[i];
   }
+  // A restarted replay (from its snapshot, or empty) stores less than it did: what this actor
+  // published until now is stored or lost, not on the way.
+  if (stored < last_stored_) lost_ = std::max<int64_t>(0, published_ - stored);
+  last_stored_ = stored;
   // A restarted actor may find more stored under its id than it has published: nothing of its
   // own is then on the way.
-  const int64_t on_the_way = std::max<int64_t>(0, published_ - stored);
+  const int64_t on_the_way = std::max<int64_t>(0, published_ - lost_ - stored);
   insert_limit_ = published_ + std::max<int64_t>(0, share - on_the_way);
 }
 

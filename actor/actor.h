@@ -85,7 +85,9 @@ class Actor {
  private:
   // Takes the replay's flow control: insert_allowed, and this actor's share of the insert
   // credit, credit / num_actors (rounded up), less its transitions still on the way (published
-  // but not yet stored by the replay, as far as the message says).
+  // but not yet stored by the replay, as far as the message says). A count of stored
+  // transitions that goes back means a restarted replay (from its snapshot, or empty): what
+  // was published until then is taken as lost, not as on the way.
   void OnFlow(const rlmsg::flow_control_t& f);
 
   struct EnvSlot {
@@ -129,6 +131,10 @@ class Actor {
   int64_t env_steps_ = 0;
   int64_t episodes_ = 0;
   int64_t published_ = 0;
+  // The replay's count of this actor's stored transitions in the last flow message, and the
+  // transitions published that a restarted replay lost (never to be stored).
+  int64_t last_stored_ = 0;
+  int64_t lost_ = 0;
   std::deque<double> recent_returns_;  // last 100 episode returns
   rlmsg::transition_batch_t batch_{};
   bool pixels_ = false;  // the env gives frames

@@ -26,9 +26,31 @@
 //                             transitions from 8 simulated actors: memory_bytes() / size(), and
 //                             the process's VmRSS growth around filling it.
 //
+// Authenticated messages (common/message_auth.h):
+//   mac_hmac_sha256_{pixel_batch,4mb}  checking the MAC of a 230 KB and of a 4 MB message, MB/s.
+//   pixel_replay_insert_mac   pixel_replay_insert with the run's key on both sides (the actor
+//                             signs, the replay checks), on two more ports: compare its rate and
+//                             replay_cpu_us_per_transition with pixel_replay_insert's.
+//
+// Snapshots (replay/snapshotter.h: fork, then the child writes), of a CarRacing-size pixel table
+// (capacity 100,000, frame capacity 130,000 of 84 x 84, prioritized; about 1 GB) and of a
+// CartPole-size flat table (capacity 50,000, obs 4, uniform), both full, into files in the
+// temporary directory:
+//   replay_snapshot_pause_{pixel,flat}  the parent's pause (building the section list + fork()),
+//                             in ms; with the file's bytes, the process's RSS and how much of it
+//                             is in transparent huge pages (the pixel table's frame ring asks
+//                             for them: replay/huge_page_allocator.h).
+//   replay_snapshot_write_{pixel,flat}  the child's write (checksum, write, fsync, rename), in s;
+//                             the parent goes on inserting meanwhile (copy-on-write faults), and
+//                             its insert rate during the write and before it are given.
+//
 // Usage: bench_replay [repeats] [seconds] [port]   (run it in its own network namespace, or
 // give it four free ports from `port` on)
+//        bench_replay --snapshots [repeats]        the snapshot rows only
+//        bench_replay --mac [repeats] [seconds] [port]  the MAC rows only (below)
 #include <malloc.h>
+
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -37,6 +59,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <random>
@@ -48,9 +73,12 @@
 #include "common/channels.h"
 #include "common/check.h"
 #include "common/clock.h"
+#include "common/message_auth.h"
 #include "replay/pixel_table.h"
 #include "replay/prioritized_sampler.h"
 #include "replay/replay_service.h"
+#include "replay/replay_table.h"
+#include "replay/snapshotter.h"
 #include "replay/uniform_sampler.h"
 #include "rlmsg/flow_control_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
@@ -58,8 +86,9 @@
 
 namespace {
 
-rl::BusConfig Config(int port, const std::string& sender) {
+rl::BusConfig Config(int port, const std::string& sender, const std::string& key = "") {
   rl::BusConfig c;
+  c.key = key;
   c.url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0&recv_buf_size=4194304";
   c.bulk_url = "udpm://239.255.76.67:" + std::to_string(port + 1) + "?ttl=0&recv_buf_size=4194304";
   c.run_id = 77;
@@ -313,10 +342,17 @@ struct ServiceProbe {
   std::atomic<int64_t> missing_frames{0};  // transitions skipped for a frame never received
   std::atomic<int64_t> lost{0};            // sequence gaps counted by the service's bus
   std::atomic<int64_t> dropped{0};         // malformed, invalid or refused
+  std::atomic<double> cpu_seconds{0};      // the service thread's CPU time
 };
 
-void RunPixelService(int port, ServiceProbe* probe) {
-  rl::Bus bus(Config(port, "replay"));
+double ThreadCpuSeconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
+}
+
+void RunPixelService(int port, ServiceProbe* probe, const std::string& key) {
+  rl::Bus bus(Config(port, "replay", key));
   rl::replay::ReplayServiceOptions o;
   o.table.capacity = kCapacity;
   o.limiter.samples_per_insert = 0;  // no rate limiting
@@ -330,7 +366,9 @@ void RunPixelService(int port, ServiceProbe* probe) {
     }
     const rl::BusCounters& c = bus.counters();
     probe->lost.store(c.lost);
-    probe->dropped.store(c.malformed + c.invalid + service.counters().batches_refused);
+    probe->dropped.store(c.malformed + c.invalid + c.unauthenticated +
+                         service.counters().batches_refused);
+    probe->cpu_seconds.store(ThreadCpuSeconds());
     return probe->stop.load();
   });
 }
@@ -352,8 +390,11 @@ int64_t Settle(rl::Bus* bus, const ServiceProbe& probe, int64_t target, double q
   }
 }
 
-// pixel_replay_insert: one actor's batches published back to back from the main thread.
-bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double seconds) {
+// pixel_replay_insert[_mac]: one actor's batches published back to back from the main thread.
+// Also the replay thread's CPU time per stored transition (what a MAC adds to the replay's work,
+// unlike the rate, which the transport's losses make noisy).
+bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double seconds,
+                 const char* name) {
   PixelActorSim sim(0, 1);
 
   // The first batch makes the service allocate its table (about 0.8 GB for 100,000 stacks).
@@ -372,7 +413,7 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
   }
   const double first_batch_s = rl::MonoSeconds() - first_sent;
 
-  std::vector<double> rates, mb_rates, offered, loss;
+  std::vector<double> rates, mb_rates, offered, loss, cpu_us;
   int64_t sent_total = 0, lost_total = 0;
   const int64_t gaps_before = probe.lost.load();
   const int64_t missing_before = probe.missing_frames.load();
@@ -380,6 +421,7 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
   double bytes_per_transition = 0;
   for (int r = 0; r < repeats; ++r) {
     const int64_t before = probe.inserts.load();
+    const double cpu_before = probe.cpu_seconds.load();
     int64_t sent = 0;
     double bytes = 0;
     const double start = rl::MonoSeconds();
@@ -399,6 +441,8 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
     mb_rates.push_back(rates.back() * bytes_per_transition / 1e6);
     offered.push_back(static_cast<double>(sent) / (send_end - start));
     loss.push_back(static_cast<double>(sent - stored) / static_cast<double>(sent));
+    cpu_us.push_back((probe.cpu_seconds.load() - cpu_before) * 1e6 /
+                     static_cast<double>(std::max<int64_t>(1, stored)));
     sent_total += sent;
     lost_total += sent - stored;
   }
@@ -412,16 +456,17 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
       "\"lcm_bytes_per_transition\": %.0f, \"published_per_s_median\": %.0f, "
       "\"lost_fraction_median\": %.4f, \"lost_fraction_max\": %.4f, \"sent\": %lld, "
       "\"lost\": %lld, \"lost_batches_seq_gaps\": %lld, \"transitions_missing_frames\": %lld, "
-      "\"dropped_invalid\": %lld, \"first_batch_s\": %.3f, \"capacity\": %lld",
+      "\"dropped_invalid\": %lld, \"first_batch_s\": %.3f, \"capacity\": %lld, "
+      "\"replay_cpu_us_per_transition_median\": %.2f, \"mac\": \"%s\"",
       kBatch, kHeight, kWidth, kStack, mb.median, mb.min, mb.max, bytes_per_transition,
       rl::bench::Summarize(offered).median, loss_s.median, loss_s.max,
       static_cast<long long>(sent_total), static_cast<long long>(lost_total),
       static_cast<long long>(probe.lost.load() - gaps_before),
       static_cast<long long>(probe.missing_frames.load() - missing_before),
       static_cast<long long>(probe.dropped.load() - dropped_before), first_batch_s,
-      static_cast<long long>(kCapacity));
-  rl::bench::Emit("pixel_replay_insert", "transitions/s", rl::bench::Summarize(rates), repeats,
-                  extra);
+      static_cast<long long>(kCapacity), rl::bench::Summarize(cpu_us).median,
+      bus->config().key.empty() ? "none" : "HMAC-SHA256");
+  rl::bench::Emit(name, "transitions/s", rl::bench::Summarize(rates), repeats, extra);
   return true;
 }
 
@@ -585,24 +630,31 @@ void PixelActors(rl::Bus* bus, const ServiceProbe& probe, int port, int multipli
   rl::bench::Emit(name, "transitions/s", rl::bench::Summarize(delivered), windows, extra);
 }
 
-// Pixel benchmarks through LCM, on `port` and port + 1.
-int RunPixelLcm(int repeats, double seconds, int port) {
+// Pixel benchmarks through LCM, on `port` and port + 1; with a key, or insert_only, only the
+// insert row.
+int RunPixelLcm(int repeats, double seconds, int port, const std::string& key = "",
+                bool insert_only = false) {
   ServiceProbe probe;
-  std::thread service_thread([&] { RunPixelService(port, &probe); });
+  std::thread service_thread([&] { RunPixelService(port, &probe, key); });
   auto stop = [&] {
     probe.stop = true;
     service_thread.join();
   };
 
-  rl::Bus bus(Config(port, "learner"));
+  rl::Bus bus(Config(port, "learner", key));
   if (!WaitForReplay(&bus)) {
     std::fprintf(stderr, "bench_replay: the pixel replay service did not come up\n");
     stop();
     return 1;
   }
-  if (!PixelInsert(&bus, probe, repeats, seconds)) {
+  if (!PixelInsert(&bus, probe, repeats, seconds,
+                   key.empty() ? "pixel_replay_insert" : "pixel_replay_insert_mac")) {
     stop();
     return 1;
+  }
+  if (!key.empty() || insert_only) {
+    stop();
+    return 0;
   }
   PixelSample(&bus, repeats, seconds);
   const int windows = std::max(repeats, 3);
@@ -691,16 +743,196 @@ void PixelMemory(bool prioritized) {
                   "bytes/transition", s, 1, extra);
 }
 
+// Bytes of this process's anonymous memory in transparent huge pages (0 when unknown).
+int64_t AnonHugePageBytes() {
+  std::FILE* f = std::fopen("/proc/self/smaps_rollup", "r");
+  if (f == nullptr) return 0;
+  char line[256];
+  int64_t kb = 0;
+  while (std::fgets(line, sizeof(line), f) != nullptr) {
+    if (std::strncmp(line, "AnonHugePages:", 14) == 0) {
+      kb = std::atoll(line + 14);
+      break;
+    }
+  }
+  std::fclose(f);
+  return kb * 1024;
+}
+
+// Snapshots of a full table: `insert` stores one batch and returns its transitions, `save` adds
+// the table to a snapshot. Emits the pause and write rows for `name`.
+void SnapshotRows(const std::string& name, int repeats, const std::function<int()>& insert,
+                  const std::function<std::string(rl::StateStream*)>& save) {
+  namespace fs = std::filesystem;
+  const std::string path =
+      (fs::temp_directory_path() / ("bench_replay_snapshot_" + std::to_string(getpid()) + ".bin"))
+          .string();
+  rl::replay::SnapshotterOptions options;
+  options.path = path;
+  options.every_seconds = 1e9;  // only StartNow()
+  options.program = "bench_replay";
+  int64_t version = 0;
+  rl::replay::Snapshotter snapshots(options, rl::replay::ReplayService::kSnapshotKind, save,
+                                    [&version] { return version; });
+  std::vector<double> pauses, forks, writes, rates_during, rates_before;
+  int64_t bytes = 0;
+  for (int r = 0; r < repeats; ++r) {
+    // The insert rate without a snapshot, for as long as the last write took (at least 0.2 s).
+    const double window = std::max(0.2, writes.empty() ? 0.5 : writes.back());
+    int64_t inserted = 0;
+    double start = rl::MonoSeconds();
+    while (rl::MonoSeconds() - start < window) inserted += insert();
+    rates_before.push_back(static_cast<double>(inserted) / (rl::MonoSeconds() - start));
+    // A snapshot, inserting on while the child writes.
+    ++version;
+    RL_CHECK(snapshots.StartNow()) << "snapshot not started";
+    inserted = 0;
+    start = rl::MonoSeconds();
+    while (snapshots.running()) {
+      inserted += insert();
+      snapshots.Tick(rl::MonoSeconds());
+    }
+    rates_during.push_back(static_cast<double>(inserted) / (rl::MonoSeconds() - start));
+    const rl::replay::SnapshotStats& st = snapshots.stats();
+    RL_CHECK(st.failed == 0) << "a snapshot failed";
+    pauses.push_back(1e3 * st.last_pause_seconds);
+    forks.push_back(1e3 * st.last_fork_seconds);
+    writes.push_back(st.last_write_seconds);
+    bytes = st.last_bytes;
+  }
+  fs::remove(path);
+  const rl::bench::Summary fork = rl::bench::Summarize(forks);
+  char extra[512];
+  std::snprintf(extra, sizeof(extra),
+                "\"bytes\": %lld, \"rss_bytes\": %lld, \"anon_huge_page_bytes\": %lld, "
+                "\"fork_ms_median\": %.3f, \"fork_ms_max\": %.3f",
+                static_cast<long long>(bytes), static_cast<long long>(RssBytes()),
+                static_cast<long long>(AnonHugePageBytes()), fork.median, fork.max);
+  rl::bench::Emit("replay_snapshot_pause_" + name, "ms", rl::bench::Summarize(pauses), repeats,
+                  extra);
+  const rl::bench::Summary during = rl::bench::Summarize(rates_during);
+  const rl::bench::Summary before = rl::bench::Summarize(rates_before);
+  std::snprintf(extra, sizeof(extra),
+                "\"bytes\": %lld, \"mb_per_s_median\": %.0f, "
+                "\"inserts_per_s_during_write_median\": %.0f, "
+                "\"inserts_per_s_without_median\": %.0f",
+                static_cast<long long>(bytes),
+                static_cast<double>(bytes) / 1e6 / rl::bench::Summarize(writes).median,
+                during.median, before.median);
+  rl::bench::Emit("replay_snapshot_write_" + name, "s", rl::bench::Summarize(writes), repeats,
+                  extra);
+}
+
+// replay_snapshot_*_pixel: a full CarRacing-size prioritized pixel table.
+void PixelSnapshots(int repeats) {
+  rl::replay::PixelTableOptions o;
+  o.capacity = kCapacity;
+  o.frame_capacity = 130'000;
+  o.height = kHeight;
+  o.width = kWidth;
+  o.stack = kStack;
+  rl::replay::PixelTable table(
+      o, std::make_unique<rl::replay::PrioritizedSampler>(kCapacity, 0.6, 1e-6));
+  std::vector<PixelActorSim> sims;
+  for (int a = 0; a < kActors; ++a) sims.emplace_back(a, 900 + static_cast<uint64_t>(a));
+  size_t turn = 0;
+  const auto insert = [&] {
+    const char* why = table.Insert(View(*sims[turn++ % sims.size()].Next()));
+    RL_CHECK(why == nullptr) << why;
+    return kBatch;
+  };
+  // Every frame and slot written once.
+  while (table.total_frames() < o.frame_capacity || table.total_inserts() < kCapacity) insert();
+  SnapshotRows("pixel", repeats, insert, [&table](rl::StateStream* out) {
+    table.Save("pixels.", out);
+    return std::string("pixel table");
+  });
+}
+
+// replay_snapshot_*_flat: a full CartPole-size uniform flat table.
+void FlatSnapshots(int repeats) {
+  rl::replay::ReplayTableOptions o;
+  o.capacity = 50'000;
+  o.obs_size = 4;
+  o.action_width = 1;
+  rl::replay::ReplayTable table(o);
+  std::vector<float> obs(kBatch * 4, 0.5f), action(kBatch, 1.0f), reward(kBatch, 1.0f),
+      discount(kBatch, 0.99f);
+  const rl::replay::TransitionBatchView batch{
+      4, kBatch, obs, obs, rl::replay::ColumnsView{1, action, reward, discount, {}, {}}};
+  const auto insert = [&] {
+    const char* why = table.Insert(batch);
+    RL_CHECK(why == nullptr) << why;
+    return kBatch;
+  };
+  while (table.total_inserts() < o.capacity) insert();
+  SnapshotRows("flat", repeats, insert, [&table](rl::StateStream* out) {
+    table.Save("flat.", out);
+    return std::string("flat table");
+  });
+}
+
 }  // namespace
 
+// mac_hmac_sha256: signing and checking (common/message_auth.h) messages of a pixel batch's size
+// (32 transitions with their frames) and of a sample reply's (4 MB), MB/s.
+void MacRows(int repeats) {
+  rl::MessageAuthenticator auth(std::string(rl::kKeyBytes, 'k'));
+  for (const size_t size : {size_t{230'000}, size_t{4'000'000}}) {
+    std::vector<uint8_t> msg(size, 0x5a);
+    std::fill(msg.begin() + 40, msg.begin() + 40 + rl::kMacBytes, 0);
+    if (!auth.Sign(msg.data(), msg.size(), 40)) std::abort();
+    std::vector<double> rates;
+    for (int r = 0; r < repeats; ++r) {
+      int64_t n = 0;
+      const double start = rl::MonoSeconds();
+      while (rl::MonoSeconds() - start < 0.3) {
+        if (auth.Verify(msg.data(), msg.size(), 40) != nullptr) std::abort();
+        ++n;
+      }
+      rates.push_back(static_cast<double>(n) * static_cast<double>(size) / 1e6 /
+                      (rl::MonoSeconds() - start));
+    }
+    char extra[128];
+    std::snprintf(extra, sizeof(extra), "\"message_bytes\": %zu, \"mac_bytes\": %zu", size,
+                  rl::kMacBytes);
+    rl::bench::Emit(size < 1'000'000 ? "mac_hmac_sha256_pixel_batch" : "mac_hmac_sha256_4mb",
+                    "MB/s", rl::bench::Summarize(rates), repeats, extra);
+  }
+}
+
 int main(int argc, char** argv) {
+  if (argc > 1 && std::string(argv[1]) == "--mac") {
+    // The MAC's cost alone: its throughput, and pixel inserts without and with it.
+    const int repeats = argc > 2 ? std::atoi(argv[2]) : 5;
+    const double seconds = argc > 3 ? std::atof(argv[3]) : 1.0;
+    const int port = argc > 4 ? std::atoi(argv[4]) : 17667;
+    MacRows(repeats);
+    if (const int rc = RunPixelLcm(repeats, seconds, port + 2, "", /*insert_only=*/true); rc != 0) {
+      return rc;
+    }
+    return RunPixelLcm(repeats, seconds, port + 4, std::string(rl::kKeyBytes, 'k'));
+  }
+  if (argc > 1 && std::string(argv[1]) == "--snapshots") {
+    const int repeats = argc > 2 ? std::atoi(argv[2]) : 5;
+    FlatSnapshots(repeats);
+    PixelSnapshots(repeats);
+    return 0;
+  }
   const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
   const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
   const int port = argc > 3 ? std::atoi(argv[3]) : 17667;
 
   if (const int rc = RunFlat(repeats, seconds, port); rc != 0) return rc;
   if (const int rc = RunPixelLcm(repeats, seconds, port + 2); rc != 0) return rc;
+  MacRows(repeats);
+  if (const int rc = RunPixelLcm(repeats, seconds, port + 4, std::string(rl::kKeyBytes, 'k'));
+      rc != 0) {
+    return rc;
+  }
   PixelMemory(/*prioritized=*/false);
   PixelMemory(/*prioritized=*/true);
+  FlatSnapshots(repeats);
+  PixelSnapshots(repeats);
   return 0;
 }

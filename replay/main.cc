@@ -2,14 +2,17 @@
 // holding both to a samples-per-insert ratio. See README.md.
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
 #include <span>
 #include <string>
 
+#include "common/clock.h"
 #include "common/lcm_bus.h"
 #include "common/options.h"
 #include "common/shutdown.h"
 #include "envs/specs.h"
 #include "replay/replay_service.h"
+#include "replay/snapshotter.h"
 
 namespace {
 
@@ -20,7 +23,12 @@ constexpr char kUsage[] =
     "or pixel frames stored once and stacks rebuilt), holding the ratio of samples to inserts\n"
     "near --samples-per-insert (actors are paused through RL_FLOW). With --env, every action is\n"
     "checked against the env's action space (width, integer indices, bounds) and a batch with a\n"
-    "bad one is refused and counted.";
+    "bad one is refused and counted.\n"
+    "With --snapshot PATH, the replay loads PATH at its start when it exists (a file that is not\n"
+    "a replay snapshot of this run and configuration, or is torn or corrupted, is refused: the\n"
+    "replay exits with status 2 and says why) and writes its whole state there every\n"
+    "--snapshot-every seconds from a forked child (copy-on-write; the service pauses for the fork\n"
+    "only), and once more when it stops.";
 
 int Main(int argc, char** argv) {
   namespace po = rl::po;
@@ -28,6 +36,7 @@ int Main(int argc, char** argv) {
   rl::replay::ReplayServiceOptions options;
   options.progress_seconds = 5.0;
   std::string env_id;
+  rl::replay::SnapshotterOptions snapshots;
 
   po::options_description desc("Options");
   rl::AddCommonOptions(&desc, &common);
@@ -73,7 +82,14 @@ int Main(int argc, char** argv) {
       ("flow-hz", po::value(&options.flow_hz)->default_value(options.flow_hz),
        "RL_FLOW messages per second (and at once on every change)")  //
       ("stats-hz", po::value(&options.stats_hz)->default_value(options.stats_hz),
-       "RL_STATS_REPLAY messages per second");
+       "RL_STATS_REPLAY messages per second")  //
+      ("snapshot", po::value(&snapshots.path),
+       "snapshot file: loaded at the start when it exists, written every --snapshot-every "
+       "seconds and at the end (none: no snapshots)")  //
+      ("snapshot-every",
+       po::value(&snapshots.every_seconds)->default_value(snapshots.every_seconds),
+       "seconds between snapshots: after a crash, at most the transitions of this long are "
+       "lost");
   po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "replay", kUsage, desc, &vm)) return 0;
 
@@ -87,13 +103,37 @@ int Main(int argc, char** argv) {
   }
   // Refuse bad values before touching the network.
   options.Validate();
+  snapshots.Validate();
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("replay"));
   rl::replay::ReplayService service(&bus, options);
+  // The last snapshot, if any: a file that is there but refused ends the daemon (status 2).
+  if (!snapshots.path.empty()) {
+    if (std::filesystem::exists(snapshots.path)) {
+      const double start = rl::MonoSeconds();
+      const std::string loaded = service.LoadSnapshot(snapshots.path);
+      std::printf("replay: snapshot %s loaded (%s) in %.2f s\n", snapshots.path.c_str(),
+                  loaded.c_str(), rl::MonoSeconds() - start);
+    } else {
+      std::printf("replay: no snapshot %s yet; starting empty\n", snapshots.path.c_str());
+    }
+  }
+  rl::replay::Snapshotter snapshotter(
+      snapshots, rl::replay::ReplayService::kSnapshotKind,
+      [&service](rl::StateStream* out) { return service.SaveSnapshot(out); },
+      [&service] {
+        return service.total_inserts() + service.total_samples() +
+               service.counters().priorities_applied;
+      });
   std::printf("replay: ready\n");
   std::fflush(stdout);
 
-  service.Run(rl::StopRequested);
+  // Between rounds: reap the last snapshot's writer, and start the next one when it is due.
+  service.Run([&snapshotter] {
+    snapshotter.Tick(rl::MonoSeconds());
+    return rl::StopRequested();
+  });
+  snapshotter.Finish();
   std::printf("replay: stopped after %lld inserts and %lld samples\n",
               static_cast<long long>(service.total_inserts()),
               static_cast<long long>(service.total_samples()));

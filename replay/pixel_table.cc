@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "common/check.h"
+#include "common/state_file.h"
 #include "replay/priorities.h"
 #include "replay/uniform_sampler.h"
 
@@ -308,6 +309,162 @@ int64_t PixelTable::memory_bytes() const {
                  items_.capacity() * sizeof(SampledItem) + actors_.capacity() * sizeof(ActorFrames);
   for (const ActorFrames& actor : actors_) bytes += actor.window.capacity() * sizeof(FrameRef);
   return static_cast<int64_t>(bytes) + columns_.memory_bytes() + sampler_->memory_bytes();
+}
+
+}  // namespace rl::replay
+
+namespace rl::replay {
+
+void PixelTable::Save(const std::string& prefix, StateStream* out) const {
+  const int64_t shape[] = {options_.capacity,      frame_capacity_, height_, width_, stack_,
+                           columns_.action_width()};
+  const int64_t counts[] = {size_,         total_inserts_,  total_samples_,
+                            total_frames_, missing_frames_, stale_draws_};
+  out->PutInts(prefix + "shape", shape);
+  out->PutInts(prefix + "counts", counts);
+  out->AddBytes(prefix + "frames", frames_);
+  out->AddInts(prefix + "frame_refs", frame_refs_);
+  columns_.Save(prefix, out);
+  // Per actor: id, newest local id, whether it has sent a frame; then all windows, in order
+  // (a FrameRef is two int64: local id, global number).
+  static_assert(sizeof(FrameRef) == 2 * sizeof(int64_t));
+  std::vector<int64_t> actors;
+  for (const ActorFrames& a : actors_) {
+    actors.insert(actors.end(), {int64_t{a.actor_id}, a.last_id, int64_t{a.any ? 1 : 0}});
+  }
+  out->PutInts(prefix + "actors", actors);
+  out->AddInts(prefix + "windows", {});
+  for (const ActorFrames& a : actors_) {
+    out->AddPiece(a.window.data(), a.window.size() * sizeof(FrameRef));
+  }
+  sampler_->Save(prefix + "sampler.", out);
+}
+
+void PixelTable::Restore(const std::string& prefix, const StateView& in) {
+  int64_t shape[6] = {};
+  int64_t counts[6] = {};
+  in.Copy<int64_t>(prefix + "shape", shape);
+  in.Copy<int64_t>(prefix + "counts", counts);
+  const auto refuse = [](const std::string& why) { throw std::runtime_error(why); };
+  const int64_t capacity = shape[0];
+  if (capacity != options_.capacity || shape[1] != frame_capacity_) {
+    refuse("the snapshot's pixel table has capacity " + std::to_string(capacity) +
+           " and frame capacity " + std::to_string(shape[1]) + ", this replay's " +
+           std::to_string(options_.capacity) + " and " + std::to_string(frame_capacity_));
+  }
+  const int64_t height = shape[2], width = shape[3], stack = shape[4], action_width = shape[5];
+  const bool geometry = height > 0 || width > 0 || stack > 0;
+  if (geometry && (height < 1 || height > kMaxSide || width < 1 || width > kMaxSide || stack < 1 ||
+                   stack > kMaxStack)) {
+    refuse("the snapshot's pixel table has a bad geometry");
+  }
+  if (geometry && ((options_.height > 0 && height != options_.height) ||
+                   (options_.width > 0 && width != options_.width) ||
+                   (options_.stack > 0 && stack != options_.stack))) {
+    refuse("the snapshot's frames are " + std::to_string(height) + " x " + std::to_string(width) +
+           " in stacks of " + std::to_string(stack) + ", this replay's " +
+           std::to_string(options_.height) + " x " + std::to_string(options_.width) + " in " +
+           std::to_string(options_.stack));
+  }
+  if (action_width < 0 || action_width > TransitionColumns::kMaxActionWidth ||
+      (action_width > 0 && options_.action_width > 0 && action_width != options_.action_width)) {
+    refuse("the snapshot's action width " + std::to_string(action_width) +
+           " is not this replay's " + std::to_string(options_.action_width));
+  }
+  const int64_t size = counts[0], inserts = counts[1], samples = counts[2], frames = counts[3];
+  // (Counts stay far from overflow: 2^62 is ages of any run.)
+  constexpr int64_t kMaxCount = int64_t{1} << 62;
+  const auto count_ok = [](int64_t n) { return n >= 0 && n <= kMaxCount; };
+  if (size < 0 || size > capacity || !count_ok(inserts) || !count_ok(samples) ||
+      !count_ok(frames) || !count_ok(counts[4]) || !count_ok(counts[5]) ||
+      (inserts > 0 && (action_width == 0 || !geometry)) || (frames > 0 && !geometry)) {
+    refuse("the snapshot's pixel table counters are inconsistent");
+  }
+  // The lengths of the large sections, before anything is allocated for them.
+  const int64_t frame_bytes = height * width;
+  const int64_t frame_section = in.Count<uint8_t>(prefix + "frames");
+  const int64_t refs_section = in.Count<int64_t>(prefix + "frame_refs");
+  const bool frames_fit =
+      geometry ? frame_section % frame_bytes == 0 && frame_section / frame_bytes == frame_capacity_
+               : frame_section == 0;
+  const bool refs_fit =
+      geometry ? refs_section % (2 * stack) == 0 && refs_section / (2 * stack) == capacity
+               : refs_section == 0;
+  if (!frames_fit || !refs_fit) {
+    refuse("the snapshot's frame ring or frame references do not fit its geometry");
+  }
+  const std::vector<int64_t> actors = in.Ints(prefix + "actors", 3 * int64_t{kMaxActors});
+  if (actors.size() % 3 != 0 || in.Count<int64_t>(prefix + "windows") !=
+                                    static_cast<int64_t>(actors.size() / 3) * 2 * kWindow) {
+    refuse("the snapshot's actor windows do not fit its actors");
+  }
+
+  // Storage.
+  if (geometry) {
+    Allocate(static_cast<int>(height), static_cast<int>(width), static_cast<int>(stack));
+  } else {
+    height_ = width_ = stack_ = 0;
+    frames_.clear();
+    frame_refs_.clear();
+  }
+  in.Copy<uint8_t>(prefix + "frames", frames_);
+  in.Copy<int64_t>(prefix + "frame_refs", frame_refs_);
+  columns_.Restore(prefix, in, capacity, static_cast<int>(action_width));
+  size_ = size;
+  total_inserts_ = inserts;
+  total_samples_ = samples;
+  total_frames_ = frames;
+  missing_frames_ = counts[4];
+  stale_draws_ = counts[5];
+
+  // Actors, in increasing id, with windows of frames received.
+  std::vector<int64_t> windows(actors.size() / 3 * 2 * kWindow);
+  in.Copy<int64_t>(prefix + "windows", windows);
+  actors_.clear();
+  for (size_t k = 0; k < actors.size() / 3; ++k) {
+    ActorFrames a;
+    const int64_t id = actors[3 * k];
+    if (id < 0 || id > kMaxActorId || (k > 0 && id <= actors_.back().actor_id) ||
+        (actors[3 * k + 2] != 0 && actors[3 * k + 2] != 1)) {
+      refuse("the snapshot's actors are not in increasing id order, or out of range");
+    }
+    a.actor_id = static_cast<int32_t>(id);
+    a.last_id = actors[3 * k + 1];
+    a.any = actors[3 * k + 2] != 0;
+    a.window.resize(static_cast<size_t>(kWindow));
+    for (size_t e = 0; e < a.window.size(); ++e) {
+      const int64_t* ref = windows.data() + (k * kWindow + e) * 2;
+      if (ref[1] < -1 || ref[1] >= frames)
+        refuse("the snapshot's actor windows name unknown frames");
+      a.window[e] = FrameRef{ref[0], ref[1]};
+    }
+    actors_.push_back(std::move(a));
+  }
+
+  // Slots: a transition where the insert number is set (that of the slot, among the last
+  // `capacity` inserts), naming frames received; none elsewhere.
+  int64_t stored = 0;
+  const std::vector<int64_t>& numbers = columns_.insert_numbers();
+  for (size_t slot = 0; slot < numbers.size(); ++slot) {
+    const int64_t n = numbers[slot];
+    if (n < 0) continue;
+    if (n >= inserts || n < inserts - capacity || n % capacity != static_cast<int64_t>(slot)) {
+      refuse("the snapshot's insert numbers are not a table's");
+    }
+    const int64_t* refs = frame_refs_.data() + slot * 2 * static_cast<size_t>(stack_);
+    for (int64_t k = 0; k < 2 * stack_; ++k) {
+      if (refs[k] < 0 || refs[k] >= frames)
+        refuse("the snapshot's transitions name unknown frames");
+    }
+    ++stored;
+  }
+  if (stored != size) refuse("the snapshot's pixel table size is not its number of transitions");
+  if (numbers.empty()) {
+    sampler_->Restore(prefix + "sampler.", in,
+                      std::vector<int64_t>(static_cast<size_t>(capacity), -1));
+  } else {
+    sampler_->Restore(prefix + "sampler.", in, numbers);
+  }
 }
 
 }  // namespace rl::replay

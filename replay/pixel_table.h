@@ -25,8 +25,9 @@
 // its oldest frame (frame_capacity too small for the frames that arrive while it is kept);
 // Sample() then removes it from the sampler and draws again (counted in stale_draws()).
 //
-// Memory: frame_capacity * height * width bytes + capacity * (16 * stack + 4 * action_width + 24)
-// bytes + 64 KiB
+// Memory: frame_capacity * height * width bytes (in transparent huge pages where the kernel
+// offers them: huge_page_allocator.h) + capacity * (16 * stack + 4 * action_width + 24) bytes +
+// 64 KiB
 // per actor, allocated when the geometry becomes known (from the options, or the first batch),
 // plus the sampler's (16 bytes per slot for the uniform sampler, 32 to 64 for the prioritized
 // one). With the default frame_capacity (capacity * 1.03125 + 4096) and 84 x 84 stacks of 4, a
@@ -40,8 +41,10 @@
 #include <memory>
 #include <random>
 #include <span>
+#include <string>
 #include <vector>
 
+#include "replay/huge_page_allocator.h"
 #include "replay/sampler.h"
 #include "replay/transition_columns.h"
 
@@ -184,6 +187,19 @@ class PixelTable {
   /// The sampler, for inspection (probabilities, size).
   const Sampler& sampler() const { return *sampler_; }
 
+  /// Adds the table (geometry, counters, the frame ring, every slot, each actor's window of
+  /// frame ids, the sampler's state) to a snapshot as sections prefix + "...", referring to its
+  /// arrays: the table must not change until the snapshot is written (a fork()ed child writes a
+  /// copy-on-write image of it). O(actors) besides the section entries.
+  void Save(const std::string& prefix, StateStream* out) const;
+  /// Replaces the table's contents by a snapshot's. Throws std::runtime_error saying why it is
+  /// refused: another capacity or frame capacity, a geometry or action width other than the
+  /// configured ones, or contents that are not a table's (counters, insert numbers, frame
+  /// references, actor windows or sampler state inconsistent). Every length is checked against
+  /// the configuration before anything is allocated. A table whose Restore threw must not be
+  /// used further. O(frame bytes + capacity * stack + actors * 4096).
+  void Restore(const std::string& prefix, const StateView& in);
+
  private:
   // Where an actor's recent local frame ids are: entry local_id % kWindow.
   struct FrameRef {
@@ -223,7 +239,8 @@ class PixelTable {
   int64_t stale_draws_ = 0;
   double beta_ = 1.0;
 
-  std::vector<uint8_t> frames_;      // frame_capacity_ frames of height_ * width_ bytes
+  // frame_capacity_ frames of height_ * width_ bytes, in huge pages where the kernel offers them
+  std::vector<uint8_t, HugePageAllocator<uint8_t>> frames_;
   std::vector<ActorFrames> actors_;  // sorted by actor_id
 
   // Per-slot storage (frame_refs_: 2 * stack_ global frame numbers per slot, obs then next_obs).

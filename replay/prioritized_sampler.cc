@@ -4,8 +4,10 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/check.h"
+#include "common/state_file.h"
 
 namespace rl::replay {
 namespace {
@@ -93,6 +95,53 @@ double PrioritizedSampler::Probability(int64_t slot) const {
 
 double PrioritizedSampler::MinProbability() const {
   return size_ == 0 ? 0.0 : tree_.Min() / tree_.Total();
+}
+
+void PrioritizedSampler::Save(const std::string& prefix, StateStream* out) const {
+  out->PutText(prefix + "kind", "prioritized");
+  const double params[] = {alpha_, epsilon_, max_priority_};
+  out->PutDoubles(prefix + "params", params);
+  out->PutInt(prefix + "seen_priority", seen_priority_ ? 1 : 0);
+  out->AddDoubles(prefix + "values", tree_.leaves());
+}
+
+void PrioritizedSampler::Restore(const std::string& prefix, const StateView& in,
+                                 std::span<const int64_t> insert_number) {
+  const int64_t capacity = tree_.capacity();
+  RL_CHECK(static_cast<int64_t>(insert_number.size()) == capacity)
+      << "insert_number must have one entry per slot";
+  const std::string kind = in.Text(prefix + "kind");
+  if (kind != "prioritized") {
+    throw std::runtime_error("the snapshot's sampler is " + kind + ", this replay's prioritized");
+  }
+  double params[3] = {};
+  in.Copy<double>(prefix + "params", params);
+  if (params[0] != alpha_ || params[1] != epsilon_) {
+    throw std::runtime_error("the snapshot's priorities have alpha " + std::to_string(params[0]) +
+                             " and epsilon " + std::to_string(params[1]) + ", this replay's " +
+                             std::to_string(alpha_) + " and " + std::to_string(epsilon_));
+  }
+  if (!std::isfinite(params[2]) || params[2] <= 0.0) {
+    throw std::runtime_error("section '" + prefix + "params' has a bad largest priority");
+  }
+  const int64_t seen = in.Int(prefix + "seen_priority");
+  // A value per slot: within the stored bounds where a transition is, 0 elsewhere.
+  std::vector<double> values(static_cast<size_t>(capacity));
+  in.Copy<double>(prefix + "values", values);
+  int64_t size = 0;
+  for (int64_t slot = 0; slot < capacity; ++slot) {
+    const double v = values[static_cast<size_t>(slot)];
+    const bool stored = insert_number[static_cast<size_t>(slot)] >= 0;
+    if (stored ? !(v >= kMinStored && v <= kMaxStored) : v != 0.0) {
+      throw std::runtime_error("section '" + prefix + "values' disagrees with the table at slot " +
+                               std::to_string(slot));
+    }
+    size += stored ? 1 : 0;
+  }
+  tree_.Assign(values);
+  max_priority_ = params[2];
+  seen_priority_ = seen != 0;
+  size_ = size;
 }
 
 }  // namespace rl::replay

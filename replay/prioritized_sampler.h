@@ -56,6 +56,11 @@ class PrioritizedSampler final : public Sampler {
   double MinProbability() const override;
   int64_t size() const override { return size_; }
   int64_t memory_bytes() const override { return tree_.memory_bytes(); }
+  /// The stored values of every slot, the largest priority seen, alpha and epsilon (a snapshot
+  /// of other alpha or epsilon is refused: its values would mean other probabilities).
+  void Save(const std::string& prefix, StateStream* out) const override;
+  void Restore(const std::string& prefix, const StateView& in,
+               std::span<const int64_t> insert_number) override;
 
   double alpha() const { return alpha_; }
   double epsilon() const { return epsilon_; }

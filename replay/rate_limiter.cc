@@ -74,6 +74,16 @@ int64_t RateLimiter::InsertCredit() const {
   return static_cast<int64_t>(std::floor(std::max({0.0, room, before_min})));
 }
 
+void RateLimiter::Restore(int64_t inserts, int64_t samples) {
+  if (inserts < 0 || samples < 0) {
+    throw std::invalid_argument("rate limiter: counts must be >= 0, got " +
+                                std::to_string(inserts) + " inserts and " +
+                                std::to_string(samples) + " samples");
+  }
+  inserts_ = inserts;
+  samples_ = samples;
+}
+
 int64_t RateLimiter::max_sample_batch() const {
   if (!enabled()) return 0;
   return static_cast<int64_t>(

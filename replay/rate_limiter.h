@@ -62,6 +62,8 @@ class RateLimiter {
   void Insert(int64_t n) { inserts_ += n; }
   /// Records n transitions sampled (allowed or not).
   void Sample(int64_t n) { samples_ += n; }
+  /// Sets both counts (from a snapshot); throws std::invalid_argument when one is negative.
+  void Restore(int64_t inserts, int64_t samples);
 
   /// Largest sample batch that can never deadlock (see the file comment); 0 when SPI <= 0 (no
   /// limit).

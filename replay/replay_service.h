@@ -30,6 +30,12 @@
 // For CartPole a batch of 128 is about 7 KB; a batch of 32 Nature-DQN stacks (4 x 84 x 84) about
 // 1.8 MB.
 //
+// Snapshots (replay_service_snapshot.cc): SaveSnapshot() describes the whole state a restarted
+// replay needs to serve as before (the table with its sampler, the limiter's counts, the
+// sampler's random generator, the per-actor insert counts, the service's counters; not the
+// pending requests, which their requesters send again) as a StateStream of kind
+// kSnapshotKind; RestoreSnapshot()/LoadSnapshot() load one into a fresh service.
+//
 // Not thread-safe: one thread constructs the service and calls every method; the bus must be
 // used by that thread only and must outlive the service.
 #pragma once
@@ -45,6 +51,7 @@
 
 #include "common/clock.h"
 #include "common/lcm_bus.h"
+#include "common/state_file.h"
 #include "replay/pixel_table.h"
 #include "replay/rate_limiter.h"
 #include "replay/replay_table.h"
@@ -153,6 +160,25 @@ class ReplayService {
   /// Last value of insert_allowed published on RL_FLOW.
   bool insert_allowed() const { return insert_allowed_; }
 
+  /// The state file kind of a replay snapshot.
+  static constexpr const char* kSnapshotKind = "replay snapshot";
+  /// Adds the service's whole state to `out` (a StateStream of kSnapshotKind), referring to the
+  /// tables' arrays: nothing may change until the snapshot is written (a fork()ed child writes a
+  /// copy-on-write image). Returns a one-line summary ("size N, inserts N, samples N"). O(actors)
+  /// and a copy of the generator's state (about 6 KB); the arrays are not copied.
+  std::string SaveSnapshot(StateStream* out) const;
+  /// Loads a snapshot into this service, which must be fresh (nothing inserted, sampled or
+  /// requested: std::logic_error otherwise). Throws std::runtime_error saying why the snapshot is
+  /// refused: not a replay snapshot (bad magic, another kind), torn or corrupted (checksum), of
+  /// another run id, of another table (flat or pixels, capacity, frame capacity, shapes,
+  /// uniform or prioritized, alpha, epsilon), or with contents that are not a replay's. Never
+  /// crashes on any bytes; allocates only what the configuration and lengths checked against
+  /// it call for. A service whose restore threw must be discarded. Returns the summary.
+  std::string RestoreSnapshot(std::string_view bytes);
+  /// Maps the file at `path` and restores it; errors are "state <path> refused: <why>" (or
+  /// "cannot read state <path>: <why>").
+  std::string LoadSnapshot(const std::string& path);
+
  private:
   struct PendingRequest {
     std::string requester;
@@ -167,6 +193,10 @@ class ReplayService {
   void OnSampleRequest(const rlmsg::sample_request_t& m);
   void OnPriorities(const rlmsg::priority_update_t& m);
   std::unique_ptr<Sampler> MakeSampler() const;
+  std::unique_ptr<PixelTable> MakePixelTable() const;
+  void CheckFresh() const;
+  void Restore(const StateView& in);
+  std::string Summary() const;
   // Draws and publishes the reply to one request.
   void Answer(const PendingRequest& request);
   // Why a request can never be answered, or nullptr.

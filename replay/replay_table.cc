@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "common/check.h"
+#include "common/state_file.h"
 #include "replay/priorities.h"
 #include "replay/uniform_sampler.h"
 
@@ -152,6 +153,82 @@ int64_t ReplayTable::UpdatePriorities(std::span<const int64_t> index,
                                       std::span<const float> priority) {
   return ApplyPriorities(index, priority, columns_.insert_numbers(), total_inserts_,
                          sampler_.get());
+}
+
+void ReplayTable::Save(const std::string& prefix, StateStream* out) const {
+  // An unallocated table (nothing inserted yet) has shape 0 whatever was configured.
+  const int64_t shape[] = {options_.capacity, columns_.allocated() ? obs_size_ : 0,
+                           columns_.action_width()};
+  const int64_t counts[] = {size_, total_inserts_, total_samples_};
+  out->PutInts(prefix + "shape", shape);
+  out->PutInts(prefix + "counts", counts);
+  out->AddFloats(prefix + "obs", obs_);
+  out->AddFloats(prefix + "next_obs", next_obs_);
+  columns_.Save(prefix, out);
+  sampler_->Save(prefix + "sampler.", out);
+}
+
+void ReplayTable::Restore(const std::string& prefix, const StateView& in) {
+  int64_t shape[3] = {};
+  int64_t counts[3] = {};
+  in.Copy<int64_t>(prefix + "shape", shape);
+  in.Copy<int64_t>(prefix + "counts", counts);
+  const int64_t capacity = shape[0];
+  const int64_t obs_size = shape[1];
+  const int64_t width = shape[2];
+  const auto refuse = [](const std::string& why) { throw std::runtime_error(why); };
+  if (capacity != options_.capacity) {
+    refuse("the snapshot's table has capacity " + std::to_string(capacity) + ", this replay's " +
+           std::to_string(options_.capacity));
+  }
+  if (obs_size < 0 || obs_size > kMaxObsSize || width < 0 ||
+      width > TransitionColumns::kMaxActionWidth || (obs_size == 0) != (width == 0)) {
+    refuse("the snapshot's table has a bad shape");
+  }
+  if (width > 0 && ((options_.obs_size > 0 && obs_size != options_.obs_size) ||
+                    (options_.action_width > 0 && width != options_.action_width))) {
+    refuse("the snapshot's transitions have obs_size " + std::to_string(obs_size) +
+           " and action width " + std::to_string(width) + ", this replay's " +
+           std::to_string(options_.obs_size) + " and " + std::to_string(options_.action_width));
+  }
+  const int64_t size = counts[0];
+  const int64_t inserts = counts[1];
+  const int64_t samples = counts[2];
+  // (Counts stay far from overflow: 2^62 is ages of any run.)
+  constexpr int64_t kMaxCount = int64_t{1} << 62;
+  if (inserts < 0 || samples < 0 || inserts > kMaxCount || samples > kMaxCount ||
+      size != std::min(inserts, capacity) || (width == 0 && inserts > 0)) {
+    refuse("the snapshot's table counters are inconsistent");
+  }
+
+  // The arrays, sized from the configuration and the shape once the file is known to hold them.
+  const int64_t floats = in.Count<float>(prefix + "obs");
+  if (obs_size == 0 ? floats != 0 : floats % obs_size != 0 || floats / obs_size != capacity) {
+    refuse("section '" + prefix + "obs' does not hold capacity * obs_size floats");
+  }
+  if (width > 0) {
+    Allocate(static_cast<int>(obs_size), static_cast<int>(width));
+  } else {
+    obs_.clear();
+    next_obs_.clear();
+    obs_size_ = options_.obs_size;
+  }
+  in.Copy<float>(prefix + "obs", obs_);
+  in.Copy<float>(prefix + "next_obs", next_obs_);
+  columns_.Restore(prefix, in, capacity, static_cast<int>(width));
+  size_ = size;
+  total_inserts_ = inserts;
+  total_samples_ = samples;
+
+  // Slot s holds the newest insert number n < total_inserts with n % capacity == s.
+  std::vector<int64_t> numbers(static_cast<size_t>(capacity), -1);
+  for (int64_t slot = 0; slot < size; ++slot) {
+    numbers[static_cast<size_t>(slot)] = slot + (inserts - 1 - slot) / capacity * capacity;
+  }
+  if (width > 0 && columns_.insert_numbers() != numbers) {
+    refuse("the snapshot's insert numbers are not a table's");
+  }
+  sampler_->Restore(prefix + "sampler.", in, numbers);
 }
 
 int64_t ReplayTable::memory_bytes() const {

@@ -20,6 +20,7 @@
 #include <memory>
 #include <random>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "replay/sampler.h"
@@ -138,6 +139,18 @@ class ReplayTable {
   int64_t memory_bytes() const;
   /// The sampler, for inspection (probabilities, size).
   const Sampler& sampler() const { return *sampler_; }
+
+  /// Adds the table (shape, counters, every slot, the sampler's state) to a snapshot as sections
+  /// prefix + "...", referring to its arrays: the table must not change until the snapshot is
+  /// written (a fork()ed child writes a copy-on-write image of it). O(1) besides the section
+  /// entries.
+  void Save(const std::string& prefix, StateStream* out) const;
+  /// Replaces the table's contents by a snapshot's. Throws std::runtime_error saying why it is
+  /// refused: another capacity, an obs_size or action width other than the configured ones, or
+  /// contents that are not a table's (counters, insert numbers or sampler state inconsistent).
+  /// A table whose Restore threw must not be used further. O(capacity * obs_size); allocates
+  /// what the configured capacity and the snapshot's checked shape need.
+  void Restore(const std::string& prefix, const StateView& in);
 
  private:
   void Allocate(int obs_size, int action_width);

@@ -13,6 +13,12 @@
 #include <cstdint>
 #include <random>
 #include <span>
+#include <string>
+
+namespace rl {
+class StateStream;
+class StateView;
+}  // namespace rl
 
 namespace rl::replay {
 
@@ -62,6 +68,18 @@ class Sampler {
 
   /// Bytes of memory held (the capacities of its arrays).
   virtual int64_t memory_bytes() const = 0;
+
+  /// Adds the sampler's state to a snapshot, as sections named `prefix` + "...": its kind and
+  /// parameters are copied, its per-slot arrays referred to (they must stay unchanged until the
+  /// snapshot is written). O(1) besides the section entries.
+  virtual void Save(const std::string& prefix, StateStream* out) const = 0;
+  /// Replaces the sampler's state by the one Save() wrote, for a table whose slot s holds a
+  /// transition exactly when insert_number[s] >= 0 (one entry per slot). Throws
+  /// std::runtime_error naming the section when the snapshot's sampler is of another kind or
+  /// parameters, or inconsistent with the table (a slot drawable that holds nothing, or the
+  /// other way round, a slot out of range or twice). O(capacity); allocates O(capacity) at most.
+  virtual void Restore(const std::string& prefix, const StateView& in,
+                       std::span<const int64_t> insert_number) = 0;
 };
 
 /// Importance-sampling weight of a draw made with probability `probability` (Schaul et al.

@@ -69,6 +69,27 @@ int64_t SumTree::Find(double mass) const {
   return static_cast<int64_t>(node - leaves);
 }
 
+std::span<const double> SumTree::leaves() const {
+  return {sum_.data() + leaves_, static_cast<size_t>(capacity_)};
+}
+
+void SumTree::Assign(std::span<const double> values) {
+  RL_CHECK(static_cast<int64_t>(values.size()) == capacity_)
+      << "Assign() needs " << capacity_ << " values, got " << values.size();
+  const auto first = static_cast<size_t>(leaves_);
+  for (size_t i = 0; i < values.size(); ++i) {
+    RL_CHECK(std::isfinite(values[i]) && values[i] >= 0.0)
+        << "leaf value must be finite and >= 0, got " << values[i];
+    sum_[first + i] = values[i];
+    min_[first + i] = values[i] > 0.0 ? values[i] : kInfinity;
+  }
+  // Every parent from its two children, deepest first (as Set() computes each of them).
+  for (size_t node = first - 1; node >= 1; --node) {
+    sum_[node] = sum_[2 * node] + sum_[2 * node + 1];
+    min_[node] = std::min(min_[2 * node], min_[2 * node + 1]);
+  }
+}
+
 int64_t SumTree::memory_bytes() const {
   return static_cast<int64_t>((sum_.capacity() + min_.capacity()) * sizeof(double));
 }

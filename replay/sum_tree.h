@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace rl::replay {
@@ -39,6 +40,12 @@ class SumTree {
   /// Total() (a rounding error of the caller's) gives the last non-zero leaf, a negative one the
   /// first. Must not be called while Total() == 0. O(log N).
   int64_t Find(double mass) const;
+
+  /// The capacity() leaf values, in leaf order (for snapshots). O(1).
+  std::span<const double> leaves() const;
+  /// Sets every leaf at once (values finite and >= 0; anything else is a caller bug and aborts),
+  /// rebuilding the tree bottom-up: the same tree as Set() of each leaf gives. O(N).
+  void Assign(std::span<const double> values);
 
   int64_t capacity() const { return capacity_; }
   /// Bytes held by the two arrays.

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "common/state_file.h"
+
 namespace rl::replay {
 
 const char* TransitionColumns::Check(const ColumnsView& view, size_t count, int table_width) {
@@ -65,6 +67,29 @@ int64_t TransitionColumns::memory_bytes() const {
       (action_.capacity() + reward_.capacity() + discount_.capacity()) * sizeof(float) +
       (episode_id_.capacity() + insert_number_.capacity()) * sizeof(int64_t);
   return static_cast<int64_t>(bytes);
+}
+
+void TransitionColumns::Save(const std::string& prefix, StateStream* out) const {
+  out->AddFloats(prefix + "action", action_);
+  out->AddFloats(prefix + "reward", reward_);
+  out->AddFloats(prefix + "discount", discount_);
+  out->AddInts(prefix + "episode_id", episode_id_);
+  out->AddInts(prefix + "insert_number", insert_number_);
+}
+
+void TransitionColumns::Restore(const std::string& prefix, const StateView& in, int64_t slots,
+                                int action_width) {
+  if (action_width == 0) {
+    *this = TransitionColumns();
+    slots = 0;
+  } else {
+    Allocate(slots, action_width);
+  }
+  in.Copy<float>(prefix + "action", action_);
+  in.Copy<float>(prefix + "reward", reward_);
+  in.Copy<float>(prefix + "discount", discount_);
+  in.Copy<int64_t>(prefix + "episode_id", episode_id_);
+  in.Copy<int64_t>(prefix + "insert_number", insert_number_);
 }
 
 }  // namespace rl::replay

@@ -9,7 +9,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
+
+namespace rl {
+class StateStream;
+class StateView;
+}  // namespace rl
 
 namespace rl::replay {
 
@@ -63,6 +69,15 @@ class TransitionColumns {
   const std::vector<int64_t>& insert_numbers() const { return insert_number_; }
 
   int64_t memory_bytes() const;
+
+  /// Adds the columns to a snapshot as sections prefix + "action", "reward", "discount",
+  /// "episode_id", "insert_number", referring to them (they must stay unchanged until the
+  /// snapshot is written). Empty sections when not allocated.
+  void Save(const std::string& prefix, StateStream* out) const;
+  /// Allocates `slots` slots of `action_width` floats (0: none, the columns stay unallocated
+  /// and the sections must be empty) and fills them from a snapshot. Throws std::runtime_error
+  /// naming a section of another length; the values themselves are the table's to check.
+  void Restore(const std::string& prefix, const StateView& in, int64_t slots, int action_width);
 
  private:
   int action_width_ = 0;

@@ -1,8 +1,11 @@
 #include "replay/uniform_sampler.h"
 
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "common/check.h"
+#include "common/state_file.h"
 
 namespace rl::replay {
 
@@ -61,6 +64,46 @@ double UniformSampler::MinProbability() const {
 
 int64_t UniformSampler::memory_bytes() const {
   return static_cast<int64_t>((position_.capacity() + slots_.capacity()) * sizeof(int64_t));
+}
+
+}  // namespace rl::replay
+
+namespace rl::replay {
+
+void UniformSampler::Save(const std::string& prefix, StateStream* out) const {
+  out->PutText(prefix + "kind", "uniform");
+  out->AddInts(prefix + "slots", slots_);
+}
+
+void UniformSampler::Restore(const std::string& prefix, const StateView& in,
+                             std::span<const int64_t> insert_number) {
+  const auto capacity = static_cast<int64_t>(position_.size());
+  RL_CHECK(static_cast<int64_t>(insert_number.size()) == capacity)
+      << "insert_number must have one entry per slot";
+  const std::string kind = in.Text(prefix + "kind");
+  if (kind != "uniform") {
+    throw std::runtime_error("the snapshot's sampler is " + kind + ", this replay's uniform");
+  }
+  const std::vector<int64_t> slots = in.Ints(prefix + "slots", capacity);
+  // Every stored slot exactly once, and nothing else.
+  std::vector<int64_t> position(static_cast<size_t>(capacity), -1);
+  for (size_t i = 0; i < slots.size(); ++i) {
+    const int64_t slot = slots[i];
+    if (slot < 0 || slot >= capacity || position[static_cast<size_t>(slot)] >= 0 ||
+        insert_number[static_cast<size_t>(slot)] < 0) {
+      throw std::runtime_error("section '" + prefix +
+                               "slots' names a slot out of range, twice, or without a transition");
+    }
+    position[static_cast<size_t>(slot)] = static_cast<int64_t>(i);
+  }
+  for (int64_t slot = 0; slot < capacity; ++slot) {
+    if (insert_number[static_cast<size_t>(slot)] >= 0 && position[static_cast<size_t>(slot)] < 0) {
+      throw std::runtime_error("section '" + prefix + "slots' misses a slot with a transition");
+    }
+  }
+  position_ = std::move(position);
+  slots_.assign(slots.begin(), slots.end());
+  slots_.reserve(static_cast<size_t>(capacity));
 }
 
 }  // namespace rl::replay

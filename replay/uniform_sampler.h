@@ -29,6 +29,10 @@ class UniformSampler final : public Sampler {
   double MinProbability() const override;
   int64_t size() const override { return static_cast<int64_t>(slots_.size()); }
   int64_t memory_bytes() const override;
+  /// The stored slots in their order (so that a restored sampler draws the same slots).
+  void Save(const std::string& prefix, StateStream* out) const override;
+  void Restore(const std::string& prefix, const StateView& in,
+               std::span<const int64_t> insert_number) override;
 
  private:
   void CheckSlot(int64_t slot) const;

@@ -96,14 +96,15 @@ TEST_F(ActorTest, PausesAtItsShareOfTheInsertCredit) {
   bus_.Publish(channels::kFlow, &f);
   bus_.Handle(0);
   EXPECT_EQ(actor.insert_limit(), 48 + 4);
-  // A message that does not name this actor: all it published is on the way.
+  // A message that no longer names this actor: a replay restarted empty. What the actor
+  // published until then is lost, not on the way.
   f.num_actors = 1;
   f.actor_id = {0};
   f.actor_inserts = {500};
   f.insert_credit = 200;
   bus_.Publish(channels::kFlow, &f);
   bus_.Handle(0);
-  EXPECT_EQ(actor.insert_limit(), 100);
+  EXPECT_EQ(actor.insert_limit(), 48 + 100);
   // No credit without insert_allowed; no limit when the ratio is not enforced.
   f.insert_allowed = 0;
   bus_.Publish(channels::kFlow, &f);
@@ -114,6 +115,38 @@ TEST_F(ActorTest, PausesAtItsShareOfTheInsertCredit) {
   bus_.Publish(channels::kFlow, &f);
   bus_.Handle(0);
   EXPECT_FALSE(actor.paused());
+}
+
+// A replay restarted from its snapshot has stored fewer of this actor's transitions than the
+// one before it: the difference is lost, and the actor does not wait for it forever.
+TEST_F(ActorTest, GoesOnAfterTheReplayRestartsFromASnapshot) {
+  Actor actor(config_, &bus_);
+  rlmsg::flow_control_t f{};
+  f.insert_allowed = 1;
+  f.insert_credit = 1000;
+  f.num_actors = 1;
+  f.actor_id = {0};
+  f.actor_inserts = {0};
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  while (actor.published() < 320) actor.StepEnvs();
+  f.insert_credit = 10;  // nearly spent, 300 stored: 20 on the way
+  f.actor_inserts = {300};
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  EXPECT_TRUE(actor.paused());
+  // The restarted replay holds 200 (its snapshot's) and has credit again.
+  f.insert_credit = 100;
+  f.actor_inserts = {200};
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  EXPECT_EQ(actor.insert_limit(), 320 + 100);
+  EXPECT_FALSE(actor.paused());
+  // Transitions that were on the way arrive: nothing of its own counts twice.
+  f.actor_inserts = {216};
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  EXPECT_EQ(actor.insert_limit(), actor.published() + 100);
 }
 
 TEST_F(ActorTest, SwitchesToACompleteWeightsVersionAndActsGreedily) {

@@ -163,5 +163,27 @@ TEST(SumTreeDeathTest, AbortsOnABadLeafOrValue) {
   EXPECT_DEATH(tree.Find(0.0), "all 0");
 }
 
+TEST(SumTreeTest, AssignBuildsTheTreeThatSetGives) {
+  for (int64_t capacity : {1, 2, 5, 64, 1000}) {
+    std::mt19937_64 rng(static_cast<uint64_t>(capacity));
+    std::uniform_real_distribution<double> value(0.0, 3.0);
+    std::vector<double> leaves(static_cast<size_t>(capacity));
+    SumTree by_set(capacity);
+    for (int64_t i = 0; i < capacity; ++i) {
+      leaves[static_cast<size_t>(i)] = i % 3 == 0 ? 0.0 : value(rng);
+      by_set.Set(i, leaves[static_cast<size_t>(i)]);
+    }
+    SumTree assigned(capacity);
+    assigned.Set(0, 9.0);  // replaced
+    assigned.Assign(leaves);
+    EXPECT_EQ(assigned.Total(), by_set.Total()) << capacity;
+    EXPECT_EQ(assigned.Min(), by_set.Min()) << capacity;
+    EXPECT_EQ(std::vector<double>(assigned.leaves().begin(), assigned.leaves().end()), leaves);
+    for (double mass = 0.0; mass < by_set.Total(); mass += by_set.Total() / 37) {
+      EXPECT_EQ(assigned.Find(mass), by_set.Find(mass)) << capacity << " " << mass;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rl::replay
