@@ -3,6 +3,7 @@
 #include <poll.h>
 
 #include <cstdio>
+#include <limits>
 #include <stdexcept>
 
 namespace rl {
@@ -69,6 +70,11 @@ bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header
       return false;
     }
   }
+  if (header.seq < 0 || header.incarnation < 0) {
+    ++counters_.invalid;
+    LogDrop(channel, "invalid", "a negative sequence number or incarnation");
+    return false;
+  }
   // Only what comes after what we heard from this incarnation is fresh; a newer incarnation is
   // the sender restarted, and its sequence starts again.
   auto [it, inserted] =
@@ -86,7 +92,12 @@ bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header
                                                   : "a sequence number already passed");
     return false;
   }
-  counters_.lost += header.seq - last.seq - 1;
+  // Both are >= 0, so the gap cannot overflow; the sum saturates (a gap of 2^62 is a forgery by a
+  // holder of the key, or on a bus without one).
+  const int64_t gap = header.seq - last.seq - 1;
+  counters_.lost = gap > std::numeric_limits<int64_t>::max() - counters_.lost
+                       ? std::numeric_limits<int64_t>::max()
+                       : counters_.lost + gap;
   last.seq = header.seq;
   return true;
 }

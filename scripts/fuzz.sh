@@ -65,6 +65,10 @@ bin="$build_dir/bin"
 if [ "$seeds" -eq 1 ]; then
   # Messages, state files, checkpoints: written by the project's own encoders.
   "$bin/fuzz_seeds" fuzz/corpus
+  # The bus target reads the messages target's inputs.
+  mkdir -p fuzz/corpus/bus
+  find fuzz/corpus/bus -type f ! -name 'repro-*' -delete
+  find fuzz/corpus/messages -type f ! -name 'repro-*' -exec cp {} fuzz/corpus/bus/ \;
   # Presets as they are, and every env id they name.
   mkdir -p fuzz/corpus/config fuzz/corpus/env_id
   find fuzz/corpus/config fuzz/corpus/env_id -type f ! -name 'repro-*' -delete

@@ -252,6 +252,18 @@ TEST_F(KeyedBusTest, ARestartedSenderStartsItsSequenceAgainAndItsOldSelfIsReplay
   EXPECT_EQ(stats.lost, 8);
 }
 
+TEST_F(KeyedBusTest, AForgedHugeGapSaturatesLostAndANegativeSequenceIsInvalid) {
+  Send(Stamped(5, 0, kKey));
+  Send(Stamped(5, std::numeric_limits<int64_t>::max(), kKey));
+  Send(Stamped(6, 0, kKey));
+  Send(Stamped(6, std::numeric_limits<int64_t>::max(), kKey));  // the sum would overflow
+  EXPECT_EQ(bus_.counters().lost, std::numeric_limits<int64_t>::max());
+  Send(Stamped(7, -3, kKey));
+  Send(Stamped(-1, 4, kKey));
+  EXPECT_EQ(bus_.counters().invalid, 2);
+  EXPECT_EQ(got_.size(), 4U);
+}
+
 TEST(BusKeyTest, AnUnkeyedBusAlsoDropsReplayedMessages) {
   Bus bus(MemqConfig(42, "replay"));
   int got = 0;
