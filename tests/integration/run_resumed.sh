@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A run stopped with a signal (as Ctrl-C stops it) and continued with `launch.sh --resume`: the
-# same folder, run id and config; the learner resumes from its saved state; update counts, env
-# steps and the evaluation history carry on; and the resumed run reaches the CartPole goal.
+# same folder, run id and config; the learner resumes from its saved state and the replay from
+# its snapshot; update counts, env steps and the evaluation history carry on; and the resumed run
+# reaches the CartPole goal.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
@@ -39,6 +40,11 @@ resumed=$(sed -n 's/.*resumed at update \([0-9]*\).*/\1/p' "$dir/run/logs/learne
 [ "$(wc -l < "$dir/run/eval.jsonl")" -gt "$evals_before" ] || fail "no new evaluation"
 head -n "$evals_before" "$dir/run/eval.jsonl" | tail -1 | grep -q "\"update\": $last_update_before," ||
   fail "the earlier evaluations were not kept"
+# The replay wrote its last snapshot when it stopped, and the resumed one started from it.
+grep -q "^replay: last snapshot written to $dir/run/replay-snapshot.bin (size [1-9]" "$dir/run/logs/replay.log" ||
+  fail "the stopped replay wrote no last snapshot"
+grep -q "^replay: snapshot $dir/run/replay-snapshot.bin loaded (size [1-9]" "$dir/run/logs/replay.log" ||
+  fail "the resumed replay did not load its snapshot"
 awk -F'"update": ' '{split($2, a, ","); u = a[1] + 0; if (u < prev) { print "update " u " after " prev; exit 1 } prev = u}' \
   "$dir/run/eval.jsonl" || fail "evaluation updates went back"
 awk -F'"env_steps": ' '{split($2, a, ","); s = a[1] + 0; if (s < prev) { print "env steps " s " after " prev; exit 1 } prev = s}' \
