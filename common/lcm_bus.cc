@@ -57,7 +57,7 @@ bool Bus::Sign(uint8_t* data, size_t size, const rlmsg::header_t& header) {
 }
 
 bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header,
-                       const uint8_t* data, size_t size) {
+                       const uint8_t* data, size_t size, Heard* heard) {
   if (header.run_id != config_.run_id) {
     ++counters_.foreign;
     LogDrop(channel, "foreign", "another run's id");
@@ -78,7 +78,7 @@ bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header
   // Only what comes after what we heard from this incarnation is fresh; a newer incarnation is
   // the sender restarted, and its sequence starts again.
   auto [it, inserted] =
-      heard_.try_emplace({channel, header.sender}, SenderPosition{header.incarnation, header.seq});
+      heard->by_sender.try_emplace(header.sender, SenderPosition{header.incarnation, header.seq});
   SenderPosition& last = it->second;
   if (inserted) return true;
   if (header.incarnation > last.incarnation) {
@@ -95,9 +95,11 @@ bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header
   // Both are >= 0, so the gap cannot overflow; the sum saturates (a gap of 2^62 is a forgery by a
   // holder of the key, or on a bus without one).
   const int64_t gap = header.seq - last.seq - 1;
-  counters_.lost = gap > std::numeric_limits<int64_t>::max() - counters_.lost
-                       ? std::numeric_limits<int64_t>::max()
-                       : counters_.lost + gap;
+  if (heard->counts_lost) {
+    counters_.lost = gap > std::numeric_limits<int64_t>::max() - counters_.lost
+                         ? std::numeric_limits<int64_t>::max()
+                         : counters_.lost + gap;
+  }
   last.seq = header.seq;
   return true;
 }

@@ -27,6 +27,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -134,16 +135,23 @@ class Bus {
                     RawSubscription* sub);
   // Signs an encoded message of ours (no-op without a key).
   bool Sign(uint8_t* data, size_t size, const rlmsg::header_t& header);
-  // Checks run id, MAC and freshness of a decoded message; returns false (and counts) when the
-  // message is to be dropped.
-  bool AcceptHeader(const std::string& channel, const rlmsg::header_t& header, const uint8_t* data,
-                    size_t size);
-  void LogDrop(const std::string& channel, const char* kind, const char* reason);
-
   struct SenderPosition {
     int64_t incarnation;
     int64_t seq;
   };
+  // What one subscription has taken from each sender. Each subscription keeps its own, since LCM
+  // hands every message to every subscription of its channel; only the channel's first
+  // subscription counts gaps, so that a channel subscribed twice does not count them twice.
+  struct Heard {
+    bool counts_lost = false;
+    std::map<std::string, SenderPosition> by_sender;
+  };
+
+  // Checks run id, MAC and freshness of a decoded message; returns false (and counts) when the
+  // message is to be dropped.
+  bool AcceptHeader(const std::string& channel, const rlmsg::header_t& header, const uint8_t* data,
+                    size_t size, Heard* heard);
+  void LogDrop(const std::string& channel, const char* kind, const char* reason);
 
   BusConfig config_;
   int64_t incarnation_;
@@ -151,8 +159,8 @@ class Bus {
   std::unique_ptr<lcm::LCM> main_;
   std::unique_ptr<lcm::LCM> bulk_;
   std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
-  std::map<std::string, int64_t> publish_seq_;                           // by channel
-  std::map<std::pair<std::string, std::string>, SenderPosition> heard_;  // by channel, sender
+  std::map<std::string, int64_t> publish_seq_;  // by channel
+  std::set<std::string> subscribed_;            // channels with a subscription
   std::vector<uint8_t> encode_buffer_;
   BusCounters counters_;
   int64_t drops_logged_ = 0;
@@ -177,29 +185,31 @@ template <class Msg>
 void Bus::Subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
                     Port port) {
   auto decoded = std::make_shared<Msg>();
-  SubscribeRaw(
-      channel, port,
-      [this, channel, handler = std::move(handler), decoded](const uint8_t* data, size_t size) {
-        Msg& msg = *decoded;
-        if (const char* why = Decode(data, size, &msg)) {
-          ++counters_.malformed;
-          LogDrop(channel, "malformed", why);
-          return;
-        }
-        if (!AcceptHeader(channel, msg.header, data, size)) return;
-        if (const char* why = Validate(msg)) {
-          ++counters_.invalid;
-          LogDrop(channel, "invalid", why);
-          return;
-        }
-        try {
-          handler(msg);
-          ++counters_.received;
-        } catch (const std::exception& e) {
-          ++counters_.invalid;
-          LogDrop(channel, "invalid", e.what());
-        }
-      });
+  auto heard = std::make_shared<Heard>();
+  heard->counts_lost = subscribed_.insert(channel).second;
+  SubscribeRaw(channel, port,
+               [this, channel, handler = std::move(handler), decoded, heard](const uint8_t* data,
+                                                                             size_t size) {
+                 Msg& msg = *decoded;
+                 if (const char* why = Decode(data, size, &msg)) {
+                   ++counters_.malformed;
+                   LogDrop(channel, "malformed", why);
+                   return;
+                 }
+                 if (!AcceptHeader(channel, msg.header, data, size, heard.get())) return;
+                 if (const char* why = Validate(msg)) {
+                   ++counters_.invalid;
+                   LogDrop(channel, "invalid", why);
+                   return;
+                 }
+                 try {
+                   handler(msg);
+                   ++counters_.received;
+                 } catch (const std::exception& e) {
+                   ++counters_.invalid;
+                   LogDrop(channel, "invalid", e.what());
+                 }
+               });
 }
 
 }  // namespace rl

@@ -264,6 +264,17 @@ TEST_F(KeyedBusTest, AForgedHugeGapSaturatesLostAndANegativeSequenceIsInvalid) {
   EXPECT_EQ(got_.size(), 4U);
 }
 
+TEST_F(KeyedBusTest, TwoSubscriptionsOfAChannelEachGetEveryFreshMessageAndCountGapsOnce) {
+  std::vector<int64_t> second;
+  bus_.Subscribe<rlmsg::transition_batch_t>(
+      channels::kTransitions,
+      [&second](const rlmsg::transition_batch_t& m) { second.push_back(m.header.seq); });
+  for (int64_t seq : {0, 1, 4, 4}) Send(Stamped(5, seq, kKey));
+  EXPECT_EQ(got_.size(), 3U);
+  EXPECT_EQ(second, (std::vector<int64_t>{0, 1, 4}));
+  EXPECT_EQ(bus_.counters().lost, 2);
+}
+
 TEST(BusKeyTest, AnUnkeyedBusAlsoDropsReplayedMessages) {
   Bus bus(MemqConfig(42, "replay"));
   int got = 0;

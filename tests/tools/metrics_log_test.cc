@@ -32,10 +32,11 @@ TEST(MetricsLineTest, WritesOneJsonObjectPerRoleWithTheStatsFields) {
   learner.mean_q = std::numeric_limits<double>::quiet_NaN();
   learner.lost = 2;
   learner.dropped_invalid = 3;
+  learner.dropped_replayed = 4;  // counted in "dropped" and on its own
   EXPECT_EQ(MetricsLine(12.5, learner),
             "{\"t\": 12.500, \"role\": \"learner\", \"updates\": 5000, \"updates_per_second\": 0, "
             "\"loss\": 0.25, \"mean_q\": null, \"env_steps\": 0, \"weights_version\": 0, "
-            "\"lost\": 2, \"dropped\": 3}\n");
+            "\"lost\": 2, \"dropped\": 7, \"replayed\": 4, \"unauthenticated\": 0}\n");
   rlmsg::stats_actor_t actor{};
   actor.header.sender = "actor-3";
   actor.env_steps = 1234567;
