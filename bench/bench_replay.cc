@@ -31,6 +31,7 @@
 //   pixel_replay_insert_mac   pixel_replay_insert with the run's key on both sides (the actor
 //                             signs, the replay checks), on two more ports: compare its rate and
 //                             replay_cpu_us_per_transition with pixel_replay_insert's.
+//   pixel_replay_8_actors_4x_mac  pixel_replay_8_actors_4x with the key.
 //
 // Snapshots (replay/snapshotter.h: fork, then the child writes), of a CarRacing-size pixel table
 // (capacity 100,000, frame capacity 130,000 of 84 x 84, prioritized; about 1 GB) and of a
@@ -560,7 +561,7 @@ void PixelActors(rl::Bus* bus, const ServiceProbe& probe, int port, int multipli
   for (int a = 0; a < kActors; ++a) {
     const int32_t id = first_actor_id + a;
     actors.emplace_back([&, id] {
-      rl::Bus actor_bus(Config(port, "actor-" + std::to_string(id)));
+      rl::Bus actor_bus(Config(port, "actor-" + std::to_string(id), bus->config().key));
       actor_bus.Subscribe<rlmsg::flow_control_t>(
           rl::channels::kFlow, [&](const rlmsg::flow_control_t&) { ++flow_messages; });
       PixelActorSim sim(id, 1000 + static_cast<uint64_t>(id));
@@ -604,7 +605,8 @@ void PixelActors(rl::Bus* bus, const ServiceProbe& probe, int port, int multipli
   if (multiplier == 1) {
     std::snprintf(name, sizeof(name), "pixel_replay_8_actors");
   } else {
-    std::snprintf(name, sizeof(name), "pixel_replay_8_actors_%dx", multiplier);
+    std::snprintf(name, sizeof(name), "pixel_replay_8_actors_%dx%s", multiplier,
+                  bus->config().key.empty() ? "" : "_mac");
   }
   const double offered = rate * kActors;
   char extra[1024];
@@ -652,6 +654,7 @@ int RunPixelLcm(int repeats, double seconds, int port, const std::string& key = 
     stop();
     return 1;
   }
+  if (!key.empty()) PixelActors(&bus, probe, port, 4, std::max(repeats, 3), seconds, 300);
   if (!key.empty() || insert_only) {
     stop();
     return 0;
