@@ -169,13 +169,14 @@ StateFile StateFile::FromView(const StateView& view) {
   StateFile state(view.kind());
   // Every section, in the view's (name) order; the view has checked lengths and types.
   for (const auto& [name, s] : view.sections_) {
+    // Copy() handles empty sections (an empty vector's data() may be null, never memcpy's).
     if (s.type == kFloats) {
       std::vector<float> v(s.data.size() / sizeof(float));
-      std::memcpy(v.data(), s.data.data(), s.data.size());
+      view.Copy<float>(name, v);
       state.PutFloats(name, v);
     } else if (s.type == kInts) {
       std::vector<int64_t> v(s.data.size() / sizeof(int64_t));
-      std::memcpy(v.data(), s.data.data(), s.data.size());
+      view.Copy<int64_t>(name, v);
       state.PutInts(name, v);
     } else if (s.type == kText) {
       state.PutText(name, s.data);

@@ -50,6 +50,18 @@ TEST(StateFileTest, RoundTripsEverySectionThroughAFile) {
   EXPECT_FALSE(s.Has("other"));
 }
 
+// Found by fuzz_state_file: parsing an empty section copied from a null vector (UB under UBSan).
+TEST(StateFileTest, RoundTripsEmptySections) {
+  StateFile s("learner td3");
+  s.PutFloats("none", std::span<const float>());
+  s.PutInts("no_ints", std::span<const int64_t>());
+  const StateFile back = StateFile::Parse(s.Serialize(), "learner td3");
+  EXPECT_TRUE(back.Has("none"));
+  EXPECT_TRUE(back.Floats("none").empty());
+  EXPECT_TRUE(back.Has("no_ints"));
+  EXPECT_TRUE(back.Ints("no_ints").empty());
+}
+
 TEST(StateFileTest, RefusesTornCorruptedAndForeignFiles) {
   const std::string bytes = Sample().Serialize();
   EXPECT_NO_THROW(StateFile::Parse(bytes, "learner td3"));
