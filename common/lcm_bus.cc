@@ -2,6 +2,8 @@
 
 #include <poll.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
@@ -24,7 +26,22 @@ bool ShouldLog(int64_t n) { return n < 10 || n % 1000 == 0; }
 
 }  // namespace
 
-Bus::Bus(BusConfig config) : config_(std::move(config)), incarnation_(WallMicros()) {
+namespace {
+
+// A start time in microseconds later than every earlier Bus's of this process.
+int64_t NewIncarnation() {
+  static std::atomic<int64_t> last{0};
+  int64_t previous = last.load();
+  int64_t next = 0;
+  do {
+    next = std::max(WallMicros(), previous + 1);
+  } while (!last.compare_exchange_weak(previous, next));
+  return next;
+}
+
+}  // namespace
+
+Bus::Bus(BusConfig config) : config_(std::move(config)), incarnation_(NewIncarnation()) {
   if (!config_.key.empty()) auth_ = std::make_unique<MessageAuthenticator>(config_.key);
   main_ = OpenLcm(config_.url);
   bulk_ = OpenLcm(config_.bulk_url);
@@ -52,8 +69,9 @@ void Bus::OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/,
   }
 }
 
-bool Bus::Sign(uint8_t* data, size_t size, const rlmsg::header_t& header) {
-  return auth_ == nullptr || auth_->Sign(data, size, MacOffset(header.sender.size()));
+bool Bus::Sign(const std::string& channel, uint8_t* data, size_t size,
+               const rlmsg::header_t& header) {
+  return auth_ == nullptr || auth_->Sign(channel, data, size, MacOffset(header.sender.size()));
 }
 
 bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header,
@@ -64,7 +82,7 @@ bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header
     return false;
   }
   if (auth_ != nullptr) {
-    if (const char* why = auth_->Verify(data, size, MacOffset(header.sender.size()))) {
+    if (const char* why = auth_->Verify(channel, data, size, MacOffset(header.sender.size()))) {
       ++counters_.unauthenticated;
       LogDrop(channel, "unauthenticated", why);
       return false;

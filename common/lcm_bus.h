@@ -107,7 +107,8 @@ class Bus {
 
   const BusCounters& counters() const { return counters_; }
   const BusConfig& config() const { return config_; }
-  // This bus's incarnation: when it started, in microseconds since the Unix epoch.
+  // This bus's incarnation: when it started, in microseconds since the Unix epoch, and later than
+  // any other Bus of this process (the MAC's nonces rely on it: common/message_auth.h).
   int64_t incarnation() const { return incarnation_; }
 
   // Copies the counters into a stats message's dropped_* and lost fields.
@@ -133,8 +134,8 @@ class Bus {
                     std::function<void(const uint8_t*, size_t)> on_bytes);
   static void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                     RawSubscription* sub);
-  // Signs an encoded message of ours (no-op without a key).
-  bool Sign(uint8_t* data, size_t size, const rlmsg::header_t& header);
+  // Signs an encoded message of ours published on `channel` (no-op without a key).
+  bool Sign(const std::string& channel, uint8_t* data, size_t size, const rlmsg::header_t& header);
   struct SenderPosition {
     int64_t incarnation;
     int64_t seq;
@@ -177,7 +178,7 @@ bool Bus::Publish(const std::string& channel, Msg* msg, Port port) {
   const int size = msg->getEncodedSize();
   encode_buffer_.resize(static_cast<size_t>(size));
   if (msg->encode(encode_buffer_.data(), 0, size) != size) return false;
-  if (!Sign(encode_buffer_.data(), encode_buffer_.size(), msg->header)) return false;
+  if (!Sign(channel, encode_buffer_.data(), encode_buffer_.size(), msg->header)) return false;
   return lcm(port).publish(channel, encode_buffer_.data(), static_cast<unsigned>(size)) == 0;
 }
 

@@ -1,15 +1,15 @@
 #include "common/message_auth.h"
 
 #include <fcntl.h>
-#include <openssl/core_names.h>
 #include <openssl/crypto.h>
 #include <openssl/evp.h>
-#include <openssl/params.h>
+#include <openssl/hmac.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 namespace rl {
@@ -46,61 +46,159 @@ std::string ReadKeyFile(const std::string& path) {
   return key;
 }
 
-MessageAuthenticator::MessageAuthenticator(const std::string& key) : key_(key) {
+namespace {
+
+constexpr char kLabel[] = "rl-gmac-v1";
+
+int64_t ReadBigEndian64(const uint8_t* p) {
+  uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
+  return static_cast<int64_t>(v);
+}
+
+// The header fields before the MAC (MacOffset()): sender at 20, then seq, utime, incarnation.
+size_t SenderLength(size_t mac_offset) { return mac_offset - MacOffset(0); }
+const uint8_t* Sender(const uint8_t* data) { return data + 20; }
+const uint8_t* Seq(const uint8_t* data, size_t mac_offset) { return data + mac_offset - 24; }
+const uint8_t* Incarnation(const uint8_t* data, size_t mac_offset) { return data + mac_offset - 8; }
+
+bool HasRoom(size_t size, size_t mac_offset) {
+  return mac_offset >= MacOffset(0) && mac_offset <= size && size - mac_offset >= kMacBytes &&
+         size <= static_cast<size_t>(std::numeric_limits<int>::max());
+}
+
+// Appends a length-prefixed field, so that no two (channel, sender) pairs read alike.
+void AppendField(std::string* out, const void* data, size_t size) {
+  const uint32_t n = static_cast<uint32_t>(size);
+  out->append(reinterpret_cast<const char*>(&n), sizeof(n));
+  out->append(static_cast<const char*>(data), size);
+}
+
+}  // namespace
+
+void MessageAuthenticator::CipherFree::operator()(evp_cipher_ctx_st* c) const {
+  EVP_CIPHER_CTX_free(c);
+}
+
+MessageAuthenticator::MessageAuthenticator(const std::string& key)
+    : key_(key), scratch_(EVP_CIPHER_CTX_new()) {
   if (key_.size() != kKeyBytes) {
     throw std::invalid_argument("a message key has " + std::to_string(kKeyBytes) + " bytes, not " +
                                 std::to_string(key_.size()));
   }
-  mac_ = EVP_MAC_fetch(nullptr, OSSL_MAC_NAME_HMAC, nullptr);
-  if (mac_ != nullptr) ctx_ = EVP_MAC_CTX_new(mac_);
-  if (ctx_ == nullptr) throw std::runtime_error("OpenSSL provides no HMAC");
-  char digest[] = "SHA256";
-  const OSSL_PARAM params[] = {OSSL_PARAM_construct_utf8_string(OSSL_MAC_PARAM_DIGEST, digest, 0),
-                               OSSL_PARAM_construct_end()};
-  if (EVP_MAC_CTX_set_params(ctx_, params) != 1) {
+  if (scratch_ == nullptr ||
+      EVP_EncryptInit_ex(scratch_.get(), EVP_aes_256_gcm(), nullptr, nullptr, nullptr) != 1) {
+    throw std::runtime_error("OpenSSL provides no AES-256-GCM");
+  }
+  unsigned char probe[32];
+  unsigned int probe_size = 0;
+  if (HMAC(EVP_sha256(), key_.data(), static_cast<int>(key_.size()),
+           reinterpret_cast<const unsigned char*>(kLabel), sizeof(kLabel), probe,
+           &probe_size) == nullptr) {
     throw std::runtime_error("OpenSSL provides no HMAC-SHA256");
   }
 }
 
-MessageAuthenticator::~MessageAuthenticator() {
-  EVP_MAC_CTX_free(ctx_);
-  EVP_MAC_free(mac_);
-}
+MessageAuthenticator::~MessageAuthenticator() = default;
 
-bool MessageAuthenticator::Compute(const uint8_t* data, size_t size, size_t mac_offset,
-                                   uint8_t* mac) {
-  static constexpr uint8_t kZero[kMacBytes] = {};
-  uint8_t full[EVP_MAX_MD_SIZE];
-  size_t full_size = 0;
-  const size_t tail = mac_offset + kMacBytes;
-  const auto* key = reinterpret_cast<const unsigned char*>(key_.data());
-  if (EVP_MAC_init(ctx_, key, key_.size(), nullptr) != 1 ||
-      EVP_MAC_update(ctx_, data, mac_offset) != 1 || EVP_MAC_update(ctx_, kZero, kMacBytes) != 1 ||
-      EVP_MAC_update(ctx_, data + tail, size - tail) != 1 ||
-      EVP_MAC_final(ctx_, full, &full_size, sizeof(full)) != 1 || full_size < kMacBytes) {
-    return false;
+evp_cipher_ctx_st* MessageAuthenticator::KeyFor(std::string_view channel, const uint8_t* data,
+                                                size_t mac_offset, bool* derived) {
+  lookup_.assign(channel);
+  lookup_.push_back('\0');
+  lookup_.append(reinterpret_cast<const char*>(Sender(data)), SenderLength(mac_offset));
+  const int64_t incarnation = ReadBigEndian64(Incarnation(data, mac_offset));
+  *derived = false;
+  if (auto it = streams_.find(lookup_);
+      it != streams_.end() && it->second.incarnation == incarnation) {
+    return it->second.cipher.get();
   }
-  std::memcpy(mac, full, kMacBytes);
-  return true;
+  // HMAC-SHA256(run key, label | channel | sender | incarnation), each field length-prefixed.
+  std::string info;
+  AppendField(&info, kLabel, sizeof(kLabel) - 1);
+  AppendField(&info, channel.data(), channel.size());
+  AppendField(&info, Sender(data), SenderLength(mac_offset));
+  AppendField(&info, Incarnation(data, mac_offset), 8);
+  unsigned char stream_key[32];
+  unsigned int stream_key_size = 0;
+  if (HMAC(EVP_sha256(), key_.data(), static_cast<int>(key_.size()),
+           reinterpret_cast<const unsigned char*>(info.data()), info.size(), stream_key,
+           &stream_key_size) == nullptr ||
+      stream_key_size != sizeof(stream_key) ||
+      EVP_EncryptInit_ex(scratch_.get(), nullptr, nullptr, stream_key, nullptr) != 1) {
+    OPENSSL_cleanse(stream_key, sizeof(stream_key));
+    return nullptr;
+  }
+  OPENSSL_cleanse(stream_key, sizeof(stream_key));
+  *derived = true;
+  return scratch_.get();
 }
 
-bool MessageAuthenticator::Sign(uint8_t* data, size_t size, size_t mac_offset) {
-  if (mac_offset > size || size - mac_offset < kMacBytes) return false;
+void MessageAuthenticator::Keep(const uint8_t* data, size_t mac_offset) {
+  const int64_t incarnation = ReadBigEndian64(Incarnation(data, mac_offset));
+  auto it = streams_.find(lookup_);
+  if (it == streams_.end()) {
+    if (streams_.size() >= kMaxStreams) return;
+    it = streams_.emplace(lookup_, Stream{}).first;
+  } else if (incarnation < it->second.incarnation) {
+    return;  // an older incarnation (a replayed message, about to be dropped): keep the newer
+  }
+  Cipher fresh(EVP_CIPHER_CTX_new());
+  if (fresh == nullptr ||
+      EVP_EncryptInit_ex(fresh.get(), EVP_aes_256_gcm(), nullptr, nullptr, nullptr) != 1) {
+    if (!it->second.cipher) streams_.erase(it);
+    return;
+  }
+  it->second.incarnation = incarnation;
+  it->second.cipher = std::move(scratch_);
+  scratch_ = std::move(fresh);
+}
+
+bool MessageAuthenticator::Compute(evp_cipher_ctx_st* cipher, const uint8_t* data, size_t size,
+                                   size_t mac_offset, uint8_t* mac) {
+  static constexpr uint8_t kZero[kMacBytes] = {};
+  uint8_t nonce[12] = {};
+  std::memcpy(nonce, Seq(data, mac_offset), 8);
+  const size_t tail = mac_offset + kMacBytes;
+  // AES-GCM with the whole message as associated data (the MAC's bytes as zero), nothing
+  // encrypted: the tag is the GMAC. Setting the nonce restarts the hash, the key stays.
+  int n = 0;
+  uint8_t none[16];
+  return EVP_EncryptInit_ex(cipher, nullptr, nullptr, nullptr, nonce) == 1 &&
+         EVP_EncryptUpdate(cipher, nullptr, &n, data, static_cast<int>(mac_offset)) == 1 &&
+         EVP_EncryptUpdate(cipher, nullptr, &n, kZero, kMacBytes) == 1 &&
+         EVP_EncryptUpdate(cipher, nullptr, &n, data + tail, static_cast<int>(size - tail)) == 1 &&
+         EVP_EncryptFinal_ex(cipher, none, &n) == 1 &&
+         EVP_CIPHER_CTX_ctrl(cipher, EVP_CTRL_GCM_GET_TAG, kMacBytes, mac) == 1;
+}
+
+bool MessageAuthenticator::Sign(std::string_view channel, uint8_t* data, size_t size,
+                                size_t mac_offset) {
+  if (!HasRoom(size, mac_offset)) return false;
+  bool derived = false;
+  evp_cipher_ctx_st* cipher = KeyFor(channel, data, mac_offset, &derived);
   uint8_t mac[kMacBytes];
-  if (!Compute(data, size, mac_offset, mac)) return false;
+  if (cipher == nullptr || !Compute(cipher, data, size, mac_offset, mac)) return false;
+  if (derived) Keep(data, mac_offset);
   std::memcpy(data + mac_offset, mac, kMacBytes);
   return true;
 }
 
-const char* MessageAuthenticator::Verify(const uint8_t* data, size_t size, size_t mac_offset) {
-  if (mac_offset > size || size - mac_offset < kMacBytes) return "no room for a MAC";
+const char* MessageAuthenticator::Verify(std::string_view channel, const uint8_t* data, size_t size,
+                                         size_t mac_offset) {
+  if (!HasRoom(size, mac_offset)) return "no room for a MAC";
   const uint8_t* got = data + mac_offset;
   uint8_t any = 0;
   for (size_t i = 0; i < kMacBytes; ++i) any |= got[i];
   if (any == 0) return "no MAC";
+  bool derived = false;
+  evp_cipher_ctx_st* cipher = KeyFor(channel, data, mac_offset, &derived);
   uint8_t want[kMacBytes];
-  if (!Compute(data, size, mac_offset, want)) return "wrong MAC";
-  return CRYPTO_memcmp(want, got, kMacBytes) == 0 ? nullptr : "wrong MAC";
+  if (cipher == nullptr || !Compute(cipher, data, size, mac_offset, want) ||
+      CRYPTO_memcmp(want, got, kMacBytes) != 0) {
+    return "wrong MAC";
+  }
+  if (derived) Keep(data, mac_offset);
+  return nullptr;
 }
 
 }  // namespace rl

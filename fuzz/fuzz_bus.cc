@@ -77,7 +77,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const size_t at = rl::MacOffset(static_cast<size_t>(sender));
     if (at + rl::kMacBytes <= msg.size()) {
       std::memset(msg.data() + at, 0, rl::kMacBytes);
-      if (!h->auth.Sign(msg.data(), msg.size(), at)) Fail("cannot sign");
+      if (!h->auth.Sign(channel, msg.data(), msg.size(), at)) Fail("cannot sign");
       h->bus.PublishRaw(channel, msg.data(), msg.size());
       h->bus.Handle(0);
       const int64_t after_first = h->handled;

@@ -503,10 +503,14 @@ int Main(int argc, char** argv) {
       if (keyed) {
         send(t.good(header));  // no MAC
         std::vector<uint8_t> forged = t.good(header);
-        other->Sign(forged.data(), forged.size(), mac_at);
+        other->Sign(t.channel, forged.data(), forged.size(), mac_at);
         send(forged);  // another key's MAC
-        std::vector<uint8_t> flipped = t.good(header);
-        auth->Sign(flipped.data(), flipped.size(), mac_at);
+        // Signed as a later incarnation of ours (that sends nothing else), so that this MAC's
+        // nonce is not the one of the invalid message below (common/message_auth.h).
+        rlmsg::header_t later = header;
+        later.incarnation = header.incarnation + 1;
+        std::vector<uint8_t> flipped = t.good(later);
+        auth->Sign(t.channel, flipped.data(), flipped.size(), mac_at);
         flipped[mac_at - 9] ^= 0x10;  // in header.utime: still decodes
         send(flipped);                // changed after signing
       }
@@ -515,7 +519,7 @@ int Main(int argc, char** argv) {
       header.run_id = common.run_id;
       header.seq = next_seq[t.channel]++;
       std::vector<uint8_t> invalid = t.invalid(header);
-      if (keyed) auth->Sign(invalid.data(), invalid.size(), mac_at);
+      if (keyed) auth->Sign(t.channel, invalid.data(), invalid.size(), mac_at);
       send(invalid);
       send(invalid);  // the same again: replayed
       bus.Handle(1);

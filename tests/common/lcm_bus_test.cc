@@ -168,7 +168,8 @@ std::vector<uint8_t> Stamped(int64_t incarnation, int64_t seq, const std::string
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   if (!key.empty()) {
     MessageAuthenticator auth(key);
-    EXPECT_TRUE(auth.Sign(bytes.data(), bytes.size(), MacOffset(m.header.sender.size())));
+    EXPECT_TRUE(auth.Sign(channels::kTransitions, bytes.data(), bytes.size(),
+                          MacOffset(m.header.sender.size())));
   }
   return bytes;
 }
@@ -221,6 +222,23 @@ TEST_F(KeyedBusTest, DropsNoMacAWrongKeyAndEveryFlippedBitAsUnauthenticated) {
   EXPECT_EQ(c.replayed + c.invalid + c.received, 0);
   Send(good);
   EXPECT_EQ(got_.size(), 1U);
+}
+
+// The MAC binds the channel: a signed message moved to another channel of the same type is
+// dropped.
+TEST_F(KeyedBusTest, DropsAMessageSignedForAnotherChannel) {
+  auto m = MakeBatch(1, 4);
+  m.header.run_id = 42;
+  m.header.sender = "actor-2";
+  m.header.incarnation = 1;
+  m.header.seq = 0;
+  std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  MessageAuthenticator auth(kKey);
+  ASSERT_TRUE(auth.Sign("RL_OTHER", bytes.data(), bytes.size(), MacOffset(7)));
+  Send(bytes);
+  EXPECT_TRUE(got_.empty());
+  EXPECT_EQ(bus_.counters().unauthenticated, 1);
 }
 
 TEST_F(KeyedBusTest, DropsAnotherRunsMessagesAsForeignBeforeCheckingTheirMac) {
