@@ -12,7 +12,15 @@ std::string FormatDouble(const char* fmt, double v) {
   return buf;
 }
 
-std::string Score(double v) { return FormatDouble(std::fabs(v) < 10 ? "%.2f" : "%.1f", v); }
+std::string Score(double v) {
+  const bool small = std::fabs(v) < 10;
+  const double scale = small ? 100 : 10;
+  // Rounded down, so that a score never reads as reaching a goal it missed (899.96 is not "900.0");
+  // the small margin keeps a value that is a hair under its decimal (475 computed as 474.99999...)
+  // from losing a digit.
+  if (std::isfinite(v)) v = std::floor(v * scale + 1e-6) / scale;
+  return FormatDouble(small ? "%.2f" : "%.1f", v);
+}
 
 std::string Thousands(int64_t v) {
   const std::string digits = std::to_string(v < 0 ? -v : v);

@@ -10,7 +10,8 @@ namespace rl {
 /// printf of one double with `fmt` (at most 63 characters of output).
 std::string FormatDouble(const char* fmt, double v);
 
-/// A return or a rate: two decimals below 10 in magnitude (grasp success 0.36), else one.
+/// A return or a rate: two decimals below 10 in magnitude (grasp success 0.35), else one; rounded
+/// down, so that a mean below a goal never shows as the goal (899.96 -> "899.9").
 std::string Score(double v);
 
 /// 1234567 -> "1,234,567" (negative values keep their sign).

@@ -51,6 +51,7 @@ EnvIdParts ParseEnvId(const std::string& id) {
       {"render-width", &c.render_width},
       {"render-height", &c.render_height},
       {"noop-start", &c.noop_start},
+      {"time-limit", &c.time_limit},
   };
   std::stringstream list(id.substr(open, close - open));
   std::string item;
@@ -62,23 +63,27 @@ EnvIdParts ParseEnvId(const std::string& id) {
       throw std::invalid_argument("env '" + id + "': expected key=value, got '" + item + "'");
     }
     const std::string value = item.substr(eq + 1);
-    if (key == "max-pool" || key == "off-track") {
+    if (key == "max-pool" || key == "off-track" || key == "lap-ends") {
       const int v = ParseInt(id, key, value);
       if (v != 0 && v != 1) throw std::invalid_argument("env '" + id + "': " + key + " is 0 or 1");
-      (key == "max-pool" ? c.max_pool : c.off_track) = v == 1;
+      (key == "max-pool" ? c.max_pool : key == "off-track" ? c.off_track : c.lap_ends) = v == 1;
     } else if (auto it = ints.find(key); it != ints.end()) {
       *it->second = ParseInt(id, key, value);
     } else {
       throw std::invalid_argument(
           "env '" + id + "': unknown pixels key '" + key +
           "' (known: width, height, stack, skip, max-pool, crop-top, crop-bottom, crop-left, "
-          "crop-right, render-width, render-height, noop-start, off-track)");
+          "crop-right, render-width, render-height, noop-start, off-track, time-limit, "
+          "lap-ends)");
     }
   }
   try {
     c.Validate();
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("env '" + id + "': " + e.what());
+  }
+  if (!c.lap_ends && !parts.base.starts_with("CarRacing")) {
+    throw std::invalid_argument("env '" + id + "': lap-ends applies to CarRacing only");
   }
   return parts;
 }

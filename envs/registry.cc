@@ -18,69 +18,68 @@
 namespace rl::envs {
 namespace {
 
-// One registered id and how to build it, time limit included.
+// What an id's image pipeline changes in the env under it (ImagePipelineConfig).
+struct BaseOptions {
+  bool lap_ends = true;  // CarRacing only
+};
+
+// One registered id: how to build the env, and its time limit (TimeLimit, in MakeEnv).
 struct Registration {
   std::string_view id;
-  std::unique_ptr<Env> (*make)();
+  int max_episode_steps;
+  std::unique_ptr<Env> (*make)(const BaseOptions&);
 };
 
 constexpr std::array kRegistrations = {
-    Registration{"CartPole-v1",
-                 []() -> std::unique_ptr<Env> {
-                   return std::make_unique<TimeLimit>(std::make_unique<CartPole>(), 500);
+    Registration{
+        "CartPole-v1", 500,
+        [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<CartPole>(); }},
+    Registration{
+        "LunarLander-v3", 1000,
+        [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<LunarLander>(); }},
+    Registration{"LunarLanderContinuous-v3", 1000,
+                 [](const BaseOptions&) -> std::unique_ptr<Env> {
+                   return std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true});
                  }},
-    Registration{"LunarLander-v3",
-                 []() -> std::unique_ptr<Env> {
-                   return std::make_unique<TimeLimit>(std::make_unique<LunarLander>(), 1000);
+    // CarRacing: 1,000 frames; an episode also ends when every tile is visited (unless lap_ends
+    // is off) or the car leaves the playfield.
+    Registration{"CarRacing-v3", 1000,
+                 [](const BaseOptions& o) -> std::unique_ptr<Env> {
+                   return std::make_unique<CarRacing>(CarRacingConfig{.lap_ends = o.lap_ends});
                  }},
-    Registration{"LunarLanderContinuous-v3",
-                 []() -> std::unique_ptr<Env> {
-                   return std::make_unique<TimeLimit>(
-                       std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true}), 1000);
+    Registration{"CarRacingDiscrete-v3", 1000,
+                 [](const BaseOptions& o) -> std::unique_ptr<Env> {
+                   return std::make_unique<CarRacing>(
+                       CarRacingConfig{.continuous = false, .lap_ends = o.lap_ends});
                  }},
-    // CarRacing: 1,000 frames; an episode also ends when every tile is visited or the car leaves
-    // the playfield.
-    Registration{"CarRacing-v3",
-                 []() -> std::unique_ptr<Env> {
-                   return std::make_unique<TimeLimit>(std::make_unique<CarRacing>(), 1000);
-                 }},
-    Registration{"CarRacingDiscrete-v3",
-                 []() -> std::unique_ptr<Env> {
-                   return std::make_unique<TimeLimit>(
-                       std::make_unique<CarRacing>(CarRacingConfig{.continuous = false}), 1000);
-                 }},
-    Registration{"Pendulum-v1",
-                 []() -> std::unique_ptr<Env> {
-                   return std::make_unique<TimeLimit>(std::make_unique<Pendulum>(), 200);
-                 }},
+    Registration{
+        "Pendulum-v1", 200,
+        [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<Pendulum>(); }},
     // Every Catch episode ends after 9 steps, so the limit never cuts one short: it only marks
     // the terminating step truncated as well (terminated still means no bootstrapping).
-    Registration{"Catch-v0",
-                 []() -> std::unique_ptr<Env> {
-                   return std::make_unique<TimeLimit>(std::make_unique<Catch>(), 9);
-                 }},
+    Registration{
+        "Catch-v0", 9,
+        [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<Catch>(); }},
     // KUKA grasping from a camera: 15 steps on the training objects; the held-out test objects
     // with the 20 steps of evaluation. An episode also ends at its grasp attempt.
-    Registration{"KukaDiverseObjectGrasping-v0",
-                 []() -> std::unique_ptr<Env> {
-                   return std::make_unique<TimeLimit>(std::make_unique<KukaDiverseObjectEnv>(), 15);
+    Registration{"KukaDiverseObjectGrasping-v0", 15,
+                 [](const BaseOptions&) -> std::unique_ptr<Env> {
+                   return std::make_unique<KukaDiverseObjectEnv>();
                  }},
-    Registration{"KukaDiverseObjectGraspingTest-v0",
-                 []() -> std::unique_ptr<Env> {
-                   return std::make_unique<TimeLimit>(
-                       std::make_unique<KukaDiverseObjectEnv>(
-                           KukaDiverseObjectConfig{.is_test = true, .max_steps = 20}),
-                       20);
+    Registration{"KukaDiverseObjectGraspingTest-v0", 20,
+                 [](const BaseOptions&) -> std::unique_ptr<Env> {
+                   return std::make_unique<KukaDiverseObjectEnv>(
+                       KukaDiverseObjectConfig{.is_test = true, .max_steps = 20});
                  }},
 };
 
-}  // namespace
-
-std::unique_ptr<Env> MakeEnv(const std::string& id) {
-  const EnvIdParts parts = ParseEnvId(id);
-  if (parts.pixels) return MakePixelEnv(MakeEnv(parts.base), parts.image);
+// A registered env with its time limit: `time_limit` when positive, else the registration's.
+std::unique_ptr<Env> MakeBase(const std::string& id, int time_limit, const BaseOptions& options) {
   for (const Registration& r : kRegistrations) {
-    if (r.id == id) return r.make();
+    if (r.id == id) {
+      return std::make_unique<TimeLimit>(r.make(options),
+                                         time_limit > 0 ? time_limit : r.max_episode_steps);
+    }
   }
   std::string known;
   for (const std::string& name : RegisteredEnvs()) {
@@ -88,6 +87,16 @@ std::unique_ptr<Env> MakeEnv(const std::string& id) {
   }
   throw std::invalid_argument("MakeEnv: unknown environment id \"" + id +
                               "\"; known ids: " + known);
+}
+
+}  // namespace
+
+std::unique_ptr<Env> MakeEnv(const std::string& id) {
+  const EnvIdParts parts = ParseEnvId(id);
+  if (!parts.pixels) return MakeBase(id, 0, {});
+  return MakePixelEnv(
+      MakeBase(parts.base, parts.image.time_limit, {.lap_ends = parts.image.lap_ends}),
+      parts.image);
 }
 
 std::vector<std::string> RegisteredEnvs() {

@@ -91,9 +91,10 @@ EnvSpec KukaDiverseObjectSpec(bool is_test, int max_steps, int width, int height
 EnvSpec PixelSpec(const EnvSpec& inner, const ImagePipelineConfig& config) {
   config.Validate();
   EnvSpec spec = inner;
-  // ceil(max_episode_steps / frame_skip): the outer step that contains the inner limit.
-  spec.max_episode_steps = static_cast<int>(
-      (int64_t{inner.max_episode_steps} + config.frame_skip - 1) / config.frame_skip);
+  // ceil(inner limit / frame_skip): the outer step that contains the inner limit.
+  const int inner_limit = config.time_limit > 0 ? config.time_limit : inner.max_episode_steps;
+  spec.max_episode_steps =
+      static_cast<int>((int64_t{inner_limit} + config.frame_skip - 1) / config.frame_skip);
   const int raw_width = config.render_width > 0 ? config.render_width : inner.render_width;
   const int raw_height = config.render_height > 0 ? config.render_height : inner.render_height;
   const int64_t cropped_width = int64_t{raw_width} - config.crop_left - config.crop_right;

@@ -16,6 +16,7 @@
 #include "common/channels.h"
 #include "common/clock.h"
 #include "common/shutdown.h"
+#include "common/text_format.h"
 #include "envs/registry.h"
 #include "envs/specs.h"
 #include "nn/checkpoint.h"
@@ -299,7 +300,7 @@ bool EvaluatorService::ScorePending() {
       record.second_mean = second.mean;
       record.second_std = second.std;
       record.second_episodes = second.episodes;
-      Log("evaluator: update %lld on the second metric: mean %.1f \xC2\xB1 %.1f (%d episodes, "
+      Log("evaluator: update %lld on the second metric: mean %.2f \xC2\xB1 %.1f (%d episodes, "
           "%.2f s)\n",
           static_cast<long long>(record.update), second.mean, second.std, second.episodes,
           second.eval_seconds);
@@ -355,7 +356,7 @@ bool EvaluatorService::ScorePending() {
   result.goal_reached = reached ? 1 : 0;
   bus_->Publish(channels::kEval, &result);
 
-  Log("evaluator: update %lld, env steps %lld, wall %.1f s: mean %.1f \xC2\xB1 %.1f "
+  Log("evaluator: update %lld, env steps %lld, wall %.1f s: mean %.2f \xC2\xB1 %.1f "
       "(min %g, max %g, %d episodes, %.2f s)%s\n",
       static_cast<long long>(record.update), static_cast<long long>(record.env_steps),
       record.wall_seconds, record.mean, record.std, record.min, record.max, record.episodes,
@@ -482,9 +483,10 @@ void EvaluatorService::RecordVideo(const std::string& path, const EvalRecord& re
     char caption[256];
     std::snprintf(caption, sizeof(caption),
                   "Greedy episode (epsilon 0, seed %llu) of the best checkpoint, %s (update %lld, "
-                  "evaluation mean %.1f): return %.1f over %d frames.",
+                  "evaluation mean %s): return %s over %d frames.",
                   static_cast<unsigned long long>(config_.seed_base), record.checkpoint.c_str(),
-                  static_cast<long long>(record.update), record.mean, v.episode_return, v.frames);
+                  static_cast<long long>(record.update), rl::Score(record.mean).c_str(),
+                  rl::Score(v.episode_return).c_str(), v.frames);
     video_caption_ = caption;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "evaluator: no video: %s\n", e.what());
@@ -568,9 +570,7 @@ std::string EvaluatorService::FinalLine() const {
   if (goal_reached_) return "evaluator: goal reached";
   const EvalRecord* b = best();
   if (b == nullptr) return "evaluator: goal not reached (no checkpoint scored)";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.1f", b->mean);
-  return std::string("evaluator: goal not reached (best ") + buf + ")";
+  return "evaluator: goal not reached (best " + rl::Score(b->mean) + ")";
 }
 
 }  // namespace rl::evaluator

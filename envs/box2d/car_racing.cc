@@ -370,7 +370,7 @@ StepResult CarRacing::Finish() {
   result.reward = p.reward - prev_reward_;
   prev_reward_ = p.reward;
   lap_finished_ = false;
-  if (p.visited_count == track_.size() || p.new_lap) {
+  if (config_.lap_ends && (p.visited_count == track_.size() || p.new_lap)) {
     result.terminated = true;
     lap_finished_ = true;
   }

@@ -30,6 +30,9 @@ struct CarRacingConfig {
   bool continuous = true;              // [steer, gas, brake]; false: Discrete(5).
   bool domain_randomize = false;       // Random road, background and grass colours every Reset.
   double lap_complete_percent = 0.95;  // See CarRacing's class comment on the lap rule.
+  // Whether finishing the lap ends the episode (v3); false: the car drives on, as in the TD3
+  // article's code (ImagePipelineConfig::lap_ends).
+  bool lap_ends = true;
   // Point samples per pixel side of the 96 x 96 observation (4: 16 samples per pixel, see
   // car_racing_render.h). Larger renders use fewer, never more than one per surface pixel.
   int supersample = 4;

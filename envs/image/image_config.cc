@@ -60,6 +60,7 @@ void ImagePipelineConfig::Validate() const {
                 "width and height must both be 0 (keep the cropped size) or both positive");
   CheckAtLeast(stack, 1, "stack");
   CheckAtLeast(noop_start, 0, "noop_start");
+  CheckAtLeast(time_limit, 0, "time_limit");
   CheckAtMost(render_width, kMaxFrameSide, "render_width");
   CheckAtMost(render_height, kMaxFrameSide, "render_height");
   CheckAtMost(width, kMaxFrameSide, "width");

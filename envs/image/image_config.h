@@ -43,12 +43,20 @@ struct ImagePipelineConfig {
   // 96 x 96 frame (scaled to the render size), i.e. grass or white kerb on both sides of the car.
   // That inner step's reward is replaced by -10 and the Step ends, terminated.
   bool off_track = false;
+  // Inner steps after which an episode is truncated, replacing the env's own time limit
+  // (EnvSpec::max_episode_steps); 0 keeps it. The TD3 CarRacing article tests for 18,000.
+  int time_limit = 0;
+  // Whether finishing the lap ends a CarRacing episode (Gymnasium v3: terminated). The TD3
+  // article's code ignores it (its Gymnasium reported the lap as a truncation), so there a car that
+  // finished drives on, earning -0.1 a frame, until the time limit, the off-track rule or the
+  // playfield's edge ends the episode. CarRacing only (ParseEnvId refuses it for other envs).
+  bool lap_ends = true;
 
   /// Throws std::invalid_argument naming the field unless: render_width and render_height are
   /// both 0 or both positive, frame_skip >= 1, the crops are >= 0 (and, with an explicit render
   /// size, leave at least one pixel each way), width and height are both 0 or both positive,
-  /// stack >= 1 and noop_start >= 0; and the sizes are at most kMaxFrameSide, the stack at most
-  /// kMaxFrameStack.
+  /// stack >= 1, noop_start >= 0 and time_limit >= 0; and the sizes are at most kMaxFrameSide, the
+  /// stack at most kMaxFrameStack.
   void Validate() const;
 };
 

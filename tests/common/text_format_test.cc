@@ -9,11 +9,16 @@
 namespace rl {
 namespace {
 
-TEST(TextFormatTest, ScoresKeepTwoDecimalsBelowTen) {
-  EXPECT_EQ(Score(0.356), "0.36");
-  EXPECT_EQ(Score(-9.994), "-9.99");
+TEST(TextFormatTest, ScoresKeepTwoDecimalsBelowTenRoundedDown) {
+  EXPECT_EQ(Score(0.356), "0.35");
+  EXPECT_EQ(Score(-9.984), "-9.99");
   EXPECT_EQ(Score(475.04), "475.0");
-  EXPECT_EQ(Score(-12.25), "-12.2");
+  EXPECT_EQ(Score(475.0), "475.0");
+  EXPECT_EQ(Score(474.99999999999994), "475.0");
+  EXPECT_EQ(Score(-12.25), "-12.3");
+  // Below a goal never reads as the goal.
+  EXPECT_EQ(Score(899.96), "899.9");
+  EXPECT_EQ(Score(-200.04), "-200.1");
 }
 
 TEST(TextFormatTest, ThousandsAreSeparated) {

@@ -89,7 +89,8 @@ TEST(SpecsTest, PixelIdsHaveTheSpecOfTheImagePipeline) {
        {"Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)",
         "CartPole-v1+pixels(width=84,height=84,stack=4,skip=4)",
         "CartPole-v1+pixels(width=0,height=0,stack=3,crop-top=100,crop-left=10,crop-right=30)",
-        "LunarLanderContinuous-v3+pixels(width=42,height=42,stack=2,skip=3)"}) {
+        "LunarLanderContinuous-v3+pixels(width=42,height=42,stack=2,skip=3)",
+        "CarRacing-v3+pixels(skip=5,time-limit=18000,lap-ends=0)"}) {
     ExpectSameSpec(MakeEnv(id)->spec(), LookupSpec(id), id);
   }
 }

@@ -186,6 +186,30 @@ TEST(CarRacingTest, ALapVisitingEveryTileScoresAThousandLessATenthPerFrame) {
   EXPECT_NEAR(sum, 1000 - 0.1 * frames, 1e-6);
 }
 
+// With lap_ends off (the TD3 article's rule), the finished lap ends nothing: the car drives on,
+// every further frame costs 0.1 and pays nothing, until the playfield's edge or a time limit.
+TEST(CarRacingTest, WithoutLapEndsTheCarDrivesOnPastAFinishedLap) {
+  CarRacing env(CarRacingConfig{.lap_ends = false});
+  CarRacingPilot pilot;
+  env.Reset(21);
+  double sum = 0;
+  int frames = 0;
+  while (env.tiles_visited() < env.track().size()) {
+    ASSERT_LT(frames, 1000);
+    const StepResult r = env.StepContinuous(pilot.Act(env));
+    ASSERT_FALSE(r.terminated);
+    sum += r.reward;
+    ++frames;
+  }
+  EXPECT_NEAR(sum, 1000 - 0.1 * frames, 1e-6);
+  for (int k = 0; k < 50; ++k) {
+    const StepResult r = env.StepContinuous(pilot.Act(env));
+    EXPECT_FALSE(r.terminated);
+    EXPECT_FALSE(env.lap_finished());
+    EXPECT_NEAR(r.reward, -0.1, 1e-9);
+  }
+}
+
 TEST(CarRacingTest, ScriptedPilotCompletesLapsWithAHighScore) {
   // Thirty tracks here (bench/ reports 100): the env is drivable and its reward right. Episodes
   // end at 1,000 frames, as MakeEnv's TimeLimit ends them.
