@@ -370,8 +370,7 @@ void RunPixelService(int port, ServiceProbe* probe, const std::string& key) {
     }
     const rl::BusCounters& c = bus.counters();
     probe->lost.store(c.lost);
-    probe->dropped.store(c.malformed + c.invalid + c.unauthenticated +
-                         service.counters().batches_refused);
+    probe->dropped.store(c.dropped() + service.counters().batches_refused);
     probe->cpu_seconds.store(ThreadCpuSeconds());
     return probe->stop.load();
   });
