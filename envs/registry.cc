@@ -13,6 +13,7 @@
 #include "envs/kuka/kuka_diverse_object_env.h"
 #include "envs/pendulum.h"
 #include "envs/pixel_spec.h"
+#include "envs/specs.h"
 #include "envs/time_limit.h"
 
 namespace rl::envs {
@@ -23,62 +24,62 @@ struct BaseOptions {
   bool lap_ends = true;  // CarRacing only
 };
 
-// One registered id: how to build the env, and its time limit (TimeLimit, in MakeEnv).
+// One registered id and how to build the env under its TimeLimit (MakeBase), whose default
+// limit is the id's spec's (envs/specs.h: one table of the limits).
 struct Registration {
   std::string_view id;
-  int max_episode_steps;
   std::unique_ptr<Env> (*make)(const BaseOptions&);
 };
 
 constexpr std::array kRegistrations = {
     Registration{
-        "CartPole-v1", 500,
+        "CartPole-v1",
         [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<CartPole>(); }},
     Registration{
-        "LunarLander-v3", 1000,
+        "LunarLander-v3",
         [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<LunarLander>(); }},
-    Registration{"LunarLanderContinuous-v3", 1000,
+    Registration{"LunarLanderContinuous-v3",
                  [](const BaseOptions&) -> std::unique_ptr<Env> {
                    return std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true});
                  }},
     // CarRacing: 1,000 frames; an episode also ends when every tile is visited (unless lap_ends
     // is off) or the car leaves the playfield.
-    Registration{"CarRacing-v3", 1000,
+    Registration{"CarRacing-v3",
                  [](const BaseOptions& o) -> std::unique_ptr<Env> {
                    return std::make_unique<CarRacing>(CarRacingConfig{.lap_ends = o.lap_ends});
                  }},
-    Registration{"CarRacingDiscrete-v3", 1000,
+    Registration{"CarRacingDiscrete-v3",
                  [](const BaseOptions& o) -> std::unique_ptr<Env> {
                    return std::make_unique<CarRacing>(
                        CarRacingConfig{.continuous = false, .lap_ends = o.lap_ends});
                  }},
     Registration{
-        "Pendulum-v1", 200,
+        "Pendulum-v1",
         [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<Pendulum>(); }},
     // Every Catch episode ends after 9 steps, so the limit never cuts one short: it only marks
     // the terminating step truncated as well (terminated still means no bootstrapping).
     Registration{
-        "Catch-v0", 9,
+        "Catch-v0",
         [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<Catch>(); }},
     // KUKA grasping from a camera: 15 steps on the training objects; the held-out test objects
     // with the 20 steps of evaluation. An episode also ends at its grasp attempt.
-    Registration{"KukaDiverseObjectGrasping-v0", 15,
+    Registration{"KukaDiverseObjectGrasping-v0",
                  [](const BaseOptions&) -> std::unique_ptr<Env> {
                    return std::make_unique<KukaDiverseObjectEnv>();
                  }},
-    Registration{"KukaDiverseObjectGraspingTest-v0", 20,
+    Registration{"KukaDiverseObjectGraspingTest-v0",
                  [](const BaseOptions&) -> std::unique_ptr<Env> {
                    return std::make_unique<KukaDiverseObjectEnv>(
                        KukaDiverseObjectConfig{.is_test = true, .max_steps = 20});
                  }},
 };
 
-// A registered env with its time limit: `time_limit` when positive, else the registration's.
+// A registered env with its time limit: `time_limit` when positive, else its spec's.
 std::unique_ptr<Env> MakeBase(const std::string& id, int time_limit, const BaseOptions& options) {
   for (const Registration& r : kRegistrations) {
     if (r.id == id) {
-      return std::make_unique<TimeLimit>(r.make(options),
-                                         time_limit > 0 ? time_limit : r.max_episode_steps);
+      return std::make_unique<TimeLimit>(
+          r.make(options), time_limit > 0 ? time_limit : LookupSpec(id).max_episode_steps);
     }
   }
   std::string known;
