@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace rl {
 
@@ -76,19 +77,11 @@ void AppendField(std::string* out, const void* data, size_t size) {
 
 }  // namespace
 
-void MessageAuthenticator::CipherFree::operator()(evp_cipher_ctx_st* c) const {
-  EVP_CIPHER_CTX_free(c);
-}
-
 MessageAuthenticator::MessageAuthenticator(const std::string& key)
-    : key_(key), scratch_(EVP_CIPHER_CTX_new()) {
+    : key_(key), scratch_(std::make_unique<Gmac>()) {
   if (key_.size() != kKeyBytes) {
     throw std::invalid_argument("a message key has " + std::to_string(kKeyBytes) + " bytes, not " +
                                 std::to_string(key_.size()));
-  }
-  if (scratch_ == nullptr ||
-      EVP_EncryptInit_ex(scratch_.get(), EVP_aes_256_gcm(), nullptr, nullptr, nullptr) != 1) {
-    throw std::runtime_error("OpenSSL provides no AES-256-GCM");
   }
   unsigned char probe[32];
   unsigned int probe_size = 0;
@@ -101,8 +94,8 @@ MessageAuthenticator::MessageAuthenticator(const std::string& key)
 
 MessageAuthenticator::~MessageAuthenticator() = default;
 
-evp_cipher_ctx_st* MessageAuthenticator::KeyFor(std::string_view channel, const uint8_t* data,
-                                                size_t mac_offset, bool* derived) {
+Gmac* MessageAuthenticator::KeyFor(std::string_view channel, const uint8_t* data, size_t mac_offset,
+                                   bool* derived) {
   lookup_.assign(channel);
   lookup_.push_back('\0');
   lookup_.append(reinterpret_cast<const char*>(Sender(data)), SenderLength(mac_offset));
@@ -110,7 +103,7 @@ evp_cipher_ctx_st* MessageAuthenticator::KeyFor(std::string_view channel, const 
   *derived = false;
   if (auto it = streams_.find(lookup_);
       it != streams_.end() && it->second.incarnation == incarnation) {
-    return it->second.cipher.get();
+    return it->second.gmac.get();
   }
   // HMAC-SHA256(run key, label | channel | sender | incarnation), each field length-prefixed.
   std::string info;
@@ -123,8 +116,7 @@ evp_cipher_ctx_st* MessageAuthenticator::KeyFor(std::string_view channel, const 
   if (HMAC(EVP_sha256(), key_.data(), static_cast<int>(key_.size()),
            reinterpret_cast<const unsigned char*>(info.data()), info.size(), stream_key,
            &stream_key_size) == nullptr ||
-      stream_key_size != sizeof(stream_key) ||
-      EVP_EncryptInit_ex(scratch_.get(), nullptr, nullptr, stream_key, nullptr) != 1) {
+      stream_key_size != sizeof(stream_key) || !scratch_->SetKey(stream_key)) {
     OPENSSL_cleanse(stream_key, sizeof(stream_key));
     return nullptr;
   }
@@ -142,42 +134,32 @@ void MessageAuthenticator::Keep(const uint8_t* data, size_t mac_offset) {
   } else if (incarnation < it->second.incarnation) {
     return;  // an older incarnation (a replayed message, about to be dropped): keep the newer
   }
-  Cipher fresh(EVP_CIPHER_CTX_new());
-  if (fresh == nullptr ||
-      EVP_EncryptInit_ex(fresh.get(), EVP_aes_256_gcm(), nullptr, nullptr, nullptr) != 1) {
-    if (!it->second.cipher) streams_.erase(it);
-    return;
-  }
   it->second.incarnation = incarnation;
-  it->second.cipher = std::move(scratch_);
-  scratch_ = std::move(fresh);
+  std::swap(it->second.gmac, scratch_);
+  if (scratch_ == nullptr) scratch_ = std::make_unique<Gmac>();
 }
 
-bool MessageAuthenticator::Compute(evp_cipher_ctx_st* cipher, const uint8_t* data, size_t size,
-                                   size_t mac_offset, uint8_t* mac) {
+bool MessageAuthenticator::Compute(Gmac* gmac, const uint8_t* data, size_t size, size_t mac_offset,
+                                   uint8_t* mac) {
   static constexpr uint8_t kZero[kMacBytes] = {};
-  uint8_t nonce[12] = {};
+  uint8_t nonce[Gmac::kNonceBytes] = {};
   std::memcpy(nonce, Seq(data, mac_offset), 8);
+  // The whole message with the MAC's bytes as zero.
+  if (!gmac->Start(nonce)) return false;
+  gmac->Update(data, mac_offset);
+  gmac->Update(kZero, kMacBytes);
   const size_t tail = mac_offset + kMacBytes;
-  // AES-GCM with the whole message as associated data (the MAC's bytes as zero), nothing
-  // encrypted: the tag is the GMAC. Setting the nonce restarts the hash, the key stays.
-  int n = 0;
-  uint8_t none[16];
-  return EVP_EncryptInit_ex(cipher, nullptr, nullptr, nullptr, nonce) == 1 &&
-         EVP_EncryptUpdate(cipher, nullptr, &n, data, static_cast<int>(mac_offset)) == 1 &&
-         EVP_EncryptUpdate(cipher, nullptr, &n, kZero, kMacBytes) == 1 &&
-         EVP_EncryptUpdate(cipher, nullptr, &n, data + tail, static_cast<int>(size - tail)) == 1 &&
-         EVP_EncryptFinal_ex(cipher, none, &n) == 1 &&
-         EVP_CIPHER_CTX_ctrl(cipher, EVP_CTRL_GCM_GET_TAG, kMacBytes, mac) == 1;
+  gmac->Update(data + tail, size - tail);
+  return gmac->Finish(mac);
 }
 
 bool MessageAuthenticator::Sign(std::string_view channel, uint8_t* data, size_t size,
                                 size_t mac_offset) {
   if (!HasRoom(size, mac_offset)) return false;
   bool derived = false;
-  evp_cipher_ctx_st* cipher = KeyFor(channel, data, mac_offset, &derived);
+  Gmac* gmac = KeyFor(channel, data, mac_offset, &derived);
   uint8_t mac[kMacBytes];
-  if (cipher == nullptr || !Compute(cipher, data, size, mac_offset, mac)) return false;
+  if (gmac == nullptr || !Compute(gmac, data, size, mac_offset, mac)) return false;
   if (derived) Keep(data, mac_offset);
   std::memcpy(data + mac_offset, mac, kMacBytes);
   return true;
@@ -191,9 +173,9 @@ const char* MessageAuthenticator::Verify(std::string_view channel, const uint8_t
   for (size_t i = 0; i < kMacBytes; ++i) any |= got[i];
   if (any == 0) return "no MAC";
   bool derived = false;
-  evp_cipher_ctx_st* cipher = KeyFor(channel, data, mac_offset, &derived);
+  Gmac* gmac = KeyFor(channel, data, mac_offset, &derived);
   uint8_t want[kMacBytes];
-  if (cipher == nullptr || !Compute(cipher, data, size, mac_offset, want) ||
+  if (gmac == nullptr || !Compute(gmac, data, size, mac_offset, want) ||
       CRYPTO_memcmp(want, got, kMacBytes) != 0) {
     return "wrong MAC";
   }

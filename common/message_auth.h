@@ -6,11 +6,10 @@
 // header.mac; a receiver recomputes it and drops the message when it differs (another key, a
 // changed bit, another channel) or is all zero (no MAC).
 //
-// The MAC is AES-256-GMAC (AES-GCM over the message as associated data, nothing encrypted), the
-// cheapest of the MACs we measured on our largest messages (bench_replay `mac` rows): about five
-// times HMAC-SHA256's throughput with the CPU's AES and carry-less multiply instructions. GMAC
-// must never see one nonce twice under one key, so each message is keyed by what already makes
-// it unique in a run, and nothing else:
+// The MAC is AES-256-GMAC (common/gmac.h: AES-GCM over the message as associated data, nothing
+// encrypted), the cheapest of the MACs we measured on our largest messages (bench_replay `mac`
+// rows). GMAC must never see one nonce twice under one key, so each message is keyed by what
+// already makes it unique in a run, and nothing else:
 //   key   = HMAC-SHA256(run key, "rl-gmac-v1" | channel | header.sender | header.incarnation)
 //   nonce = header.seq (8 bytes big-endian) | 4 zero bytes
 // A Bus numbers each channel's messages 0, 1, 2, ... within one incarnation (its start time in
@@ -28,7 +27,7 @@
 #include <string>
 #include <string_view>
 
-struct evp_cipher_ctx_st;
+#include "common/gmac.h"
 
 namespace rl {
 
@@ -70,30 +69,25 @@ class MessageAuthenticator {
   const char* Verify(std::string_view channel, const uint8_t* data, size_t size, size_t mac_offset);
 
  private:
-  struct CipherFree {
-    void operator()(evp_cipher_ctx_st* c) const;
-  };
-  using Cipher = std::unique_ptr<evp_cipher_ctx_st, CipherFree>;
   // A derived key, ready: one (channel, sender)'s newest incarnation.
   struct Stream {
     int64_t incarnation = 0;
-    Cipher cipher;
+    std::unique_ptr<Gmac> gmac;
   };
 
   // The key for the message's (channel, sender, incarnation): a kept one, or one derived into
   // scratch_ (then *derived is true). nullptr when OpenSSL fails.
-  evp_cipher_ctx_st* KeyFor(std::string_view channel, const uint8_t* data, size_t mac_offset,
-                            bool* derived);
+  Gmac* KeyFor(std::string_view channel, const uint8_t* data, size_t mac_offset, bool* derived);
   // Keeps scratch_'s key for the message's stream (when its incarnation is the newest and there
   // is room), taking a new scratch_.
   void Keep(const uint8_t* data, size_t mac_offset);
-  bool Compute(evp_cipher_ctx_st* cipher, const uint8_t* data, size_t size, size_t mac_offset,
-               uint8_t* mac);
+  static bool Compute(Gmac* gmac, const uint8_t* data, size_t size, size_t mac_offset,
+                      uint8_t* mac);
 
   std::string key_;
   std::map<std::string, Stream, std::less<>> streams_;  // by channel '\0' sender
   std::string lookup_;                                  // the last message's stream name
-  Cipher scratch_;
+  std::unique_ptr<Gmac> scratch_;
 };
 
 }  // namespace rl
