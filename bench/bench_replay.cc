@@ -28,11 +28,16 @@
 //
 // Authenticated messages (common/message_auth.h):
 //   mac_aes256_gmac_{pixel_batch,4mb}  checking the MAC of a 230 KB and of a 4 MB message, MB/s
-//                             (mac_hmac_sha256_*: the same with HMAC-SHA256, for comparison).
+//                             (mac_aes256_gmac_openssl_*: OpenSSL's AES-GCM whole over the same
+//                             bytes; mac_hmac_sha256_*: HMAC-SHA256; both for comparison).
 //   pixel_replay_insert_mac   pixel_replay_insert with the run's key on both sides (the actor
 //                             signs, the replay checks), on two more ports: compare its rate and
 //                             replay_cpu_us_per_transition with pixel_replay_insert's.
 //   pixel_replay_8_actors_4x_mac  pixel_replay_8_actors_4x with the key.
+//   pixel_replay_insert_cpu[_mac]  the replay's CPU time per stored pixel transition (every
+//                             thread of a replay process of its own), one actor publishing at a
+//                             paced 100,000 transitions/s, without and with the key, in
+//                             alternating windows (PixelInsertCpu below).
 //
 // Snapshots (replay/snapshotter.h: fork, then the child writes), of a CarRacing-size pixel table
 // (capacity 100,000, frame capacity 130,000 of 84 x 84, prioritized; about 1 GB) and of a
@@ -53,6 +58,9 @@
 #include <malloc.h>
 #include <openssl/evp.h>
 #include <openssl/hmac.h>
+#include <sys/mman.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
 
 #include <unistd.h>
 
@@ -60,6 +68,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -68,6 +77,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <new>
 #include <random>
 #include <string>
 #include <thread>
@@ -342,16 +352,19 @@ rl::replay::PixelBatchView View(const rlmsg::transition_batch_t& m) {
 // What the pixel replay service's thread exposes to the main thread.
 struct ServiceProbe {
   std::atomic<bool> stop{false};
-  std::atomic<int64_t> inserts{0};         // transitions stored
-  std::atomic<int64_t> missing_frames{0};  // transitions skipped for a frame never received
-  std::atomic<int64_t> lost{0};            // sequence gaps counted by the service's bus
-  std::atomic<int64_t> dropped{0};         // malformed, invalid or refused
-  std::atomic<double> cpu_seconds{0};      // the service thread's CPU time
+  std::atomic<int64_t> inserts{0};             // transitions stored
+  std::atomic<int64_t> missing_frames{0};      // transitions skipped for a frame never received
+  std::atomic<int64_t> lost{0};                // sequence gaps counted by the service's bus
+  std::atomic<int64_t> dropped{0};             // malformed, invalid or refused
+  std::atomic<double> cpu_seconds{0};          // the service thread's CPU time
+  std::atomic<double> process_cpu_seconds{0};  // the whole process's (all its threads)
 };
+static_assert(std::atomic<double>::is_always_lock_free && std::atomic<int64_t>::is_always_lock_free,
+              "a ServiceProbe is shared with a forked service process");
 
-double ThreadCpuSeconds() {
+double CpuSeconds(clockid_t clock) {
   timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  clock_gettime(clock, &t);
   return static_cast<double>(t.tv_sec) + static_cast<double>(t.tv_nsec) * 1e-9;
 }
 
@@ -371,7 +384,8 @@ void RunPixelService(int port, ServiceProbe* probe, const std::string& key) {
     const rl::BusCounters& c = bus.counters();
     probe->lost.store(c.lost);
     probe->dropped.store(c.dropped() + service.counters().batches_refused);
-    probe->cpu_seconds.store(ThreadCpuSeconds());
+    probe->cpu_seconds.store(CpuSeconds(CLOCK_THREAD_CPUTIME_ID));
+    probe->process_cpu_seconds.store(CpuSeconds(CLOCK_PROCESS_CPUTIME_ID));
     return probe->stop.load();
   });
 }
@@ -468,9 +482,147 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
       static_cast<long long>(probe.missing_frames.load() - missing_before),
       static_cast<long long>(probe.dropped.load() - dropped_before), first_batch_s,
       static_cast<long long>(kCapacity), rl::bench::Summarize(cpu_us).median,
-      bus->config().key.empty() ? "none" : "AES-256-GMAC");
+      bus->config().key.empty() ? "none"
+      : rl::Gmac::Accelerated() ? "AES-256-GMAC, kernel GHASH"
+                                : "AES-256-GMAC, OpenSSL GHASH");
   rl::bench::Emit(name, "transitions/s", rl::bench::Summarize(rates), repeats, extra);
   return true;
+}
+
+// pixel_replay_insert_cpu, pixel_replay_insert_cpu_mac: what storing a pixel transition costs the
+// replay, which is what bounds its insert throughput, without and with the run's key. Two replay
+// services, each in a process of its own (forked before this process starts any thread), so that
+// a service's CPU time is that of all its threads (LCM's receive threads included) and of nothing
+// else. One actor per service publishes batches of kBatch transitions paced at `rate`
+// transitions/s, a rate both keep up with; the windows alternate between the two services, so
+// that the machine's drift falls on both. value: transitions stored per second of the replay's
+// CPU time (its insert capacity on one core); with the CPU time per transition, the share lost
+// and, in the _mac row, what the MAC takes off the capacity, window pair by window pair.
+int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
+  struct Side {
+    std::string key;
+    int port = 0;
+    ServiceProbe* probe = nullptr;
+    pid_t pid = -1;
+    std::vector<double> capacity, cpu_us, thread_cpu_us, lost;
+  };
+  Side sides[2];
+  sides[0].port = port;
+  sides[1].key = std::string(rl::kKeyBytes, 'k');
+  sides[1].port = port + 2;
+  auto stop = [&] {
+    for (Side& side : sides) {
+      if (side.probe == nullptr) continue;
+      side.probe->stop = true;
+      if (side.pid > 0) waitpid(side.pid, nullptr, 0);
+      munmap(side.probe, sizeof(ServiceProbe));
+      side.probe = nullptr;
+    }
+  };
+  for (Side& side : sides) {
+    void* shared = mmap(nullptr, sizeof(ServiceProbe), PROT_READ | PROT_WRITE,
+                        MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    if (shared == MAP_FAILED) {
+      std::perror("bench_replay: mmap");
+      stop();
+      return 1;
+    }
+    side.probe = new (shared) ServiceProbe();
+    side.pid = fork();
+    if (side.pid < 0) {
+      std::perror("bench_replay: fork");
+      stop();
+      return 1;
+    }
+    if (side.pid == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      RunPixelService(side.port, side.probe, side.key);
+      _exit(0);
+    }
+  }
+
+  std::vector<std::unique_ptr<rl::Bus>> buses;
+  std::vector<std::unique_ptr<PixelActorSim>> sims;
+  for (int i = 0; i < 2; ++i) {
+    buses.push_back(std::make_unique<rl::Bus>(Config(sides[i].port, "actor-0", sides[i].key)));
+    sims.push_back(std::make_unique<PixelActorSim>(0, 1));
+    if (!WaitForReplay(buses[i].get())) {
+      std::fprintf(stderr, "bench_replay: a forked pixel replay service did not come up\n");
+      stop();
+      return 1;
+    }
+    // The first batch makes the service allocate its table.
+    const double first = rl::MonoSeconds();
+    while (sides[i].probe->inserts.load() == 0 && rl::MonoSeconds() - first < 10) {
+      buses[i]->Publish(rl::channels::kTransitions, sims[i]->Next());
+      double settled = 0;
+      Settle(buses[i].get(), *sides[i].probe, 1, 2.0, &settled);
+    }
+  }
+
+  std::vector<double> mac_cost;
+  for (int r = 0; r < repeats; ++r) {
+    for (int i = 0; i < 2; ++i) {
+      Side& side = sides[i];
+      rl::Bus* bus = buses[i].get();
+      const int64_t before = side.probe->inserts.load();
+      const double cpu_before = side.probe->process_cpu_seconds.load();
+      const double thread_before = side.probe->cpu_seconds.load();
+      int64_t sent = 0;
+      const double start = rl::MonoSeconds();
+      double next = start;
+      while (rl::MonoSeconds() - start < seconds) {
+        rlmsg::transition_batch_t* m = sims[i]->Next();
+        bus->Publish(rl::channels::kTransitions, m);
+        sent += m->count;
+        next += kBatch / rate;
+        bus->Handle(0);
+        while (rl::MonoSeconds() < next) std::this_thread::sleep_for(std::chrono::microseconds(50));
+      }
+      double settled = 0;
+      const int64_t stored = Settle(bus, *side.probe, before + sent, 0.3, &settled) - before;
+      const double cpu = side.probe->process_cpu_seconds.load() - cpu_before;
+      side.capacity.push_back(static_cast<double>(stored) / std::max(cpu, 1e-9));
+      side.cpu_us.push_back(cpu * 1e6 / static_cast<double>(std::max<int64_t>(1, stored)));
+      side.thread_cpu_us.push_back((side.probe->cpu_seconds.load() - thread_before) * 1e6 /
+                                   static_cast<double>(std::max<int64_t>(1, stored)));
+      side.lost.push_back(static_cast<double>(sent - stored) / static_cast<double>(sent));
+    }
+    mac_cost.push_back(1.0 - sides[1].capacity.back() / sides[0].capacity.back());
+  }
+  stop();
+
+  for (int i = 0; i < 2; ++i) {
+    const Side& side = sides[i];
+    const auto cpu = rl::bench::Summarize(side.cpu_us);
+    const auto lost = rl::bench::Summarize(side.lost);
+    char extra[768];
+    int n = std::snprintf(
+        extra, sizeof(extra),
+        "\"batch\": %d, \"frame\": \"%dx%d\", \"stack\": %d, \"transport\": \"udpm\", "
+        "\"offered_transitions_per_s\": %.0f, \"seconds\": %.1f, \"replay\": \"own process\", "
+        "\"replay_cpu_us_per_transition_median\": %.3f, \"replay_cpu_us_per_transition_min\": "
+        "%.3f, \"replay_cpu_us_per_transition_max\": %.3f, \"lost_fraction_median\": %.4f, "
+        "\"lost_fraction_max\": %.4f, \"service_thread_cpu_us_per_transition_median\": %.3f, "
+        "\"service_thread_cpu_us_per_transition_min\": %.3f, \"mac\": \"%s\"",
+        kBatch, kHeight, kWidth, kStack, rate, seconds, cpu.median, cpu.min, cpu.max, lost.median,
+        lost.max, rl::bench::Summarize(side.thread_cpu_us).median,
+        rl::bench::Summarize(side.thread_cpu_us).min,
+        side.key.empty()          ? "none"
+        : rl::Gmac::Accelerated() ? "AES-256-GMAC, kernel GHASH"
+                                  : "AES-256-GMAC, OpenSSL GHASH");
+    if (i == 1) {
+      const auto cost = rl::bench::Summarize(mac_cost);
+      std::snprintf(extra + n, sizeof(extra) - static_cast<size_t>(n),
+                    ", \"mac_cost_fraction_median\": %.4f, \"mac_cost_fraction_min\": %.4f, "
+                    "\"mac_cost_fraction_max\": %.4f",
+                    cost.median, cost.min, cost.max);
+    }
+    rl::bench::Emit(i == 0 ? "pixel_replay_insert_cpu" : "pixel_replay_insert_cpu_mac",
+                    "transitions per replay CPU-second", rl::bench::Summarize(side.capacity),
+                    repeats, extra);
+  }
+  return 0;
 }
 
 // pixel_replay_sample: kSampleInFlight requests of kBatch stacks outstanding, as the learner
@@ -880,13 +1032,23 @@ void FlatSnapshots(int repeats) {
 }  // namespace
 
 // mac_aes256_gmac: checking (common/message_auth.h) messages of a pixel batch's size (32
-// transitions with their frames) and of a sample reply's (4 MB), MB/s; mac_hmac_sha256: the MAC
-// used before, HMAC-SHA256 (OpenSSL) over the same bytes, for comparison.
+// transitions with their frames) and of a sample reply's (4 MB), MB/s, with the GHASH of
+// common/gmac.h (its kernel where the build has it: "ghash" says which); for comparison, over the
+// same bytes, mac_aes256_gmac_openssl: OpenSSL's AES-256-GCM whole (what the bus used before the
+// kernel, and still uses where the build has none), and mac_hmac_sha256: the MAC used before
+// GMAC, HMAC-SHA256 (OpenSSL).
 void MacRows(int repeats) {
   rl::MessageAuthenticator auth(std::string(rl::kKeyBytes, 'k'));
   const std::string key(rl::kKeyBytes, 'k');
   const std::string sender = "actor-1";
   const size_t at = rl::MacOffset(sender.size());
+  EVP_CIPHER_CTX* gcm = EVP_CIPHER_CTX_new();
+  if (gcm == nullptr ||
+      EVP_EncryptInit_ex(gcm, EVP_aes_256_gcm(), nullptr,
+                         reinterpret_cast<const unsigned char*>(key.data()), nullptr) != 1) {
+    std::abort();
+  }
+  enum class Mac { kGmac, kOpenSslGcm, kHmac };
   for (const size_t size : {size_t{230'000}, size_t{4'000'000}}) {
     // Header bytes as MacOffset() lays them out: the sender's length and name, MAC zero.
     std::vector<uint8_t> msg(size, 0x5a);
@@ -897,16 +1059,26 @@ void MacRows(int repeats) {
     std::fill(msg.begin() + static_cast<std::ptrdiff_t>(at),
               msg.begin() + static_cast<std::ptrdiff_t>(at + rl::kMacBytes), 0);
     if (!auth.Sign("RL_TRANSITIONS", msg.data(), msg.size(), at)) std::abort();
-    for (const bool gmac : {true, false}) {
+    for (const Mac mac : {Mac::kGmac, Mac::kOpenSslGcm, Mac::kHmac}) {
       std::vector<double> rates;
       for (int r = 0; r < repeats; ++r) {
         int64_t n = 0;
         const double start = rl::MonoSeconds();
         while (rl::MonoSeconds() - start < 0.3) {
-          if (gmac) {
+          unsigned char md[32];
+          if (mac == Mac::kGmac) {
             if (auth.Verify("RL_TRANSITIONS", msg.data(), msg.size(), at) != nullptr) std::abort();
+          } else if (mac == Mac::kOpenSslGcm) {
+            unsigned char nonce[12] = {};
+            std::memcpy(nonce, &n, sizeof(n));
+            int out = 0;
+            if (EVP_EncryptInit_ex(gcm, nullptr, nullptr, nullptr, nonce) != 1 ||
+                EVP_EncryptUpdate(gcm, nullptr, &out, msg.data(), static_cast<int>(size)) != 1 ||
+                EVP_EncryptFinal_ex(gcm, md, &out) != 1 ||
+                EVP_CIPHER_CTX_ctrl(gcm, EVP_CTRL_GCM_GET_TAG, 16, md) != 1) {
+              std::abort();
+            }
           } else {
-            unsigned char md[32];
             unsigned int md_size = 0;
             if (HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), msg.data(), msg.size(),
                      md, &md_size) == nullptr) {
@@ -918,15 +1090,25 @@ void MacRows(int repeats) {
         rates.push_back(static_cast<double>(n) * static_cast<double>(size) / 1e6 /
                         (rl::MonoSeconds() - start));
       }
-      char extra[128];
-      std::snprintf(extra, sizeof(extra), "\"message_bytes\": %zu, \"mac_bytes\": %zu", size,
-                    rl::kMacBytes);
-      const std::string name = std::string(gmac ? "mac_aes256_gmac_" : "mac_hmac_sha256_") +
-                               (size < 1'000'000 ? "pixel_batch" : "4mb");
+      char extra[160];
+      std::snprintf(extra, sizeof(extra), "\"message_bytes\": %zu, \"mac_bytes\": %zu%s", size,
+                    rl::kMacBytes,
+                    mac != Mac::kGmac         ? ""
+                    : rl::Gmac::Accelerated() ? ", \"ghash\": \"kernel\""
+                                              : ", \"ghash\": \"OpenSSL\"");
+      const char* prefix = mac == Mac::kGmac         ? "mac_aes256_gmac_"
+                           : mac == Mac::kOpenSslGcm ? "mac_aes256_gmac_openssl_"
+                                                     : "mac_hmac_sha256_";
+      const std::string name = prefix + std::string(size < 1'000'000 ? "pixel_batch" : "4mb");
       rl::bench::Emit(name.c_str(), "MB/s", rl::bench::Summarize(rates), repeats, extra);
     }
   }
+  EVP_CIPHER_CTX_free(gcm);
 }
+
+// pixel_replay_insert_cpu's paced rate: a third of what one actor publishing back to back gets
+// stored (pixel_replay_insert), so that the replay keeps up and none of its CPU goes to losses.
+constexpr double kInsertCpuRate = 100'000;
 
 int main(int argc, char** argv) {
   if (argc > 1 && std::string(argv[1]) == "--mac") {
@@ -934,6 +1116,10 @@ int main(int argc, char** argv) {
     const int repeats = argc > 2 ? std::atoi(argv[2]) : 5;
     const double seconds = argc > 3 ? std::atof(argv[3]) : 1.0;
     const int port = argc > 4 ? std::atoi(argv[4]) : 17667;
+    // Forks its replay processes, so it runs first, while this process has no other thread.
+    if (const int rc = PixelInsertCpu(repeats, 2 * seconds, port + 6, kInsertCpuRate); rc != 0) {
+      return rc;
+    }
     MacRows(repeats);
     if (const int rc = RunPixelLcm(repeats, seconds, port + 2, "", /*insert_only=*/true); rc != 0) {
       return rc;
@@ -950,6 +1136,10 @@ int main(int argc, char** argv) {
   const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
   const int port = argc > 3 ? std::atoi(argv[3]) : 17667;
 
+  // Forks its replay processes, so it runs first, while this process has no other thread.
+  if (const int rc = PixelInsertCpu(repeats, 2 * seconds, port + 6, kInsertCpuRate); rc != 0) {
+    return rc;
+  }
   if (const int rc = RunFlat(repeats, seconds, port); rc != 0) return rc;
   if (const int rc = RunPixelLcm(repeats, seconds, port + 2); rc != 0) return rc;
   MacRows(repeats);
