@@ -362,6 +362,12 @@ struct ServiceProbe {
 static_assert(std::atomic<double>::is_always_lock_free && std::atomic<int64_t>::is_always_lock_free,
               "a ServiceProbe is shared with a forked service process");
 
+// The MAC a bus with `key` signs and checks with, for the rows' "mac" field.
+const char* MacName(const std::string& key) {
+  if (key.empty()) return "none";
+  return rl::Gmac::Accelerated() ? "AES-256-GMAC, kernel GHASH" : "AES-256-GMAC, OpenSSL GHASH";
+}
+
 double CpuSeconds(clockid_t clock) {
   timespec t{};
   clock_gettime(clock, &t);
@@ -482,9 +488,7 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
       static_cast<long long>(probe.missing_frames.load() - missing_before),
       static_cast<long long>(probe.dropped.load() - dropped_before), first_batch_s,
       static_cast<long long>(kCapacity), rl::bench::Summarize(cpu_us).median,
-      bus->config().key.empty() ? "none"
-      : rl::Gmac::Accelerated() ? "AES-256-GMAC, kernel GHASH"
-                                : "AES-256-GMAC, OpenSSL GHASH");
+      MacName(bus->config().key));
   rl::bench::Emit(name, "transitions/s", rl::bench::Summarize(rates), repeats, extra);
   return true;
 }
@@ -607,10 +611,7 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
         "\"service_thread_cpu_us_per_transition_min\": %.3f, \"mac\": \"%s\"",
         kBatch, kHeight, kWidth, kStack, rate, seconds, cpu.median, cpu.min, cpu.max, lost.median,
         lost.max, rl::bench::Summarize(side.thread_cpu_us).median,
-        rl::bench::Summarize(side.thread_cpu_us).min,
-        side.key.empty()          ? "none"
-        : rl::Gmac::Accelerated() ? "AES-256-GMAC, kernel GHASH"
-                                  : "AES-256-GMAC, OpenSSL GHASH");
+        rl::bench::Summarize(side.thread_cpu_us).min, MacName(side.key));
     if (i == 1) {
       const auto cost = rl::bench::Summarize(mac_cost);
       std::snprintf(extra + n, sizeof(extra) - static_cast<size_t>(n),
