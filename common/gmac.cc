@@ -101,36 +101,44 @@ constexpr int kRows = Gmac::kPowerRows;
 constexpr size_t kStride = 64 * kRows;  // bytes hashed per reduction
 
 // GHASH (Horner's rule, X = (X ^ block) * H) over whole blocks from state x, a stride at a time:
-// X * H^64 ^ B1 * H^64 ^ B2 * H^63 ^ ... ^ B64 * H, one reduction per stride.
-__m128i HashBlocks(const uint8_t* powers, __m128i x, const uint8_t* p, size_t n) {
-  alignas(64) static constexpr uint8_t kReverse[64] = {
-      15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0,  //
-      15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0,  //
-      15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0,  //
-      15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0};
-  const __m512i reverse = _mm512_load_si512(kReverse);
-  __m512i rows[kRows], rows_xor[kRows];
-  for (int r = 0; r < kRows; ++r) {
-    rows[r] = _mm512_load_si512(powers + 64 * r);
-    rows_xor[r] = HalvesXor(rows[r]);
-  }
-  for (; n >= kStride; p += kStride, n -= kStride) {
-    __m512i lo = _mm512_setzero_si512(), mid = lo, hi = lo;
-    for (int r = 0; r < kRows; ++r) {
-      __m512i data = _mm512_shuffle_epi8(_mm512_loadu_si512(p + 64 * r), reverse);
-      if (r == 0) data = _mm512_xor_si512(data, _mm512_zextsi128_si512(x));
-      MultiplyAdd(data, rows[r], rows_xor[r], &lo, &mid, &hi);
+// X * H^64 ^ B1 * H^64 ^ B2 * H^63 ^ ... ^ B64 * H, one reduction per stride. The powers and their
+// Karatsuba halves are read from memory as they are used, so that the kernel keeps few registers
+// live (ymm0-15 and their upper halves, which the compiler's vzeroupper at return clears; a thread
+// that touches zmm16-31 makes every later context switch save and restore them).
+__m128i HashBlocks(const uint8_t* powers, const uint8_t* powers_xor, __m128i x, const uint8_t* p,
+                   size_t n) {
+  if (n >= 64) {
+    alignas(64) static constexpr uint8_t kReverse[64] = {
+        15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0,  //
+        15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0,  //
+        15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0,  //
+        15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0};
+    const __m512i reverse = _mm512_load_si512(kReverse);
+    auto row = [](const uint8_t* table, int r) { return _mm512_load_si512(table + 64 * r); };
+    for (; n >= kStride; p += kStride, n -= kStride) {
+      // Empty asm statements as barriers: the first keeps the compiler from hoisting the 32
+      // loads of powers out of the loop (and spilling them), the second from computing all 48
+      // products before adding them up (and spilling those).
+      asm("" : "+r"(powers), "+r"(powers_xor));
+      __m512i lo = _mm512_setzero_si512(), mid = lo, hi = lo;
+      for (int r = 0; r < kRows; ++r) {
+        __m512i data = _mm512_shuffle_epi8(_mm512_loadu_si512(p + 64 * r), reverse);
+        if (r == 0) data = _mm512_xor_si512(data, _mm512_zextsi128_si512(x));
+        MultiplyAdd(data, row(powers, r), row(powers_xor, r), &lo, &mid, &hi);
+        asm("" : "+v"(lo), "+v"(mid), "+v"(hi));
+      }
+      x = ReduceLanes(lo, mid, hi);
     }
-    x = ReduceLanes(lo, mid, hi);
+    for (; n >= 64; p += 64, n -= 64) {  // four blocks against H^4 .. H^1 (the last row)
+      __m512i lo = _mm512_setzero_si512(), mid = lo, hi = lo;
+      const __m512i data = _mm512_xor_si512(_mm512_shuffle_epi8(_mm512_loadu_si512(p), reverse),
+                                            _mm512_zextsi128_si512(x));
+      MultiplyAdd(data, row(powers, kRows - 1), row(powers_xor, kRows - 1), &lo, &mid, &hi);
+      x = ReduceLanes(lo, mid, hi);
+    }
   }
-  for (; n >= 64; p += 64, n -= 64) {  // four blocks against H^4 .. H^1 (the last row)
-    __m512i lo = _mm512_setzero_si512(), mid = lo, hi = lo;
-    const __m512i data = _mm512_xor_si512(_mm512_shuffle_epi8(_mm512_loadu_si512(p), reverse),
-                                          _mm512_zextsi128_si512(x));
-    MultiplyAdd(data, rows[kRows - 1], rows_xor[kRows - 1], &lo, &mid, &hi);
-    x = ReduceLanes(lo, mid, hi);
-  }
-  const __m128i h = _mm512_extracti64x2_epi64(rows[kRows - 1], 3);
+  // The last blocks (and the header's, the tail's and the length block) one at a time, against H.
+  const __m128i h = _mm_load_si128(reinterpret_cast<const __m128i*>(powers + 64 * kRows - 16));
   for (; n >= 16; p += 16, n -= 16) {
     x = Multiply(_mm_xor_si128(x, Reverse(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)))),
                  h);
@@ -144,7 +152,8 @@ bool Gmac::Accelerated() { return true; }
 
 void Gmac::Blocks(const uint8_t* data, size_t size) {
   const __m128i x = _mm_load_si128(reinterpret_cast<const __m128i*>(state_));
-  _mm_store_si128(reinterpret_cast<__m128i*>(state_), HashBlocks(powers_, x, data, size));
+  _mm_store_si128(reinterpret_cast<__m128i*>(state_),
+                  HashBlocks(powers_, powers_xor_, x, data, size));
 }
 
 #else
@@ -168,6 +177,7 @@ Gmac::Gmac() : cipher_(EVP_CIPHER_CTX_new()) {
 
 Gmac::~Gmac() {
   OPENSSL_cleanse(powers_, sizeof(powers_));
+  OPENSSL_cleanse(powers_xor_, sizeof(powers_xor_));
   OPENSSL_cleanse(mask_, sizeof(mask_));
 }
 
@@ -189,6 +199,7 @@ bool Gmac::SetKey(const uint8_t* key) {
       _mm_store_si128(reinterpret_cast<__m128i*>(powers_ + 64 * r + 16 * lane),
                       power[4 * kRows - 1 - 4 * r - lane]);
     }
+    _mm512_store_si512(powers_xor_ + 64 * r, HalvesXor(_mm512_load_si512(powers_ + 64 * r)));
   }
   OPENSSL_cleanse(h_bytes, sizeof(h_bytes));
   OPENSSL_cleanse(power, sizeof(power));
