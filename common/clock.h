@@ -18,6 +18,13 @@ inline double MonoSeconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+// Nanoseconds on the same monotonic clock, for timing short calls.
+inline int64_t MonoNanos() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
 // The rate of a growing count over the interval between two readings: the stats of every
 // process (steps/s, updates/s, inserts/s). Not thread-safe.
 class RateMeter {

@@ -71,7 +71,11 @@ void Bus::OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/,
 
 bool Bus::Sign(const std::string& channel, uint8_t* data, size_t size,
                const rlmsg::header_t& header) {
-  return auth_ == nullptr || auth_->Sign(channel, data, size, MacOffset(header.sender.size()));
+  if (auth_ == nullptr) return true;
+  const int64_t start = MonoNanos();
+  const bool ok = auth_->Sign(channel, data, size, MacOffset(header.sender.size()));
+  counters_.mac_nanos += MonoNanos() - start;
+  return ok;
 }
 
 bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header,
@@ -82,7 +86,10 @@ bool Bus::AcceptHeader(const std::string& channel, const rlmsg::header_t& header
     return false;
   }
   if (auth_ != nullptr) {
-    if (const char* why = auth_->Verify(channel, data, size, MacOffset(header.sender.size()))) {
+    const int64_t start = MonoNanos();
+    const char* why = auth_->Verify(channel, data, size, MacOffset(header.sender.size()));
+    counters_.mac_nanos += MonoNanos() - start;
+    if (why != nullptr) {
       ++counters_.unauthenticated;
       LogDrop(channel, "unauthenticated", why);
       return false;

@@ -198,6 +198,26 @@ TEST_F(KeyedBusTest, DeliversItsOwnSignedMessages) {
   EXPECT_EQ(bus_.counters().dropped(), 0);
 }
 
+// What authentication costs: the time of each signature and each check adds up, and only there.
+TEST_F(KeyedBusTest, TimesItsSignaturesAndChecks) {
+  EXPECT_EQ(bus_.counters().mac_nanos, 0);
+  auto m = MakeBatch(2, 4);
+  ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
+  const int64_t signed_only = bus_.counters().mac_nanos;
+  EXPECT_GT(signed_only, 0);
+  bus_.Handle(100);
+  ASSERT_EQ(got_.size(), 1U);
+  EXPECT_GT(bus_.counters().mac_nanos, signed_only);
+}
+
+TEST_F(BusTest, WithoutAKeySpendsNoTimeOnMacs) {
+  auto m = MakeBatch(2, 4);
+  ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
+  bus_.Handle(100);
+  ASSERT_EQ(got_.size(), 1U);
+  EXPECT_EQ(bus_.counters().mac_nanos, 0);
+}
+
 TEST_F(KeyedBusTest, DropsNoMacAWrongKeyAndEveryFlippedBitAsUnauthenticated) {
   Send(Stamped(1, 0, ""));                           // no MAC
   Send(Stamped(1, 1, std::string(kKeyBytes, 'x')));  // another run's key
