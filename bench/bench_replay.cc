@@ -37,7 +37,8 @@
 //   pixel_replay_insert_cpu[_mac]  the replay's CPU time per stored pixel transition (every
 //                             thread of a replay process of its own), one actor publishing at a
 //                             paced 100,000 transitions/s, without and with the key, in
-//                             alternating windows (PixelInsertCpu below).
+//                             alternating windows; the _mac row also gives the share of the
+//                             replay's CPU time its MAC checks took (PixelInsertCpu below).
 //
 // Snapshots (replay/snapshotter.h: fork, then the child writes), of a CarRacing-size pixel table
 // (capacity 100,000, frame capacity 130,000 of 84 x 84, prioritized; about 1 GB) and of a
@@ -58,6 +59,7 @@
 #include <malloc.h>
 #include <openssl/evp.h>
 #include <openssl/hmac.h>
+#include <sched.h>
 #include <sys/mman.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -87,6 +89,7 @@
 #include "common/channels.h"
 #include "common/check.h"
 #include "common/clock.h"
+#include "common/gmac.h"
 #include "common/message_auth.h"
 #include "replay/pixel_table.h"
 #include "replay/prioritized_sampler.h"
@@ -358,6 +361,7 @@ struct ServiceProbe {
   std::atomic<int64_t> dropped{0};             // malformed, invalid or refused
   std::atomic<double> cpu_seconds{0};          // the service thread's CPU time
   std::atomic<double> process_cpu_seconds{0};  // the whole process's (all its threads)
+  std::atomic<int64_t> mac_nanos{0};           // its bus's time checking MACs
 };
 static_assert(std::atomic<double>::is_always_lock_free && std::atomic<int64_t>::is_always_lock_free,
               "a ServiceProbe is shared with a forked service process");
@@ -366,6 +370,13 @@ static_assert(std::atomic<double>::is_always_lock_free && std::atomic<int64_t>::
 const char* MacName(const std::string& key) {
   if (key.empty()) return "none";
   return rl::Gmac::Accelerated() ? "AES-256-GMAC, kernel GHASH" : "AES-256-GMAC, OpenSSL GHASH";
+}
+
+void PinTo(int cpu) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(cpu, &set);
+  if (sched_setaffinity(0, sizeof(set), &set) != 0) std::perror("bench_replay: sched_setaffinity");
 }
 
 double CpuSeconds(clockid_t clock) {
@@ -392,6 +403,7 @@ void RunPixelService(int port, ServiceProbe* probe, const std::string& key) {
     probe->dropped.store(c.dropped() + service.counters().batches_refused);
     probe->cpu_seconds.store(CpuSeconds(CLOCK_THREAD_CPUTIME_ID));
     probe->process_cpu_seconds.store(CpuSeconds(CLOCK_PROCESS_CPUTIME_ID));
+    probe->mac_nanos.store(c.mac_nanos);
     return probe->stop.load();
   });
 }
@@ -497,19 +509,45 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
 // replay, which is what bounds its insert throughput, without and with the run's key. Two replay
 // services, each in a process of its own (forked before this process starts any thread), so that
 // a service's CPU time is that of all its threads (LCM's receive threads included) and of nothing
-// else. One actor per service publishes batches of kBatch transitions paced at `rate`
-// transitions/s, a rate both keep up with; the windows alternate between the two services, so
-// that the machine's drift falls on both. value: transitions stored per second of the replay's
-// CPU time (its insert capacity on one core); with the CPU time per transition, the share lost
-// and, in the _mac row, what the MAC takes off the capacity, window pair by window pair.
+// else; given two or more CPUs, the services run on the last and the actors on the first, so that
+// neither takes the other's. One actor per service publishes batches of kBatch transitions paced
+// at `rate` transitions/s, a rate both keep up with, and both actors compute a MAC per batch (the
+// unkeyed one drops it). The windows alternate between the two services in pairs of either
+// order, so that the machine's drift falls on both. value: transitions stored per second of the
+// replay's CPU time (its insert capacity on one core); with the CPU time per transition and the
+// share lost. The _mac row adds what the key costs the replay, two ways: its bus's time in MAC
+// checks over the replay's CPU time in the same window (mac_share_of_replay_cpu), and the capacity
+// lost against the unkeyed window of the same pair (mac_cost_fraction, which the machine's noise
+// widens).
 int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
   struct Side {
     std::string key;
     int port = 0;
     ServiceProbe* probe = nullptr;
     pid_t pid = -1;
-    std::vector<double> capacity, cpu_us, thread_cpu_us, lost;
+    std::vector<double> capacity, cpu_us, thread_cpu_us, lost, mac_share;
   };
+  // The first and the last of this process's CPUs (given back at the end), for the actors and
+  // the services.
+  cpu_set_t all_cpus;
+  int first_cpu = -1, last_cpu = -1;
+  if (sched_getaffinity(0, sizeof(all_cpus), &all_cpus) == 0) {
+    for (int c = 0; c < CPU_SETSIZE; ++c) {
+      if (!CPU_ISSET(c, &all_cpus)) continue;
+      if (first_cpu < 0) first_cpu = c;
+      last_cpu = c;
+    }
+  }
+  const bool pin = first_cpu >= 0 && last_cpu > first_cpu;
+  // The unkeyed side's actor computes a MAC too (over its batch's frames, nearly all of its
+  // bytes) and drops it, so that the actor's load on the machine is the same on both sides.
+  rl::Gmac unkeyed_signer;
+  const std::string signer_key(rl::Gmac::kKeyBytes, 's');
+  if (!unkeyed_signer.SetKey(reinterpret_cast<const uint8_t*>(signer_key.data()))) {
+    std::fprintf(stderr, "bench_replay: no AES-256 from OpenSSL\n");
+    return 1;
+  }
+  int64_t unkeyed_seq = 0;
   Side sides[2];
   sides[0].port = port;
   sides[1].key = std::string(rl::kKeyBytes, 'k');
@@ -522,6 +560,7 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
       munmap(side.probe, sizeof(ServiceProbe));
       side.probe = nullptr;
     }
+    if (pin) sched_setaffinity(0, sizeof(all_cpus), &all_cpus);
   };
   for (Side& side : sides) {
     void* shared = mmap(nullptr, sizeof(ServiceProbe), PROT_READ | PROT_WRITE,
@@ -540,11 +579,13 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
     }
     if (side.pid == 0) {
       prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (pin) PinTo(last_cpu);
       RunPixelService(side.port, side.probe, side.key);
       _exit(0);
     }
   }
 
+  if (pin) PinTo(first_cpu);
   std::vector<std::unique_ptr<rl::Bus>> buses;
   std::vector<std::unique_ptr<PixelActorSim>> sims;
   for (int i = 0; i < 2; ++i) {
@@ -566,18 +607,29 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
 
   std::vector<double> mac_cost;
   for (int r = 0; r < repeats; ++r) {
-    for (int i = 0; i < 2; ++i) {
+    // The pairs' order alternates (unkeyed first, then keyed first): a window measures slower
+    // after the other side's than before it (a few %, on this machine with no key on either side).
+    for (int k = 0; k < 2; ++k) {
+      const int i = r % 2 == 0 ? k : 1 - k;
       Side& side = sides[i];
       rl::Bus* bus = buses[i].get();
       const int64_t before = side.probe->inserts.load();
       const double cpu_before = side.probe->process_cpu_seconds.load();
       const double thread_before = side.probe->cpu_seconds.load();
+      const int64_t mac_before = side.probe->mac_nanos.load();
       int64_t sent = 0;
       const double start = rl::MonoSeconds();
       double next = start;
       while (rl::MonoSeconds() - start < seconds) {
         rlmsg::transition_batch_t* m = sims[i]->Next();
         bus->Publish(rl::channels::kTransitions, m);
+        if (i == 0) {
+          uint8_t nonce[rl::Gmac::kNonceBytes] = {}, tag[rl::Gmac::kTagBytes];
+          std::memcpy(nonce, &++unkeyed_seq, sizeof(unkeyed_seq));
+          unkeyed_signer.Start(nonce);
+          unkeyed_signer.Update(m->frames.data(), m->frames.size());
+          if (!unkeyed_signer.Finish(tag)) std::abort();
+        }
         sent += m->count;
         next += kBatch / rate;
         bus->Handle(0);
@@ -591,6 +643,8 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
       side.thread_cpu_us.push_back((side.probe->cpu_seconds.load() - thread_before) * 1e6 /
                                    static_cast<double>(std::max<int64_t>(1, stored)));
       side.lost.push_back(static_cast<double>(sent - stored) / static_cast<double>(sent));
+      side.mac_share.push_back(static_cast<double>(side.probe->mac_nanos.load() - mac_before) *
+                               1e-9 / std::max(cpu, 1e-9));
     }
     mac_cost.push_back(1.0 - sides[1].capacity.back() / sides[0].capacity.back());
   }
@@ -600,7 +654,7 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
     const Side& side = sides[i];
     const auto cpu = rl::bench::Summarize(side.cpu_us);
     const auto lost = rl::bench::Summarize(side.lost);
-    char extra[768];
+    char extra[1024];
     int n = std::snprintf(
         extra, sizeof(extra),
         "\"batch\": %d, \"frame\": \"%dx%d\", \"stack\": %d, \"transport\": \"udpm\", "
@@ -608,16 +662,18 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
         "\"replay_cpu_us_per_transition_median\": %.3f, \"replay_cpu_us_per_transition_min\": "
         "%.3f, \"replay_cpu_us_per_transition_max\": %.3f, \"lost_fraction_median\": %.4f, "
         "\"lost_fraction_max\": %.4f, \"service_thread_cpu_us_per_transition_median\": %.3f, "
-        "\"service_thread_cpu_us_per_transition_min\": %.3f, \"mac\": \"%s\"",
+        "\"service_thread_cpu_us_per_transition_min\": %.3f, \"pinned\": %s, \"mac\": \"%s\"",
         kBatch, kHeight, kWidth, kStack, rate, seconds, cpu.median, cpu.min, cpu.max, lost.median,
         lost.max, rl::bench::Summarize(side.thread_cpu_us).median,
-        rl::bench::Summarize(side.thread_cpu_us).min, MacName(side.key));
+        rl::bench::Summarize(side.thread_cpu_us).min, pin ? "true" : "false", MacName(side.key));
     if (i == 1) {
       const auto cost = rl::bench::Summarize(mac_cost);
+      const auto share = rl::bench::Summarize(side.mac_share);
       std::snprintf(extra + n, sizeof(extra) - static_cast<size_t>(n),
                     ", \"mac_cost_fraction_median\": %.4f, \"mac_cost_fraction_min\": %.4f, "
-                    "\"mac_cost_fraction_max\": %.4f",
-                    cost.median, cost.min, cost.max);
+                    "\"mac_cost_fraction_max\": %.4f, \"mac_share_of_replay_cpu_median\": %.4f, "
+                    "\"mac_share_of_replay_cpu_min\": %.4f, \"mac_share_of_replay_cpu_max\": %.4f",
+                    cost.median, cost.min, cost.max, share.median, share.min, share.max);
     }
     rl::bench::Emit(i == 0 ? "pixel_replay_insert_cpu" : "pixel_replay_insert_cpu_mac",
                     "transitions per replay CPU-second", rl::bench::Summarize(side.capacity),
