@@ -14,11 +14,14 @@
 #
 # Usage: scripts/launch.sh PRESET [options]
 #        scripts/launch.sh --resume RUN_DIR [options]
+#        scripts/launch.sh --stop RUN_DIR
 #   PRESET                 a preset in configs/ (cartpole, ...)
 #   --resume RUN_DIR       continue a stopped or crashed run in its folder: its copy of the
 #                          preset, run id and seed; the learner from its saved state, the
 #                          replay from its snapshot, the evaluator's history and the metrics
 #                          kept (options as below, except --out, --seed and --run-id)
+#   --stop RUN_DIR         stop the run going in RUN_DIR as Ctrl-C would (for a run started in
+#                          the background or in another terminal); waits until it has stopped
 #   --out DIR              run folder (default runs/<preset>-<timestamp>)
 #   --actors N             actor processes on this host (default: the preset's top-level
 #                          "actors = N", else 4)
@@ -50,6 +53,29 @@ die() { echo "launch: $*" >&2; exit 2; }
 
 [ $# -ge 1 ] || { usage; exit 2; }
 case "$1" in -h|--help) usage; exit 0 ;; esac
+
+# A run's launch script: "PID START" in RUN/launch.pid, START being the process's start time
+# (field 22 of /proc/PID/stat), so that a pid since reused by another process is not taken for it.
+# Nothing for a process that has ended (gone, or a zombie).
+launch_start() { awk '$3 != "Z" { print $22 }' "/proc/$1/stat" 2>/dev/null || true; }
+if [ "$1" = "--stop" ]; then
+  [ $# -eq 2 ] || die "--stop takes a run folder and nothing else"
+  dir=$(cd "$2" 2>/dev/null && pwd) || die "no run folder '$2'"
+  [ -f "$dir/config.ini" ] || die "$dir has no config.ini: not a run folder"
+  read -r pid start 2>/dev/null < "$dir/launch.pid" || true
+  if [[ ! "${pid:-}" =~ ^[0-9]+$ ]] || [ "$(launch_start "$pid")" != "${start:-}" ]; then
+    echo "launch: the run in $dir is not going"
+    exit 1
+  fi
+  echo "launch: stopping the run in $dir (launch.sh, pid $pid)"
+  kill -TERM "$pid" 2>/dev/null || true
+  # Its processes get 10 s to stop before they are killed, and its recorder a few more.
+  for _ in $(seq 600); do
+    [ "$(launch_start "$pid")" = "$start" ] || { echo "launch: stopped"; exit 0; }
+    sleep 0.1
+  done
+  die "the run in $dir has not stopped after 60 s (pid $pid)"
+fi
 out="" actors="" num_actors="" time_budget=600 goal="" seed=1 ttl=0 port="" run_id=""
 resume=""
 if [ "$1" = "--resume" ]; then
@@ -183,6 +209,7 @@ common=(--config "$out/config.ini" --run-id "$run_id" --key-file "$out/key" --lc
 pids=()
 roles=()
 : > "$out/pids"
+echo "$$ $(launch_start $$)" > "$out/launch.pid"
 
 [ -n "$resume" ] || : > "$out/restarts"
 touch "$out/restarts"

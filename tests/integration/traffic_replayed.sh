@@ -3,7 +3,7 @@
 # records its main port (launch.sh --record); with its actors stopped, lcm-logplayer plays a copy
 # of the recording back onto the run's port; the replay and the evaluator drop every recorded
 # message of their channels as replayed (exactly as many as the file holds), the replay inserts
-# nothing, and no lost count moves. Then the run goes on and stops cleanly.
+# nothing, and no lost count moves. Then the run goes on, and launch.sh --stop stops it cleanly.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
@@ -42,10 +42,21 @@ grep -q "dropped a replayed message" "$run/logs/replay.log" || fail "the replay 
 while read -r role pid; do
   kill -0 "$pid" 2>/dev/null || fail "$role (pid $pid) died"
 done < <(awk '{p[$1] = $2} END {for (r in p) print r, p[r]}' "$run/pids")
-kill -INT -- "-$launch_pid"
+# Stopped from outside, as a run in the background or in another terminal is.
+"$root/scripts/launch.sh" --stop "$run" > "$dir/stop.log" 2>&1 || fail "launch.sh --stop: $(cat "$dir/stop.log")"
+grep -q "^launch: stopped" "$dir/stop.log" || fail "launch.sh --stop did not wait for the stop"
+while read -r role pid; do
+  kill -0 "$pid" 2>/dev/null && fail "$role (pid $pid) was still running when --stop returned"
+done < "$run/pids"
 set +e
 wait "$launch_pid"
 status=$?
 set -e
-[ "$status" -eq 130 ] || fail "launch exited with $status after Ctrl-C, expected 130"
+[ "$status" -eq 130 ] || fail "launch exited with $status after --stop, expected 130"
+set +e
+"$root/scripts/launch.sh" --stop "$run" > "$dir/stop2.log" 2>&1
+status=$?
+set -e
+[ "$status" -eq 1 ] && grep -q "is not going" "$dir/stop2.log" ||
+  fail "a second --stop did not say the run is not going (status $status): $(cat "$dir/stop2.log")"
 echo "PASS: a recording played back into its run was dropped as replayed and changed nothing"
