@@ -103,8 +103,8 @@ constexpr size_t kStride = 64 * kRows;  // bytes hashed per reduction
 // GHASH (Horner's rule, X = (X ^ block) * H) over whole blocks from state x, a stride at a time:
 // X * H^64 ^ B1 * H^64 ^ B2 * H^63 ^ ... ^ B64 * H, one reduction per stride. The powers and their
 // Karatsuba halves are read from memory as they are used, so that the kernel keeps few registers
-// live (ymm0-15 and their upper halves, which the compiler's vzeroupper at return clears; a thread
-// that touches zmm16-31 makes every later context switch save and restore them).
+// live: zmm0-15 only, whose upper bits the compiler's vzeroupper clears at return (once a thread
+// has touched zmm16-31, its context switches save and restore them).
 __m128i HashBlocks(const uint8_t* powers, const uint8_t* powers_xor, __m128i x, const uint8_t* p,
                    size_t n) {
   if (n >= 64) {
