@@ -361,7 +361,7 @@ struct ServiceProbe {
   std::atomic<int64_t> dropped{0};             // malformed, invalid or refused
   std::atomic<double> cpu_seconds{0};          // the service thread's CPU time
   std::atomic<double> process_cpu_seconds{0};  // the whole process's (all its threads)
-  std::atomic<int64_t> mac_nanos{0};           // its bus's time checking MACs
+  std::atomic<int64_t> mac_nanos{0};           // its bus's MAC time (checks, and its own signing)
 };
 static_assert(std::atomic<double>::is_always_lock_free && std::atomic<int64_t>::is_always_lock_free,
               "a ServiceProbe is shared with a forked service process");
