@@ -27,6 +27,7 @@ packages=(
   libeigen3-dev libboost-program-options-dev libgtest-dev libssl-dev
   libbox2d-dev libbullet-dev libopencv-dev libosmesa6-dev
   clang-14 libclang-rt-14-dev llvm-14  # fuzz/: clang, libFuzzer and sanitizers, symbolizer
+  clang-tidy-14  # scripts/tidy.sh
   iproute2 util-linux procps
   chromium  # headless: the integration test that renders the report and compare pages
 )
