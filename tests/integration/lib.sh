@@ -83,3 +83,23 @@ wait_line() {  # wait_line FILE PATTERN TIMEOUT_SECONDS
 run_setting() { sed -n "s/^# $2 = //p" "$1/config.ini"; }
 
 launch() { "$root/scripts/launch.sh" "$@" --no-setup --build-dir "$build_dir"; }
+
+# The last value of FIELD in ROLE's rows of a run's metrics.jsonl (empty when it has none).
+last_metric() {  # last_metric RUN_DIR ROLE FIELD
+  grep -F "\"role\": \"$2\"," "$1/metrics.jsonl" 2>/dev/null | tail -1 |
+    sed -n "s/.*\"$3\": \([-0-9.e+]*\)[,}].*/\1/p"
+}
+
+# The highest "update" of a run's eval.jsonl (-1 when it has none).
+last_scored_update() {  # last_scored_update RUN_DIR
+  { sed -n 's/.*"update": \([0-9]*\).*/\1/p' "$1/eval.jsonl" 2>/dev/null; echo -1; } | sort -n | tail -1
+}
+
+# Fails when a process of the run reported a sanitizer finding in its log (ASan, LSan, UBSan or
+# TSan, on a sanitizer build): the process aborted, and its restart would hide it.
+expect_no_sanitizer_reports() {  # expect_no_sanitizer_reports RUN_DIR
+  local pattern='^==[0-9]+==ERROR: (Address|Leak)Sanitizer|runtime error: |WARNING: ThreadSanitizer'
+  local found
+  found=$(grep -l -E "$pattern" "$1"/logs/*.log 2>/dev/null || true)
+  [ -z "$found" ] || { grep -h -A30 -E "$pattern" $found | head -80 >&2; fail "sanitizer reports in" $found; }
+}
