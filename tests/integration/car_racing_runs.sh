@@ -4,7 +4,9 @@
 # dimensions over LCM) for a bounded time: frames stored, nothing lost or dropped, and the
 # evaluator scoring checkpoints on the unmodified environment (no no-op start, no off-track rule,
 # every frame's reward) and new best ones on the article's rules as well. Learning CarRacing takes
-# hours; this test checks the plumbing.
+# hours; this test checks the plumbing, and that it kept working to the end of the budget: a run
+# that stalled and sat out its time fails, since the replay's inserts, the learner's updates and
+# the evaluator's scored checkpoints must all grow over the second half of the run.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
@@ -30,4 +32,20 @@ if grep -q 'off-track=1' "$dir/run/logs/evaluator.log"; then fail "the evaluator
 grep -q '"second_episodes": 2' "$dir/run/eval.jsonl" || fail "no second metric in eval.jsonl"
 grep -q "the TD3 article&#39;s rules\|the TD3 article's rules" "$dir/run/report/index.html" ||
   fail "the report does not name the second metric"
-echo "PASS: CarRacing TD3 pipeline ran; $(wc -l < "$dir/run/eval.jsonl") evaluations on the unmodified env"
+# Progress over the second half of the run, from the metrics rows (t: seconds since the monitor
+# started): for each count, its value at the last row of the first half and at the last row.
+progress() {  # progress ROLE FIELD: prints "VALUE_AT_HALF VALUE_AT_END END_SECONDS"
+  grep -F "\"role\": \"$1\"," "$dir/run/metrics.jsonl" |
+    sed -n "s/^{\"t\": \([0-9.]*\),.*\"$2\": \([0-9.e+]*\)[,}].*/\1 \2/p" |
+    awk -v end="$(tail -1 "$dir/run/metrics.jsonl" | sed -n 's/^{"t": \([0-9.]*\),.*/\1/p')" '
+      $1 <= end / 2 { half = $2 } { last = $2; t = $1 } END { printf "%d %d %d", half, last, t }'
+}
+report=""
+for count in "replay inserts" "learner updates" "evaluator checkpoints_scored"; do
+  read -r half last end <<<"$(progress $count)"
+  report+="${count/ /\'s } ${half:-?} at half time, ${last:-?} at ${end:-?} s; "
+  [ -n "$last" ] && [ "$last" -gt "${half:-0}" ] ||
+    fail "the run stalled: ${count/ /\'s } did not grow over the second half ($half -> $last)"
+done
+echo "progress: $report"
+echo "PASS: CarRacing TD3 pipeline ran to the end of its budget; $(wc -l < "$dir/run/eval.jsonl") evaluations on the unmodified env"
