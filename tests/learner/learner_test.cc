@@ -10,6 +10,7 @@
 
 #include "common/channels.h"
 #include "nn/checkpoint.h"
+#include "nn/parallel.h"
 #include "rlmsg/checkpoint_t.hpp"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
@@ -213,6 +214,26 @@ TEST_F(LearnerTest, TrainsOnPixelBatchesAndSendsTheirTdErrorsAsPriorities) {
   EXPECT_NE(updates.back().priority[0], updates.back().priority[1]);
   const nn::Checkpoint ckpt = nn::LoadCheckpoint(announced_.back());
   EXPECT_EQ(ckpt.meta.env_steps, 4321);
+}
+
+// With two compute threads (--threads 2) the learner trains as with one, its convolution split
+// over nn's pool (ThreadSanitizer runs this test: scripts/test.sh, preset tsan).
+TEST_F(LearnerTest, TrainsOnTwoComputeThreads) {
+  pixels_ = true;
+  LearnerConfig c = ShortRun(256, 5, 100);
+  c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)";
+  // 256 x 64 x 2 x 9 x 50 = 14.7M multiply-adds per convolution: enough to be split.
+  c.dqn.network = "conv2d(2,64,3,1,1,10,5),relu,flatten,linear(3200,3)";
+  c.threads = 2;
+  const int64_t sections = nn::internal::ParallelSections();
+  {
+    Learner learner(c, bus_.get());
+    learner.Run();
+    bus_->Handle(0);
+    EXPECT_EQ(learner.updates(), 5);
+  }
+  EXPECT_GT(nn::internal::ParallelSections(), sections) << "nothing ran on two threads";
+  nn::SetNumThreads(1);
 }
 
 TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFiles) {
