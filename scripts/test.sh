@@ -125,12 +125,18 @@ if [ ${#junits[@]} -gt 0 ]; then
     sort -rn | head -15 | awk '{ printf "  %8.1f %s\n", $1, $2 }'
 fi
 # One closing line: every test of every run, and every failed step as one failure.
-counts=$(cat "${junits[@]}" /dev/null |
-  sed -n 's/.*<testsuite [^>]*tests="\([0-9]*\)" failures="\([0-9]*\)".*/\1 \2/p' |
-  awk '{ t += $1; f += $2 } END { print t + 0, f + 0 }')
-read -r total failures <<<"$counts"
-failures=$((failures + ${#failed_steps[@]}))
+total=0 failures=0 skipped=0
+attribute() {  # attribute NAME FILE: the testsuite's count NAME (0 when missing)
+  local v
+  v=$(grep -o "$1=\"[0-9]*\"" "$2" | head -1 | tr -dc '0-9')
+  echo "${v:-0}"
+}
+for junit in ${junits[@]+"${junits[@]}"}; do
+  total=$((total + $(attribute tests "$junit")))
+  failures=$((failures + $(attribute failures "$junit")))
+  skipped=$((skipped + $(attribute skipped "$junit") + $(attribute disabled "$junit")))
+done
 [ ${#failed_steps[@]} -eq 0 ] || echo "test: failed steps: ${failed_steps[*]}"
-[ "$failures" -eq 0 ] || status=1
-echo "$((total - (failures - ${#failed_steps[@]}))) passed, $failures failed"
+[ $((failures + ${#failed_steps[@]})) -eq 0 ] || status=1
+echo "$((total - failures - skipped)) passed, $((failures + ${#failed_steps[@]})) failed, $skipped skipped"
 exit "$status"
