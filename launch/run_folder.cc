@@ -1,0 +1,204 @@
+#include "launch/run_folder.h"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/random.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "common/text_format.h"
+#include "launch/launch_options.h"
+#include "launch/proc.h"
+
+namespace rl::launch {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string ErrnoText() { return std::strerror(errno); }
+
+// A number's shortest text that reads back the same (600, 2.5).
+std::string Number(double v) { return FormatDouble("%.15g", v); }
+
+}  // namespace
+
+int RunHeader::Port() const {
+  static const std::regex port(R"(^udpm://[0-9.]+:([0-9]+))");
+  std::smatch m;
+  if (!std::regex_search(lcm_url, m, port)) return 0;
+  return std::stoi(m[1].str());
+}
+
+std::string FormatRunHeader(const RunHeader& h) {
+  std::string s = "# Run of preset '" + h.preset + "', started " + h.started + "\n";
+  s += "# run-id = " + std::to_string(h.run_id) + "\n";
+  s += "# lcm-url = " + h.lcm_url + "\n";
+  s += "# lcm-bulk-url = " + h.lcm_bulk_url + "\n";
+  s += "# actors = " + std::to_string(h.actors) + " (of " + std::to_string(h.num_actors) +
+       "), seed = " + std::to_string(h.seed) + ", goal = " + h.goal +
+       ", time budget = " + Number(h.time_budget) + " s\n";
+  if (!h.extra.empty()) s += "# extra: " + h.extra + "\n";
+  return s;
+}
+
+RunHeader ParseRunHeader(const std::string& config_text, const std::string& path) {
+  static const std::regex preset(R"(^# Run of preset '(.*)', started (.*)$)");
+  static const std::regex run_id(R"(^# run-id = ([0-9]+)\s*$)");
+  static const std::regex url(R"(^# lcm-url = (\S+)\s*$)");
+  static const std::regex bulk_url(R"(^# lcm-bulk-url = (\S+)\s*$)");
+  static const std::regex actors(
+      R"(^# actors = ([0-9]+) \(of ([0-9]+)\), seed = ([0-9]+), goal = ([^,]*), time budget = ([^ ]*) s)");
+  static const std::regex extra(R"(^# extra: (.*)$)");
+  RunHeader h;
+  bool have_preset = false, have_id = false, have_actors = false;
+  std::istringstream in(config_text);
+  std::smatch m;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] != '#') continue;
+    if (!have_preset && std::regex_match(line, m, preset)) {
+      h.preset = m[1].str();
+      h.started = m[2].str();
+      have_preset = true;
+    } else if (!have_id && std::regex_match(line, m, run_id)) {
+      h.run_id = std::stoll(m[1].str());
+      have_id = true;
+    } else if (h.lcm_url.empty() && std::regex_match(line, m, url)) {
+      h.lcm_url = m[1].str();
+    } else if (h.lcm_bulk_url.empty() && std::regex_match(line, m, bulk_url)) {
+      h.lcm_bulk_url = m[1].str();
+    } else if (!have_actors && std::regex_search(line, m, actors)) {
+      h.actors = std::stoi(m[1].str());
+      h.num_actors = std::stoi(m[2].str());
+      h.seed = std::stoull(m[3].str());
+      h.goal = m[4].str();
+      h.time_budget = std::strtod(m[5].str().c_str(), nullptr);
+      have_actors = true;
+    } else if (h.extra.empty() && std::regex_match(line, m, extra)) {
+      h.extra = m[1].str();
+    }
+  }
+  if (!have_preset || !have_id || !have_actors) {
+    throw LaunchError(path + " lacks the launcher's header (preset, run id, actors and seed)");
+  }
+  return h;
+}
+
+std::string LocalTimeNow(const char* format) {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  localtime_r(&now, &tm);
+  char buf[64];
+  std::strftime(buf, sizeof(buf), format, &tm);
+  return buf;
+}
+
+std::string IsoNow() {
+  const std::string s = LocalTimeNow("%Y-%m-%dT%H:%M:%S%z");
+  if (s.size() < 5) return s;
+  return s.substr(0, s.size() - 2) + ":" + s.substr(s.size() - 2);  // +0100 -> +01:00
+}
+
+std::string CreateRunFolder(const std::string& path, bool suffix_when_taken) {
+  std::error_code ec;
+  const fs::path wanted = fs::absolute(path, ec).lexically_normal();
+  if (ec) throw LaunchError("cannot create the run folder " + path + ": " + ec.message());
+  const std::string base = wanted.has_filename() ? wanted.string() : wanted.parent_path().string();
+  fs::create_directories(fs::path(base).parent_path(), ec);
+  if (ec) throw LaunchError("cannot create the run folder " + base + ": " + ec.message());
+  for (int k = 1; k <= 1000; ++k) {
+    const std::string candidate = k == 1 ? base : base + "-" + std::to_string(k);
+    if (mkdir(candidate.c_str(), 0777) == 0) return candidate;
+    if (errno != EEXIST) {
+      throw LaunchError("cannot create the run folder " + candidate + ": " + ErrnoText());
+    }
+    if (suffix_when_taken) continue;
+    if (!fs::is_directory(candidate, ec)) {
+      throw LaunchError("cannot create the run folder " + candidate +
+                        ": it exists and is no folder");
+    }
+    if (fs::is_empty(candidate, ec) && !ec) return candidate;
+    throw LaunchError("the run folder " + candidate +
+                      " exists and is not empty (pick another --out, or continue its run with "
+                      "--resume " +
+                      candidate + ")");
+  }
+  throw LaunchError("cannot create the run folder " + base + ": 1000 folders of that name exist");
+}
+
+RunLock::RunLock(const std::string& run_dir) {
+  const std::string path = run_dir + "/lock";
+  fd_ = open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw LaunchError("cannot create the lock file " + path + ": " + ErrnoText());
+  if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    close(fd_);
+    fd_ = -1;
+    if (err != EWOULDBLOCK) throw LaunchError("cannot lock " + path + ": " + std::strerror(err));
+    const std::optional<pid_t> pid = RunningLauncher(run_dir);
+    throw LaunchError("the run in " + run_dir + " is going (" +
+                      (pid ? "launcher pid " + std::to_string(*pid) : "another launcher") +
+                      "): stop it with scripts/launch.sh --stop " + run_dir + " first");
+  }
+}
+
+RunLock::~RunLock() {
+  if (fd_ >= 0) close(fd_);
+}
+
+void WriteLaunchPid(const std::string& run_dir) {
+  const pid_t pid = getpid();
+  std::ofstream out(run_dir + "/launch.pid", std::ios::trunc);
+  out << pid << " " << ProcessStartTime(pid) << "\n";
+  if (!out.flush()) throw LaunchError("cannot write " + run_dir + "/launch.pid");
+}
+
+std::optional<pid_t> RunningLauncher(const std::string& run_dir) {
+  std::ifstream in(run_dir + "/launch.pid");
+  long long pid = 0;
+  uint64_t start = 0;
+  if (!(in >> pid >> start) || pid <= 0) return std::nullopt;
+  if (!SameProcessAlive(static_cast<pid_t>(pid), start)) return std::nullopt;
+  return static_cast<pid_t>(pid);
+}
+
+void EnsureKeyFile(const std::string& path) {
+  std::error_code ec;
+  if (fs::is_regular_file(path, ec) && fs::file_size(path, ec) > 0 && !ec) return;
+  unsigned char key[32];
+  size_t got = 0;
+  while (got < sizeof(key)) {
+    const ssize_t n = getrandom(key + got, sizeof(key) - got, 0);
+    if (n < 0 && errno != EINTR) throw LaunchError("cannot make the run's key: " + ErrnoText());
+    if (n > 0) got += static_cast<size_t>(n);
+  }
+  const std::string tmp = path + ".tmp";
+  const int fd = open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+  bool ok = fd >= 0 && fchmod(fd, 0600) == 0 &&
+            write(fd, key, sizeof(key)) == static_cast<ssize_t>(sizeof(key)) && fsync(fd) == 0;
+  const std::string why = ErrnoText();
+  if (fd >= 0) ok = close(fd) == 0 && ok;
+  if (!ok || rename(tmp.c_str(), path.c_str()) != 0) {
+    unlink(tmp.c_str());
+    throw LaunchError("cannot write the run's key file " + path + ": " + (ok ? ErrnoText() : why));
+  }
+}
+
+int64_t RandomRunId() {
+  uint64_t v = 0;
+  unsigned char bytes[6];
+  if (getrandom(bytes, sizeof(bytes), 0) != static_cast<ssize_t>(sizeof(bytes))) {
+    throw LaunchError("cannot draw a run id: " + ErrnoText());
+  }
+  for (unsigned char b : bytes) v = (v << 8) | b;
+  return static_cast<int64_t>(v) + 1;
+}
+
+}  // namespace rl::launch
