@@ -36,4 +36,5 @@ while read -r role pid; do
 done < "$run/pids"
 grep -q "stopped" "$run/logs/replay.log" "$run/logs/learner.log" || fail "no clean stop"
 [ -s "$run/report/index.html" ] || fail "no report after Ctrl-C"
+expect_no_restarts "$run"
 echo "PASS: every bad message counted and dropped ($preset, $env_id); clean stop"

@@ -30,4 +30,5 @@ if grep -q 'off-track=1' "$dir/run/logs/evaluator.log"; then fail "the evaluator
 grep -q '"second_episodes": 2' "$dir/run/eval.jsonl" || fail "no second metric in eval.jsonl"
 grep -q "the TD3 article&#39;s rules\|the TD3 article's rules" "$dir/run/report/index.html" ||
   fail "the report does not name the second metric"
+expect_no_restarts "$dir/run"
 echo "PASS: CarRacing TD3 pipeline ran; $(wc -l < "$dir/run/eval.jsonl") evaluations on the unmodified env"
