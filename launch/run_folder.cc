@@ -7,11 +7,12 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 #include "common/text_format.h"
@@ -31,10 +32,11 @@ std::string Number(double v) { return FormatDouble("%.15g", v); }
 }  // namespace
 
 int RunHeader::Port() const {
-  static const std::regex port(R"(^udpm://[0-9.]+:([0-9]+))");
-  std::smatch m;
-  if (!std::regex_search(lcm_url, m, port)) return 0;
-  return std::stoi(m[1].str());
+  // udpm://GROUP:PORT?options
+  const size_t scheme = lcm_url.find("://");
+  const size_t colon = lcm_url.find(':', scheme == std::string::npos ? 0 : scheme + 3);
+  if (scheme == std::string::npos || colon == std::string::npos) return 0;
+  return std::atoi(lcm_url.c_str() + colon + 1);
 }
 
 std::string FormatRunHeader(const RunHeader& h) {
@@ -50,39 +52,44 @@ std::string FormatRunHeader(const RunHeader& h) {
 }
 
 RunHeader ParseRunHeader(const std::string& config_text, const std::string& path) {
-  static const std::regex preset(R"(^# Run of preset '(.*)', started (.*)$)");
-  static const std::regex run_id(R"(^# run-id = ([0-9]+)\s*$)");
-  static const std::regex url(R"(^# lcm-url = (\S+)\s*$)");
-  static const std::regex bulk_url(R"(^# lcm-bulk-url = (\S+)\s*$)");
-  static const std::regex actors(
-      R"(^# actors = ([0-9]+) \(of ([0-9]+)\), seed = ([0-9]+), goal = ([^,]*), time budget = ([^ ]*) s)");
-  static const std::regex extra(R"(^# extra: (.*)$)");
   RunHeader h;
   bool have_preset = false, have_id = false, have_actors = false;
   std::istringstream in(config_text);
-  std::smatch m;
+  // The rest of `line` after `prefix`, when it starts with it.
+  const auto after = [](const std::string& line, const char* prefix) -> std::optional<std::string> {
+    const size_t n = std::strlen(prefix);
+    if (line.compare(0, n, prefix) != 0) return std::nullopt;
+    return line.substr(n);
+  };
   for (std::string line; std::getline(in, line);) {
+    while (!line.empty() && (line.back() == ' ' || line.back() == '\r')) line.pop_back();
     if (line.empty() || line[0] != '#') continue;
-    if (!have_preset && std::regex_match(line, m, preset)) {
-      h.preset = m[1].str();
-      h.started = m[2].str();
+    if (const auto rest = after(line, "# Run of preset '"); rest && !have_preset) {
+      const size_t end = rest->rfind("', started ");
+      if (end == std::string::npos) continue;
+      h.preset = rest->substr(0, end);
+      h.started = rest->substr(end + 11);
       have_preset = true;
-    } else if (!have_id && std::regex_match(line, m, run_id)) {
-      h.run_id = std::stoll(m[1].str());
-      have_id = true;
-    } else if (h.lcm_url.empty() && std::regex_match(line, m, url)) {
-      h.lcm_url = m[1].str();
-    } else if (h.lcm_bulk_url.empty() && std::regex_match(line, m, bulk_url)) {
-      h.lcm_bulk_url = m[1].str();
-    } else if (!have_actors && std::regex_search(line, m, actors)) {
-      h.actors = std::stoi(m[1].str());
-      h.num_actors = std::stoi(m[2].str());
-      h.seed = std::stoull(m[3].str());
-      h.goal = m[4].str();
-      h.time_budget = std::strtod(m[5].str().c_str(), nullptr);
-      have_actors = true;
-    } else if (h.extra.empty() && std::regex_match(line, m, extra)) {
-      h.extra = m[1].str();
+    } else if (const auto id = after(line, "# run-id = "); id && !have_id) {
+      char* end = nullptr;
+      h.run_id = std::strtoll(id->c_str(), &end, 10);
+      have_id = !id->empty() && *end == '\0';
+    } else if (const auto url = after(line, "# lcm-url = "); url && h.lcm_url.empty()) {
+      h.lcm_url = *url;
+    } else if (const auto bulk = after(line, "# lcm-bulk-url = "); bulk && h.lcm_bulk_url.empty()) {
+      h.lcm_bulk_url = *bulk;
+    } else if (after(line, "# actors = ") && !have_actors) {
+      // "# actors = 4 (of 4), seed = 1, goal = 475, time budget = 600 s"
+      unsigned long long seed = 0;
+      char goal[64] = {};
+      have_actors = std::sscanf(line.c_str(),
+                                "# actors = %d (of %d), seed = %llu, goal = %63[^,], time budget "
+                                "= %lf s",
+                                &h.actors, &h.num_actors, &seed, goal, &h.time_budget) == 5;
+      h.seed = seed;
+      h.goal = goal;
+    } else if (const auto extra = after(line, "# extra: "); extra && h.extra.empty()) {
+      h.extra = *extra;
     }
   }
   if (!have_preset || !have_id || !have_actors) {
