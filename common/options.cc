@@ -8,6 +8,16 @@
 #include <stdexcept>
 
 namespace rl {
+namespace {
+
+bool IsConfigSection(const std::string& name) {
+  for (const char* section : kConfigSections) {
+    if (name == section) return true;
+  }
+  return false;
+}
+
+}  // namespace
 
 BusConfig CommonOptions::MakeBusConfig(const std::string& sender) const {
   BusConfig c;
@@ -22,6 +32,9 @@ BusConfig CommonOptions::MakeBusConfig(const std::string& sender) const {
 void AddCommonOptions(po::options_description* desc, CommonOptions* common) {
   desc->add_options()                         //
       ("help,h", "print this help and exit")  //
+      ("list-options",
+       "print the names of the options a preset may set for this process, one a line, and "
+       "exit")  //
       ("config", po::value(&common->config_file),
        "INI preset (top-level keys and the keys of this process's section)")  //
       ("run-id", po::value(&common->run_id)->default_value(common->run_id),
@@ -42,6 +55,13 @@ bool ParseOptions(int argc, char** argv, const std::string& role, const std::str
     std::cout << usage << "\n\n" << desc << "\n";
     return false;
   }
+  if (vm->count("list-options")) {
+    for (const auto& option : desc.options()) {
+      const std::string& name = option->long_name();
+      if (name != "help" && name != "config" && name != "list-options") std::cout << name << "\n";
+    }
+    return false;
+  }
   if (vm->count("config")) {
     const std::string path = (*vm)["config"].as<std::string>();
     std::ifstream in(path);
@@ -55,6 +75,15 @@ bool ParseOptions(int argc, char** argv, const std::string& role, const std::str
     std::set<std::string> in_section;
     for (po::option& opt : parsed.options) {
       const std::string& key = opt.string_key;
+      if (const size_t dot = key.find('.'); dot != std::string::npos) {
+        const std::string section = key.substr(0, dot);
+        if (section != role && !IsConfigSection(section)) {
+          throw std::runtime_error("config file '" + path + "': unknown section [" + section +
+                                   "] (key '" + key.substr(dot + 1) +
+                                   "'); the sections are [actor], [replay], [learner] and "
+                                   "[evaluator]");
+        }
+      }
       if (key.rfind(prefix, 0) != 0) continue;
       opt.string_key = key.substr(prefix.size());
       if (desc.find_nothrow(opt.string_key, false) == nullptr) {

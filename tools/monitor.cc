@@ -112,7 +112,9 @@ int Main(int argc, char** argv) {
       ("time-budget", rl::po::value(&time_budget)->default_value(time_budget),
        "seconds after which the run ends unsolved")  //
       ("stale-seconds", rl::po::value(&stale_seconds)->default_value(stale_seconds),
-       "a replay, learner or evaluator silent this long ends the run")  //
+       "a replay, learner or evaluator silent this long ends the run (the launcher passes its "
+       "longest restart backoff plus the time a restarted process has to get ready, plus 5 s, "
+       "so that a process being restarted is not taken for one that hangs)")  //
       ("print-seconds", rl::po::value(&print_seconds)->default_value(print_seconds),
        "seconds between progress lines")  //
       ("metrics", rl::po::value(&metrics_path),

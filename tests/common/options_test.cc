@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -62,6 +64,35 @@ TEST(OptionsTest, AnUnknownKeyInOurSectionIsRefusedWithItsName) {
               std::string::npos)
         << e.what();
   }
+}
+
+TEST(OptionsTest, ASectionOfNoProcessIsRefusedWithItsName) {
+  try {
+    Parse("env = CartPole-v1\n[lerner]\nlearning-rate = 0.001\n");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown section [lerner] (key 'learning-rate')"),
+              std::string::npos)
+        << e.what();
+  }
+  // The other processes' sections are not ours, but no error.
+  EXPECT_EQ(Parse("[replay]\ncapacity = 5\n[learner]\nx = 1\n").episodes, 100);
+}
+
+TEST(OptionsTest, ListOptionsPrintsTheNamesAPresetMaySet) {
+  CommonOptions common;
+  po::options_description desc("Options");
+  AddCommonOptions(&desc, &common);
+  desc.add_options()("episodes", po::value<int>(), "episodes");
+  std::string program = "evaluator", flag = "--list-options";
+  char* argv[] = {program.data(), flag.data()};
+  po::variables_map vm;
+  std::ostringstream out;
+  std::streambuf* saved = std::cout.rdbuf(out.rdbuf());
+  const bool go_on = ParseOptions(2, argv, "evaluator", "usage", desc, &vm);
+  std::cout.rdbuf(saved);
+  EXPECT_FALSE(go_on);
+  EXPECT_EQ(out.str(), "run-id\nkey-file\nlcm-url\nlcm-bulk-url\nepisodes\n");
 }
 
 }  // namespace

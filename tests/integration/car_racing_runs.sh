@@ -51,4 +51,5 @@ echo "progress over the second half (${end} s of metrics): replay inserts $inser
 [ "$updates_end" -gt "$updates_half" ] || fail "the run stalled: no learner update in its second half"
 [ "$scored" -gt "$updates_half" ] ||
   fail "the run stalled: the evaluator scored no checkpoint made in the second half"
+expect_no_restarts "$dir/run"
 echo "PASS: CarRacing TD3 pipeline ran to the end of its budget; $(wc -l < "$dir/run/eval.jsonl") evaluations on the unmodified env"

@@ -59,4 +59,5 @@ status=$?
 set -e
 [ "$status" -eq 1 ] && grep -q "is not going" "$dir/stop2.log" ||
   fail "a second --stop did not say the run is not going (status $status): $(cat "$dir/stop2.log")"
+expect_no_restarts "$run"
 echo "PASS: a recording played back into its run was dropped as replayed and changed nothing"
