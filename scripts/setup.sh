@@ -28,6 +28,7 @@ packages=(
   libbox2d-dev libbullet-dev libopencv-dev libosmesa6-dev
   clang-14 libclang-rt-14-dev llvm-14  # fuzz/: clang, libFuzzer and sanitizers, symbolizer
   iproute2 util-linux procps
+  slurm-wlm munge  # tests/cluster: a Slurm cluster in namespaces for the cluster tests
   chromium  # headless: the integration test that renders the report and compare pages
 )
 missing=()
