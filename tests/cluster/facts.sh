@@ -5,17 +5,18 @@
 # README.md's facts come from it.
 #
 #   tests/cluster/facts.sh [EXPERIMENT...]      all by default, in this order:
-#     env cpus exits srun_signals orphan scancel requeue timelimit timelimit_steps lost_nokill
-#     lost bcast lcm
+#     env cpus exits srun_signals orphan scancel requeue timelimit timelimit_steps selfrequeue
+#     lost_nokill lost bcast lcm
 #
 # Root only. It brings a 3-node cluster up and down, or uses the one in $CLUSTER_DIR if one is up
-# there. The timelimit ones take about 90 s each, the lost ones about 60 s each.
+# there. timelimit, timelimit_steps and selfrequeue take about 90 s each, the lost ones about
+# 60 s each; all of them about 15 minutes.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 source "$here/cluster.sh"
 
-experiments=(env cpus exits srun_signals orphan scancel requeue timelimit timelimit_steps lost_nokill lost
-  bcast lcm)
+experiments=(env cpus exits srun_signals orphan scancel requeue timelimit timelimit_steps selfrequeue
+  lost_nokill lost bcast lcm)
 case "${1:-}" in -h | --help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;; esac
 [ $# -eq 0 ] || experiments=("$@")
 
@@ -53,7 +54,7 @@ show() {
     / alive$/ { k = $2; if (seen[k]++) { last[k] = sprintf("%+8.3f %s", $1 - t0, rest); next } }
     { for (k in last) { print last[k]; delete last[k] } printf "%+8.3f %s\n", $1 - t0, rest }
     END { for (k in last) print last[k] }'
-  [ ! -s "$FACTS/$name-$id.out" ] || sed "s/^/   job $id's output: /" "$FACTS/$name-$id.out"
+  [ -z "$id" ] || [ ! -s "$FACTS/$name-$id.out" ] || sed "s/^/   job $id's output: /" "$FACTS/$name-$id.out"
 }
 watch_node() {  # watch_node NODE SECONDS: logs the node's state changes
   local end=$((SECONDS + $2)) st last=""
@@ -71,7 +72,8 @@ lcm_events() {  # lcm_events FILE: the number of events on PROBE in an LCM log f
 }
 
 for name in "${experiments[@]}"; do
-  rm -f "$FACTS/$name".*
+  rm -f "$FACTS/$name".* "$FACTS/$name"-*.out
+  id=""
   case "$name" in
     env)
       submit "--nodes=2" env; finish
@@ -114,6 +116,14 @@ for name in "${experiments[@]}"; do
       if [ "$name" = timelimit ]; then submit "--nodes=2 --time=1 --signal=B:USR1@20" probes exit 2
       else submit "--nodes=2 --time=1 --signal=USR1@20" probes exit 2; fi
       finish 150 ;;
+    selfrequeue)
+      # The batch script requeues its own job when warned of the time limit.
+      submit "--nodes=2 --time=1 --signal=B:USR1@20 --open-mode=append" probes exit 2 requeue
+      ready
+      cluster_until 150 "the job's second run" grep -q " ready (job $id, restart 1)$" "$FACTS/$name.log"
+      note "job $id: $(cluster_exec ctl scontrol show job -o "$id" | grep -o 'JobState=[A-Z]*\|Restarts=[0-9]*\|TimeLimit=[^ ]*\|StartTime=[^ ]*\|EndTime=[^ ]*' | tr '\n' ' ')"
+      cluster_exec ctl scancel "$id"
+      finish 30 ;;
     lost_nokill | lost)
       opts="--nodes=3"
       [ "$name" = lost ] || opts="--nodes=3 --no-kill"

@@ -63,8 +63,12 @@ case "$experiment" in
       fi
     done ;;
 
-  probes)  # Probe steps on node1 and node2 (mode $1, grace $2); the batch script traps signals.
+  probes)  # Probe steps on node1 and node2 (mode $1, grace $2); the batch script traps signals
+    # (with $3 = requeue, it requeues its own job on SIGUSR1).
     for s in TERM INT HUP USR1 USR2 CONT QUIT ALRM; do trap "r got $s" $s; done
+    if [ "${3:-}" = requeue ]; then
+      trap 'r "got USR1: scontrol requeue $SLURM_JOB_ID"; scontrol requeue "$SLURM_JOB_ID"; r "scontrol requeue: rc=$?"' USR1
+    fi
     r "start: job $SLURM_JOB_ID, SLURM_RESTART_COUNT=${SLURM_RESTART_COUNT-unset}, nodes $SLURM_JOB_NODELIST"
     echo "the batch script's output, incarnation ${SLURM_RESTART_COUNT:-0}"
     bg_step node1 "$FACTS/probe.pl" p1.$tag "$log" "$1" "$2"; p1=$p
