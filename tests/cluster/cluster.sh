@@ -87,28 +87,29 @@ cluster_addr() {  # cluster_addr NODE
   esac
 }
 
-# The pid of a node's init (pid 1 of its PID namespace) as the root namespace sees it: the child
-# of the unshare whose pid is in run/NODE.pid; for "sw", the switch's own process.
-cluster_init_pid() {
-  local upid child
-  upid=$(cat "$CLUSTER_DIR/run/$1.pid" 2> /dev/null) || return 1
-  if [ "$1" = sw ]; then cluster_alive "$upid" && echo "$upid"; return; fi
-  child=$(cat "/proc/$upid/task/$upid/children" 2> /dev/null) || return 1
-  child=${child%% *}
-  [ -n "$child" ] && echo "$child"
+# Sets cluster_init to the pid of a node's init (pid 1 of its PID namespace) as the root
+# namespace sees it: the child of the unshare whose pid is in run/NODE.pid; for "sw", the
+# switch's own process. Fails if the node is not running. (Builtins only: it runs often.)
+cluster_find_init() {  # cluster_find_init NODE
+  local upid=""
+  cluster_init=""
+  read -r upid 2> /dev/null < "$CLUSTER_DIR/run/$1.pid" || return 1
+  if [ "$1" = sw ]; then cluster_alive "$upid" && cluster_init=$upid; return; fi
+  read -r cluster_init _ 2> /dev/null < "/proc/$upid/task/$upid/children" || true
+  [ -n "$cluster_init" ]
 }
 
 # Sets cluster_enter to the nsenter command line that runs a command on NODE: in all of its
 # namespaces, in the current working directory if the node sees the same folder there, else /.
 cluster_enter_args() {  # cluster_enter_args NODE
-  local pid wd=/ ns=(-n -u -m -p) p
-  pid=$(cluster_init_pid "$1") || { cluster_fail "node $1 is not running"; return 1; }
+  local wd=/ ns=(-n -u -m -p) p
+  cluster_find_init "$1" || { cluster_fail "node $1 is not running"; return 1; }
   [ "$1" != sw ] || ns=(-n)
   case "$PWD/" in
     /tmp/*) while read -r p; do case "$PWD/" in "$p"/*) wd=$PWD ;; esac; done < "$CLUSTER_DIR/shared-paths" ;;
     *) wd=$PWD ;;
   esac
-  cluster_enter=(nsenter -t "$pid" "${ns[@]}" --wd="$wd" --)
+  cluster_enter=(nsenter -t "$cluster_init" "${ns[@]}" --wd="$wd" --)
 }
 
 cluster_exec() {  # cluster_exec NODE CMD...
@@ -205,25 +206,31 @@ cluster_spawn() {  # cluster_spawn NAME CMD...  (pid in run/NAME.pid)
 }
 
 cluster_node_start() {  # cluster_node_start NODE
-  cluster_node_boot "$1" && cluster_node_booted "$1"
+  cluster_node_boot "$1" && cluster_node_wire "$1" && cluster_node_booted "$1"
 }
 
 # Boots a node: its init starts in new network, UTS, PID and mount namespaces (unshare
-# --kill-child takes the node down if unshare dies) and waits for its network, which this wires
-# to the bridge; then the init sets the node up and starts its daemon (cluster_node_booted).
+# --kill-child takes the node down if unshare dies) and waits for its network
+# (cluster_node_wire); then the init sets the node up and starts its daemon
+# (cluster_node_booted).
 cluster_node_boot() {  # cluster_node_boot NODE
-  local node=$1 pid sw
-  sw=$(cluster_init_pid sw) || { cluster_fail "the switch is down"; return 1; }
+  rm -f "$CLUSTER_DIR/run/$1.net" "$CLUSTER_DIR/run/$1.ready"
+  cluster_spawn "$1" unshare --net --uts --pid --mount --fork --mount-proc --kill-child \
+    bash "$cluster_self" _init "$1" "$CLUSTER_DIR"
+}
+
+# Wires a booting node to the bridge: eth0 with its address, lo, the multicast route.
+cluster_node_wire() {  # cluster_node_wire NODE
+  local node=$1 sw
+  cluster_find_init sw || { cluster_fail "the switch is down"; return 1; }
+  sw=$cluster_init
   # The veth end of a node that died goes away with its namespace, a moment later.
   cluster_until 10 "the old port of $node going" eval "! nsenter -t $sw -n ip link show $node" || return 1
-  rm -f "$CLUSTER_DIR/run/$node.net" "$CLUSTER_DIR/run/$node.ready"
-  cluster_spawn "$node" unshare --net --uts --pid --mount --fork --mount-proc --kill-child \
-    bash "$cluster_self" _init "$node" "$CLUSTER_DIR"
-  cluster_until 10 "node $node's init" cluster_init_pid "$node" || return 1
-  pid=$(cluster_init_pid "$node")
-  ip link add eth0 netns "$pid" type veth peer name "$node" netns "$sw"
+  cluster_until 10 "node $node's init" cluster_find_init "$node" || return 1
+  cluster_find_init "$node"
+  ip link add eth0 netns "$cluster_init" type veth peer name "$node" netns "$sw"
   nsenter -t "$sw" -n ip link set "$node" master br0 up
-  nsenter -t "$pid" -n sh -e -c "ip link set lo up
+  nsenter -t "$cluster_init" -n sh -e -c "ip link set lo up
     ip addr add $(cluster_addr "$node")/24 dev eth0
     ip link set eth0 up
     ip route add 224.0.0.0/4 dev eth0"
@@ -323,13 +330,21 @@ cluster_up() {  # cluster_up N [--cpus C] [--dir DIR] [--share PATH]...
   cluster_spawn sw unshare --net -- sleep infinity
   # unshare execs sleep once the namespace is made.
   cluster_until 10 "the switch's namespace" eval "[ \"\$(cat /proc/$(cat "$CLUSTER_DIR/run/sw.pid")/comm)\" = sleep ]" || return 1
-  nsenter -t "$(cluster_init_pid sw)" -n sh -e -c 'ip link add br0 type bridge; ip link set br0 up; ip link set lo up'
+  cluster_find_init sw
+  nsenter -t "$cluster_init" -n sh -e -c 'ip link add br0 type bridge; ip link set br0 up; ip link set lo up'
   cluster_until 10 "munged's socket" test -S "$CLUSTER_DIR/munge/munge.socket" || return 1
   for node in ctl $CLUSTER_NODES; do
     mkdir -p "$CLUSTER_DIR/nodes/$node/tmp" "$CLUSTER_DIR/spool/$node"
     chmod 1777 "$CLUSTER_DIR/nodes/$node/tmp"
-    cluster_node_boot "$node" || return 1
+    cluster_node_boot "$node"
   done
+  # The nodes are wired at once (the boots stay in this shell: their parent-death signal).
+  local wires=()
+  for node in ctl $CLUSTER_NODES; do
+    cluster_node_wire "$node" &
+    wires+=($!)
+  done
+  for p in "${wires[@]}"; do wait "$p" || return 1; done
   for node in ctl $CLUSTER_NODES; do cluster_node_booted "$node" || return 1; done
   # A slurmd that starts before slurmctld listens registers once it does.
   for node in $CLUSTER_NODES; do
@@ -352,15 +367,16 @@ cluster_chain_trap() {
 # Every process of the cluster: munged, the switch, the nodes' unshare and everything in the
 # nodes' PID namespaces (a namespace is known by its inode).
 cluster_procs() {
-  local name pid init nss=" "
+  local name pid inits=() nss
   for name in munged sw ctl $CLUSTER_NODES; do
-    pid=$(cat "$CLUSTER_DIR/run/$name.pid" 2> /dev/null) || continue
+    read -r pid 2> /dev/null < "$CLUSTER_DIR/run/$name.pid" || continue
     cluster_alive "$pid" || continue
     echo "$pid"
-    [ "$name" = munged ] || [ "$name" = sw ] || ! init=$(cluster_init_pid "$name") ||
-      nss+="$(stat -L -c %i "/proc/$init/ns/pid") "
+    [ "$name" = munged ] || [ "$name" = sw ] || ! cluster_find_init "$name" ||
+      inits+=("/proc/$cluster_init/ns/pid")
   done
-  [ "$nss" != " " ] || return 0
+  [ ${#inits[@]} -gt 0 ] || return 0
+  nss=" $(stat -L -c %i "${inits[@]}" 2> /dev/null | tr '\n' ' ')"
   # (stat fails on the processes that end meanwhile)
   { stat -L -c '%i %n' /proc/[0-9]*/ns/pid 2> /dev/null || true; } |
     awk -v nss="$nss" 'index(nss, " " $1 " ") { split($2, p, "/"); print p[3] }'
