@@ -18,15 +18,20 @@ namespace rl {
 
 namespace po = boost::program_options;
 
-// Options every process has: --config, --run-id, --key-file, --lcm-url, --lcm-bulk-url.
+// Options every process has: --config, --run-id, --key-file, --lcm-url, --lcm-bulk-url,
+// --max-message-age, --max-clock-skew.
 struct CommonOptions {
   std::string config_file;
   int64_t run_id = 0;
   std::string key_file;  // the run's secret key (common/message_auth.h); empty: no MACs
   std::string lcm_url = kDefaultLcmUrl;
   std::string lcm_bulk_url = kDefaultLcmBulkUrl;
+  // The freshness window, seconds (common/lcm_bus.h: why these defaults).
+  double max_message_age = kDefaultMaxMessageAgeMicros * 1e-6;
+  double max_clock_skew = kDefaultMaxClockSkewMicros * 1e-6;
 
-  // Reads the key file, if any (throws std::runtime_error when it is unfit).
+  // Reads the key file, if any (throws std::runtime_error when it is unfit), and checks the
+  // window (std::invalid_argument naming the option when it is not in (0, 1 day]).
   BusConfig MakeBusConfig(const std::string& sender) const;
 };
 
