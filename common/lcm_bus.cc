@@ -230,8 +230,9 @@ std::vector<StreamPosition> Bus::Positions() const {
   };
   for (const auto& sub : subscriptions_) take(sub->channel, sub->heard);
   for (const auto& [channel, heard] : restored_) {
+    const std::string& name = channel;  // (a lambda may not capture a structured binding)
     const bool subscribed = std::any_of(subscriptions_.begin(), subscriptions_.end(),
-                                        [&](const auto& s) { return s->channel == channel; });
+                                        [&name](const auto& s) { return s->channel == name; });
     if (!subscribed) take(channel, heard);
   }
   const int64_t oldest = WallMicros() - config_.max_message_age;
