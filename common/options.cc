@@ -6,6 +6,7 @@
 #include <iostream>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 namespace rl {
 namespace {
@@ -25,6 +26,15 @@ BusConfig CommonOptions::MakeBusConfig(const std::string& sender) const {
   c.bulk_url = lcm_bulk_url;
   c.run_id = run_id;
   c.sender = sender;
+  // A day bounds the window far above any use and keeps the microseconds far from overflow.
+  for (const auto& [name, seconds] : {std::pair{"max-message-age", max_message_age},
+                                      std::pair{"max-clock-skew", max_clock_skew}}) {
+    if (!(seconds > 0 && seconds <= 86400)) {
+      throw std::invalid_argument(std::string("--") + name + " must be in (0, 86400] seconds");
+    }
+  }
+  c.max_message_age = static_cast<int64_t>(max_message_age * 1e6);
+  c.max_clock_skew = static_cast<int64_t>(max_clock_skew * 1e6);
   if (!key_file.empty()) c.key = ReadKeyFile(key_file);
   return c;
 }
@@ -45,7 +55,14 @@ void AddCommonOptions(po::options_description* desc, CommonOptions* common) {
       ("lcm-url", po::value(&common->lcm_url)->default_value(common->lcm_url),
        "LCM URL of the main port (small, high-rate messages)")  //
       ("lcm-bulk-url", po::value(&common->lcm_bulk_url)->default_value(common->lcm_bulk_url),
-       "LCM URL of the bulk port (weights, sample replies)");
+       "LCM URL of the bulk port (weights, sample replies)")  //
+      ("max-message-age",
+       po::value(&common->max_message_age)->default_value(common->max_message_age),
+       "seconds a message may be old (its header time against its arrival here) before it is "
+       "dropped as stale; covers network delay and clock differences between hosts")  //
+      ("max-clock-skew", po::value(&common->max_clock_skew)->default_value(common->max_clock_skew),
+       "seconds a message's header time may be ahead of this host's clock before it is dropped as "
+       "stale");
 }
 
 bool ParseOptions(int argc, char** argv, const std::string& role, const std::string& usage,

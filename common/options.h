@@ -23,16 +23,20 @@ namespace po = boost::program_options;
 // The sections a preset may have: one per process that reads presets.
 inline constexpr const char* kConfigSections[] = {"actor", "replay", "learner", "evaluator"};
 
-// Options every process has: --config, --run-id, --key-file, --lcm-url, --lcm-bulk-url, and
-// --help and --list-options.
+// Options every process has: --config, --run-id, --key-file, --lcm-url, --lcm-bulk-url,
+// --max-message-age, --max-clock-skew, and --help and --list-options.
 struct CommonOptions {
   std::string config_file;
   int64_t run_id = 0;
   std::string key_file;  // the run's secret key (common/message_auth.h); empty: no MACs
   std::string lcm_url = kDefaultLcmUrl;
   std::string lcm_bulk_url = kDefaultLcmBulkUrl;
+  // The freshness window, seconds (common/lcm_bus.h: why these defaults).
+  double max_message_age = kDefaultMaxMessageAgeMicros * 1e-6;
+  double max_clock_skew = kDefaultMaxClockSkewMicros * 1e-6;
 
-  // Reads the key file, if any (throws std::runtime_error when it is unfit).
+  // Reads the key file, if any (throws std::runtime_error when it is unfit), and checks the
+  // window (std::invalid_argument naming the option when it is not in (0, 1 day]).
   BusConfig MakeBusConfig(const std::string& sender) const;
 };
 

@@ -92,7 +92,7 @@ void Replica::Publish(const std::string& channel, Msg m, const std::string& send
   m.header.run_id = kRunId;
   m.header.sender = sender;
   m.header.seq = seq_[sender]++;
-  m.header.utime = 1;
+  m.header.utime = WallMicros();
   std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   bus_.PublishRaw(channel, bytes.data(), bytes.size());

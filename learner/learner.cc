@@ -152,6 +152,9 @@ StateFile Learner::SaveState() const {
   state.PutInt("learner.env_steps", env_steps_);
   state.PutText("learner.wall_seconds", std::to_string(MonoSeconds() - start_time_));
   PutRng(&state, "learner.shift_rng", decoder_.shift_rng());
+  // The last reply heard from each replay, so that a restarted learner refuses recorded replies
+  // older than this state (common/lcm_bus.h).
+  state.PutText("learner.bus_positions", bus_->SavePositions());
   algorithm_->SaveState(&state);
   return state;
 }
@@ -165,6 +168,8 @@ void Learner::LoadState(const StateFile& state) {
   env_steps_ = state.Int("learner.env_steps");
   resumed_wall_seconds_ = std::stod(state.Text("learner.wall_seconds"));
   GetRng(state, "learner.shift_rng", &decoder_.shift_rng());
+  // States written before the bus kept positions have none.
+  if (state.Has("learner.bus_positions")) bus_->LoadPositions(state.Text("learner.bus_positions"));
 }
 
 std::string Learner::Checkpoint() {

@@ -121,9 +121,10 @@ int Main(int argc, char** argv) {
   rl::replay::Snapshotter snapshotter(
       snapshots, rl::replay::ReplayService::kSnapshotKind,
       [&service](rl::StateStream* out) { return service.SaveSnapshot(out); },
-      [&service] {
+      [&service, &bus] {
+        // Any message taken moves the bus's positions, which the snapshot keeps.
         return service.total_inserts() + service.total_samples() +
-               service.counters().priorities_applied;
+               service.counters().priorities_applied + bus.counters().received;
       });
   std::printf("replay: ready\n");
   std::fflush(stdout);

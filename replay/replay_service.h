@@ -32,8 +32,9 @@
 //
 // Snapshots (replay_service_snapshot.cc): SaveSnapshot() describes the whole state a restarted
 // replay needs to serve as before (the table with its sampler, the limiter's counts, the
-// sampler's random generator, the per-actor insert counts, the service's counters; not the
-// pending requests, which their requesters send again) as a StateStream of kind
+// sampler's random generator, the per-actor insert counts, the service's counters, the bus's
+// last position of each sender, so that recorded traffic older than the snapshot stays refused;
+// not the pending requests, which their requesters send again) as a StateStream of kind
 // kSnapshotKind; RestoreSnapshot()/LoadSnapshot() load one into a fresh service.
 //
 // Not thread-safe: one thread constructs the service and calls every method; the bus must be

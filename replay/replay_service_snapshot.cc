@@ -59,6 +59,9 @@ std::string ReplayService::SaveSnapshot(StateStream* out) const {
   } else {
     table_.Save("flat.", out);
   }
+  // The last message heard from each sender, so that a restarted replay refuses recorded traffic
+  // that this state already holds (common/lcm_bus.h).
+  out->PutText("bus_positions", bus_.SavePositions());
   return Summary();
 }
 
@@ -106,6 +109,8 @@ void ReplayService::Restore(const StateView& in) {
   }
   insert_allowed_ = limiter_.CanInsert(options_.insert_unit);
   low_credit_ = limiter_.InsertCredit();
+  // Snapshots written before the bus kept positions have none.
+  if (in.Has("bus_positions")) bus_.LoadPositions(in.Text("bus_positions"));
 }
 
 void ReplayService::CheckFresh() const {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -92,7 +93,35 @@ TEST(OptionsTest, ListOptionsPrintsTheNamesAPresetMaySet) {
   const bool go_on = ParseOptions(2, argv, "evaluator", "usage", desc, &vm);
   std::cout.rdbuf(saved);
   EXPECT_FALSE(go_on);
-  EXPECT_EQ(out.str(), "run-id\nkey-file\nlcm-url\nlcm-bulk-url\nepisodes\n");
+  EXPECT_EQ(out.str(),
+            "run-id\nkey-file\nlcm-url\nlcm-bulk-url\nmax-message-age\nmax-clock-skew\nepisodes\n");
+}
+
+// The freshness window: seconds on the command line, microseconds in the bus's configuration;
+// a window that is not positive (or beyond a day) is refused with the option's name.
+TEST(OptionsTest, TheFreshnessWindowReachesTheBusAndABadOneIsRefused) {
+  CommonOptions defaults;
+  EXPECT_EQ(defaults.MakeBusConfig("actor-0").max_message_age, kDefaultMaxMessageAgeMicros);
+  EXPECT_EQ(defaults.MakeBusConfig("actor-0").max_clock_skew, kDefaultMaxClockSkewMicros);
+  po::options_description desc;
+  CommonOptions common;
+  AddCommonOptions(&desc, &common);
+  const char* argv[] = {"x", "--max-message-age", "2.5", "--max-clock-skew", "0.5"};
+  po::variables_map vm;
+  ASSERT_TRUE(ParseOptions(5, const_cast<char**>(argv), "actor", "usage", desc, &vm));
+  const BusConfig c = common.MakeBusConfig("actor-0");
+  EXPECT_EQ(c.max_message_age, 2'500'000);
+  EXPECT_EQ(c.max_clock_skew, 500'000);
+  for (const double bad : {0.0, -1.0, 90000.0, std::nan("")}) {
+    CommonOptions o;
+    o.max_message_age = bad;
+    try {
+      o.MakeBusConfig("actor-0");
+      ADD_FAILURE() << bad << " was taken";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("--max-message-age"), std::string::npos);
+    }
+  }
 }
 
 }  // namespace

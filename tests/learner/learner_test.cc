@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <random>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -390,6 +391,36 @@ TEST_F(LearnerTest, RefusesAStateOfAnotherRunOrATornOne) {
   Learner fresh(same, bus_.get());
   EXPECT_FALSE(fresh.resumed());
   EXPECT_EQ(fresh.updates(), 0);
+}
+
+// A restarted learner loads, with its state, the last reply it had taken from each replay:
+// replies recorded before its last checkpoint and played back to it are dropped as replayed,
+// inside the freshness window too; later ones pass the bus (and match no request of its).
+TEST_F(LearnerTest, AResumedLearnerRefusesRecordedRepliesOlderThanItsState) {
+  std::vector<std::vector<uint8_t>> recorded;  // every reply, as it went over the bus
+  bus_->Subscribe<rlmsg::sample_batch_t>(
+      channels::kSamples,
+      [&recorded](const rlmsg::sample_batch_t& m) {
+        std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+        m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+        recorded.push_back(std::move(bytes));
+      },
+      Port::kBulk);
+  LearnerConfig c = ShortRun(16, 30, 10);
+  Learner first(c, bus_.get());  // alive to the end: the bus keeps its handler
+  first.Run();                   // its last checkpoint (and state) when it stops
+  const size_t before_state = recorded.size();
+  bus_->Handle(0);  // replies to requests still in flight
+  ASSERT_GT(before_state, 0U);
+  Bus restarted(InProcessBusConfig(9, "learner"));  // the new process's bus
+  c.resume = true;
+  Learner second(c, &restarted);
+  ASSERT_TRUE(second.resumed());
+  for (const auto& bytes : recorded) {
+    restarted.Deliver(channels::kSamples, bytes.data(), bytes.size(), WallMicros());
+  }
+  EXPECT_EQ(restarted.counters().replayed, static_cast<int64_t>(before_state));
+  EXPECT_EQ(restarted.counters().received, static_cast<int64_t>(recorded.size() - before_state));
 }
 
 }  // namespace

@@ -80,7 +80,7 @@ class ReplayServiceTest : public ::testing::Test {
     m.header.run_id = run_id;
     m.header.sender = sender;
     m.header.seq = next_seq_[{channel, sender}]++;
-    m.header.utime = 1;
+    m.header.utime = WallMicros();
     std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
     ASSERT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())),
               static_cast<int>(bytes.size()));

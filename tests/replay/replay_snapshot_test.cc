@@ -115,7 +115,8 @@ class Replica {
     m.header.run_id = run_id_;
     m.header.sender = sender;
     m.header.seq = seq_[sender]++;
-    m.header.utime = 1;
+    m.header.utime = WallMicros();
+    m.header.incarnation = incarnation_;
     std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
     ASSERT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())),
               static_cast<int>(bytes.size()));
@@ -153,8 +154,16 @@ class Replica {
   ReplayService& service() { return *service_; }
 
  private:
+  // The test peer's senders start anew with each replica, as restarted processes do: a later
+  // incarnation (a restored replica refuses what the saved one's peer had sent).
+  static int64_t NewIncarnation() {
+    static int64_t last = 0;
+    return last = std::max(WallMicros(), last + 1);
+  }
+
   Bus bus_;
   int64_t run_id_;
+  int64_t incarnation_ = NewIncarnation();
   std::unique_ptr<ReplayService> service_;
   std::map<std::string, int64_t> seq_;
   std::vector<rlmsg::sample_batch_t> replies_;
@@ -437,6 +446,38 @@ TEST_F(ReplaySnapshotTest, SurvivesMutatedSnapshotsWhoseChecksumIsRight) {
     }
   }
   EXPECT_GT(loaded, 0);  // some changes (in frames, observations) are harmless
+}
+
+// A replay restored from a snapshot refuses the messages its saved self had taken (a recording
+// played back after a restart), inside the freshness window too, and stores none of them.
+TEST_F(ReplaySnapshotTest, ARestoredReplayRefusesTrafficItsSavedSelfHadTaken) {
+  std::vector<std::vector<uint8_t>> recorded;
+  Bus saved_bus(InProcessBusConfig(kRunId, "replay"));
+  ReplayService saved(&saved_bus, Options(false));
+  const int64_t now = WallMicros();
+  for (int k = 0; k < 4; ++k) {
+    rlmsg::transition_batch_t m = FlatBatch(25 * k, 25);
+    m.header.run_id = kRunId;
+    m.header.sender = "actor-0";
+    m.header.seq = k;
+    m.header.utime = now;
+    m.header.incarnation = now - 1000;
+    recorded.emplace_back(static_cast<size_t>(m.getEncodedSize()));
+    ASSERT_EQ(m.encode(recorded.back().data(), 0, static_cast<int>(recorded.back().size())),
+              static_cast<int>(recorded.back().size()));
+    saved_bus.Deliver(channels::kTransitions, recorded.back().data(), recorded.back().size(), now);
+  }
+  ASSERT_EQ(saved.total_inserts(), 100);
+  StateStream out(ReplayService::kSnapshotKind);
+  saved.SaveSnapshot(&out);
+  Bus restarted_bus(InProcessBusConfig(kRunId, "replay"));
+  ReplayService restarted(&restarted_bus, Options(false));
+  restarted.RestoreSnapshot(out.Serialize());
+  for (const auto& bytes : recorded) {
+    restarted_bus.Deliver(channels::kTransitions, bytes.data(), bytes.size(), now);
+  }
+  EXPECT_EQ(restarted.total_inserts(), 100);
+  EXPECT_EQ(restarted_bus.counters().replayed, 4);
 }
 
 TEST_F(ReplaySnapshotTest, TheSnapshotterWritesFromAForkedChildAndTheFileLoads) {
