@@ -72,6 +72,8 @@ void ReplayServiceOptions::Validate() const {
   require(beta_anneal_samples >= 0, "beta_anneal_samples", ">= 0", beta_anneal_samples);
   require(frame_capacity >= 0, "frame_capacity", ">= 0", frame_capacity);
   require(handle_timeout_ms >= 0, "handle_timeout_ms", ">= 0", handle_timeout_ms);
+  require(max_actors >= 1 && max_actors <= kMaxActorsLimit, "max_actors", "in [1, 1024]",
+          max_actors);
 }
 
 ReplayService::ReplayService(Bus* bus, ReplayServiceOptions options)
@@ -116,7 +118,8 @@ void ReplayService::OnTransitions(const rlmsg::transition_batch_t& m) {
   // The bus has checked sizes and values; the env's action check comes next, then the table
   // checks what only it knows (observation size, geometry, action width, frame references).
   const char* why = nullptr;
-  if (options_.check_action) {
+  if (m.actor_id >= options_.max_actors) why = "actor_id not below max_actors";
+  if (why == nullptr && options_.check_action) {
     const auto width = static_cast<size_t>(m.action_width);
     for (size_t i = 0; why == nullptr && i < static_cast<size_t>(m.count); ++i) {
       why = options_.check_action(std::span<const float>(m.action).subspan(i * width, width));

@@ -64,6 +64,9 @@
 
 namespace rl::replay {
 
+/// The largest max_actors: the pixel table holds the frame windows of 1024 actors at most.
+inline constexpr int kMaxActorsLimit = 1024;
+
 struct ReplayServiceOptions {
   // Storage: capacity and observation size.
   ReplayTableOptions table;
@@ -99,6 +102,10 @@ struct ReplayServiceOptions {
   double progress_seconds = 0.0;
   // Milliseconds Run() waits for traffic in each round.
   int handle_timeout_ms = 10;
+  // Actor ids stored: 0 .. max_actors - 1. A batch of another id is refused and counted, so that
+  // forged ids cannot grow the per-actor counts (and the flow messages and snapshots that carry
+  // them) without bound. At most kMaxActorsLimit.
+  int max_actors = 1024;
 
   /// Throws std::invalid_argument naming the field when a value is out of range.
   void Validate() const;
