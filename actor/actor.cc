@@ -37,7 +37,10 @@ uint64_t TrainingSeed(uint64_t run_seed, int actor_id, int env_index) {
          static_cast<uint64_t>(env_index);
 }
 
-Actor::Actor(ActorConfig config, Bus* bus) : config_(std::move(config)), bus_(bus) {
+Actor::Actor(ActorConfig config, Bus* bus)
+    : config_(std::move(config)),
+      bus_(bus),
+      assembler_([this](const std::string& architecture) { return WeightsSize(architecture); }) {
   config_.Validate();
   for (int j = 0; j < config_.envs_per_actor; ++j) {
     auto env = envs::MakeEnv(config_.env_id);
@@ -97,26 +100,47 @@ void Actor::OnFlow(const rlmsg::flow_control_t& f) {
   insert_limit_ = published_ + std::max<int64_t>(0, share - on_the_way);
 }
 
+int64_t Actor::WeightsSize(const std::string& architecture) {
+  if (policy_->has_network() && architecture == policy_->network().Architecture()) {
+    return policy_->network().FlatSize();
+  }
+  if (candidate_ && candidate_->Architecture() == architecture) return candidate_->FlatSize();
+  // Built within nn's limits (sequential.h), as large as the network the policy would hold.
+  std::string why;
+  try {
+    std::mt19937 init_rng(0);
+    nn::Sequential net = nn::BuildFromArchitecture(architecture, &init_rng);
+    why = policy_->CheckNetwork(net);
+    if (why.empty()) candidate_ = std::move(net);
+  } catch (const std::invalid_argument& e) {
+    why = e.what();
+  }
+  if (!why.empty()) {
+    if (assembler_.refused() < 10) {
+      std::fprintf(stderr, "[actor-%d] refused weights '%.200s': %s\n", config_.actor_id,
+                   architecture.c_str(), why.c_str());
+    }
+    return -1;
+  }
+  return candidate_->FlatSize();
+}
+
 void Actor::OnWeights(const rlmsg::weights_chunk_t& chunk) {
   if (!assembler_.Add(chunk)) return;
   std::optional<Weights> w = assembler_.Take();
   if (!w) return;
   if (!policy_->has_network() || w->architecture != policy_->network().Architecture()) {
-    std::string why;
-    try {
-      std::mt19937 init_rng(0);
-      nn::Sequential net = nn::BuildFromArchitecture(w->architecture, &init_rng);
-      why = policy_->CheckNetwork(net);
-      if (why.empty()) policy_->SetNetwork(std::move(net));
-    } catch (const std::invalid_argument& e) {
-      why = e.what();
+    // The candidate built for this architecture, or (when another one replaced it meanwhile)
+    // the same network built again.
+    if (!candidate_ || candidate_->Architecture() != w->architecture) {
+      candidate_.reset();
+      if (WeightsSize(w->architecture) < 0) {
+        ++weights_refused_;
+        return;
+      }
     }
-    if (!why.empty()) {
-      ++weights_refused_;
-      std::fprintf(stderr, "[actor-%d] refused weights '%s': %s\n", config_.actor_id,
-                   w->architecture.c_str(), why.c_str());
-      return;
-    }
+    policy_->SetNetwork(std::move(*candidate_));
+    candidate_.reset();
   }
   policy_->network().SetFlat(w->params.data(), w->params.size());
   weights_version_ = w->version;

@@ -15,6 +15,7 @@
 #include <deque>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -72,7 +73,9 @@ class Actor {
   int64_t weights_version() const { return weights_version_; }
   // The exploration scale now: epsilon, or the noise sigma (1 during the random start).
   double exploration() const { return policy_->exploration(env_steps_); }
-  int64_t weights_refused() const { return weights_refused_; }
+  /// Weights versions refused: of a network that does not build or fit the env, or whose
+  /// chunks claim another size than that network's (actor/weights_assembler.h).
+  int64_t weights_refused() const { return assembler_.refused() + weights_refused_; }
   /// Transitions published so far.
   int64_t published() const { return published_; }
   /// Whether the replay's flow control holds this actor: no flow message yet, insert_allowed is
@@ -105,6 +108,10 @@ class Actor {
   };
 
   void OnWeights(const rlmsg::weights_chunk_t& chunk);
+  // The assembler's SizeOf: the parameter floats of a network of `architecture` that fits the
+  // env (the policy's own, or a candidate built now and kept for when its version completes),
+  // or -1 with the reason logged.
+  int64_t WeightsSize(const std::string& architecture);
   // Appends a transition (flat observations, or stacks of frame ids) to the batch.
   template <class T>
   void Append(const BasicTransition<T>& t, int64_t episode_id);
@@ -120,6 +127,9 @@ class Actor {
   std::vector<EnvSlot> slots_;
   std::unique_ptr<Policy> policy_;
   WeightsAssembler assembler_;
+  // A network of an architecture other than the policy's, built when the first chunk of its
+  // version arrived; the policy takes it when the version completes.
+  std::optional<nn::Sequential> candidate_;
   int64_t weights_version_ = -1;
   int64_t weights_refused_ = 0;
 

@@ -196,6 +196,33 @@ TEST_F(ActorTest, RefusesWeightsOfANetworkThatDoesNotFitTheEnv) {
   EXPECT_EQ(actor.weights_version(), 2);
 }
 
+// Chunks that claim a buffer other than the network the actor built (here 256 MB for a network
+// of 58 floats) are refused before anything is allocated for them.
+TEST_F(ActorTest, RefusesWeightsChunksOfAnotherSizeThanItsNetwork) {
+  Actor actor(config_, &bus_);
+  std::mt19937 rng(1);
+  nn::Sequential net = nn::MakeMlp(4, {8}, 2, &rng);
+  std::vector<float> flat;
+  net.GetFlat(&flat);
+  for (auto& c : learner::MakeWeightChunks(1, net.Architecture(), flat)) {
+    bus_.Publish(channels::kWeights, &c, Port::kBulk);
+  }
+  bus_.Handle(0);
+  ASSERT_EQ(actor.weights_version(), 1);
+  rlmsg::weights_chunk_t huge = learner::MakeWeightChunks(2, net.Architecture(), flat)[0];
+  huge.total_size = 1 << 26;
+  huge.num_chunks = 1 << 14;
+  bus_.Publish(channels::kWeights, &huge, Port::kBulk);
+  // As many chunks as floats, each with one float: absurd, refused as well.
+  rlmsg::weights_chunk_t many = learner::MakeWeightChunks(3, net.Architecture(), flat)[0];
+  many.num_chunks = many.total_size + 1;
+  bus_.Publish(channels::kWeights, &many, Port::kBulk);
+  bus_.Handle(0);
+  EXPECT_EQ(bus_.counters().invalid, 0) << "the bus let them through: the actor refused them";
+  EXPECT_EQ(actor.weights_refused(), 2);
+  EXPECT_EQ(actor.weights_version(), 1);
+}
+
 TEST_F(ActorTest, PublishesStatsWithItsCounters) {
   std::vector<rlmsg::stats_actor_t> stats;
   bus_.Subscribe<rlmsg::stats_actor_t>(
