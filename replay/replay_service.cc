@@ -74,6 +74,8 @@ void ReplayServiceOptions::Validate() const {
   require(handle_timeout_ms >= 0, "handle_timeout_ms", ">= 0", handle_timeout_ms);
   require(max_actors >= 1 && max_actors <= kMaxActorsLimit, "max_actors", "in [1, 1024]",
           max_actors);
+  require(stop_quiet_ms >= 0, "stop_quiet_ms", ">= 0", stop_quiet_ms);
+  require(stop_drain_ms >= 0, "stop_drain_ms", ">= 0", stop_drain_ms);
 }
 
 ReplayService::ReplayService(Bus* bus, ReplayServiceOptions options)
@@ -400,6 +402,11 @@ void ReplayService::Run(const std::function<bool()>& should_stop) {
     bus_.Handle(options_.handle_timeout_ms);
     Serve();
     Tick();
+  }
+  // The actors stop at the same time and send their last steps: store them too, so that the
+  // last snapshot holds every step of theirs (a restarted actor takes its count from it).
+  const double drain_end = MonoSeconds() + options_.stop_drain_ms / 1000.0;
+  while (MonoSeconds() < drain_end && bus_.Handle(options_.stop_quiet_ms) > 0) {
   }
   // Leave a last word for the monitor, and the final counts in the log.
   const double now = MonoSeconds();

@@ -106,6 +106,11 @@ struct ReplayServiceOptions {
   // forged ids cannot grow the per-actor counts (and the flow messages and snapshots that carry
   // them) without bound. At most kMaxActorsLimit.
   int max_actors = 1024;
+  // When Run() is asked to stop, it goes on storing what arrives until nothing has for
+  // stop_quiet_ms (at most stop_drain_ms in all): the last batches of actors that stop at the
+  // same time (they flush their last steps) reach the last snapshot.
+  int stop_quiet_ms = 100;
+  int stop_drain_ms = 1000;
 
   /// Throws std::invalid_argument naming the field when a value is out of range.
   void Validate() const;
@@ -140,7 +145,8 @@ class ReplayService {
   void Tick() { Tick(MonoSeconds()); }
 
   /// Handles traffic, serves and ticks until should_stop() returns true (checked before each
-  /// round). Publishes a flow_control_t and a stats_replay_t before returning.
+  /// round), then stores what still arrives (options: stop_quiet_ms, stop_drain_ms). Publishes
+  /// a flow_control_t and a stats_replay_t before returning.
   void Run(const std::function<bool()>& should_stop);
 
   /// The flat table (empty when the run stores pixels).

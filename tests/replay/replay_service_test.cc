@@ -543,6 +543,15 @@ TEST_F(ReplayServiceTest, RunServesUntilAskedToStop) {
   EXPECT_EQ(stats_.back().total_samples, 8);
 }
 
+// Actors that stop with the replay send their last steps as they go: a replay asked to stop
+// still stores what arrives (until it has been quiet a while), so its last snapshot has them.
+TEST_F(ReplayServiceTest, RunStoresWhatArrivesAsItStops) {
+  Start(Options(8, 10, 200));
+  SendTransitions(0, 10);
+  service_->Run([] { return true; });
+  EXPECT_EQ(service_->total_inserts(), 10);
+}
+
 // Actor ids at or above max_actors are refused and counted: a forged id cannot grow the
 // per-actor counts that every flow message and snapshot carries.
 TEST_F(ReplayServiceTest, RefusesActorIdsFromMaxActorsOn) {
