@@ -1,6 +1,7 @@
 #include "evaluator/evaluator_service.h"
 
 #include "envs/specs.h"
+#include "evaluator/announced_checkpoint.h"
 #include "evaluator/frame_grid.h"
 #include "evaluator/tsne_map.h"
 #include "evaluator/video.h"
@@ -89,8 +90,14 @@ void EvaluatorConfig::Validate() const {
 
 nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env_id,
                                  nn::CheckpointMeta* meta) {
-  // Load and build; every failure is a refusal with a reason.
-  nn::Checkpoint ckpt = nn::LoadCheckpoint(path);
+  const nn::Checkpoint ckpt = nn::LoadCheckpoint(path);
+  if (meta != nullptr) *meta = ckpt.meta;
+  return PolicyNetwork(ckpt, path, env_id);
+}
+
+nn::Sequential PolicyNetwork(const nn::Checkpoint& ckpt, const std::string& path,
+                             const std::string& env_id) {
+  // Build; every failure is a refusal with a reason.
   std::mt19937 init_rng(0);  // the initial weights are overwritten by the checkpoint's
   nn::Sequential net;
   try {
@@ -107,15 +114,22 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
   net.SetFlat(ckpt.params.data(), ckpt.params.size());
   const std::string misfit = CheckNetworkFitsEnv(net, envs::LookupSpec(env_id));
   if (!misfit.empty()) throw std::runtime_error("checkpoint " + path + ": " + misfit);
-  if (meta != nullptr) *meta = ckpt.meta;
   return net;
 }
 
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
                                double epsilon, uint64_t first_seed, double gamma,
                                const std::function<void()>& after_episode) {
-  nn::CheckpointMeta meta;
-  nn::Sequential net = LoadPolicyNetwork(path, env_id, &meta);
+  return ScoreCheckpoint(nn::LoadCheckpoint(path), path, env_id, episodes, epsilon, first_seed,
+                         gamma, after_episode);
+}
+
+EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
+                           const std::string& env_id, int episodes, double epsilon,
+                           uint64_t first_seed, double gamma,
+                           const std::function<void()>& after_episode) {
+  const nn::CheckpointMeta& meta = ckpt.meta;
+  nn::Sequential net = PolicyNetwork(ckpt, path, env_id);
 
   // Score.
   const double start = MonoSeconds();
@@ -204,6 +218,11 @@ void EvaluatorService::Log(const char* fmt, ...) const {
   std::fflush(progress_);
 }
 
+std::string EvaluatorService::CheckpointFolder() const {
+  if (config_.out_dir.empty()) return {};
+  return (std::filesystem::path(config_.out_dir) / "checkpoints").string();
+}
+
 void EvaluatorService::OnCheckpoint(const rlmsg::checkpoint_t& msg) {
   // A re-announcement of a scored checkpoint changes nothing.
   if (scored_keys_.count({FileName(msg.path), msg.update}) > 0 ||
@@ -255,19 +274,22 @@ bool EvaluatorService::ScorePending() {
   busy_ = true;
   PublishStats();
 
-  // Load and score; a refused file is logged and counted.
+  // Load and score; a refused path or file is logged and counted. The file is read once, from
+  // the run's checkpoint folder only (announced_checkpoint.h), and serves every use below.
   EvalRecord record;
+  nn::Checkpoint ckpt;
   // Thrown between episodes when a stop was requested: an unfinished evaluation is dropped.
   struct Stopped {};
   try {
+    ckpt = ReadAnnouncedCheckpoint(announced.path, CheckpointFolder());
     // Stats keep flowing during a long evaluation (KUKA: about a second per episode), so the
     // monitor never mistakes a busy evaluator for a dead one, and a stop request is honoured
     // after the current episode.
-    record = ScoreCheckpointFile(announced.path, config_.env_id, config_.episodes, config_.epsilon,
-                                 config_.seed_base, config_.gamma, [this] {
-                                   if (StopRequested()) throw Stopped{};
-                                   if (MonoSeconds() >= next_stats_time_) PublishStats();
-                                 });
+    record = ScoreCheckpoint(ckpt, announced.path, config_.env_id, config_.episodes,
+                             config_.epsilon, config_.seed_base, config_.gamma, [this] {
+                               if (StopRequested()) throw Stopped{};
+                               if (MonoSeconds() >= next_stats_time_) PublishStats();
+                             });
   } catch (const Stopped&) {
     busy_ = false;
     std::printf("evaluator: stopped during an evaluation; %s is left unscored\n",
@@ -292,11 +314,11 @@ bool EvaluatorService::ScorePending() {
     busy_ = true;
     try {
       const EvalRecord second =
-          ScoreCheckpointFile(announced.path, config_.second_env, config_.second_episodes,
-                              config_.epsilon, config_.seed_base, config_.gamma, [this] {
-                                if (StopRequested()) throw Stopped{};
-                                if (MonoSeconds() >= next_stats_time_) PublishStats();
-                              });
+          ScoreCheckpoint(ckpt, announced.path, config_.second_env, config_.second_episodes,
+                          config_.epsilon, config_.seed_base, config_.gamma, [this] {
+                            if (StopRequested()) throw Stopped{};
+                            if (MonoSeconds() >= next_stats_time_) PublishStats();
+                          });
       record.second_mean = second.mean;
       record.second_std = second.std;
       record.second_episodes = second.episodes;
@@ -319,12 +341,12 @@ bool EvaluatorService::ScorePending() {
   records_.push_back(record);
   scored_keys_.insert({record.checkpoint, record.update});
   if (config_.videos && !report_dir_.empty() && record.mean > best_video_mean_) {
-    RecordVideo(announced.path, record);
+    RecordVideo(ckpt, announced.path, record);
   }
   // A new best checkpoint's t-SNE map becomes due (replacing an older best's that was not made).
   if (config_.tsne > 0 && !report_dir_.empty() && record.mean > best_tsne_mean_) {
     try {
-      tsne_net_ = LoadPolicyNetwork(announced.path, config_.env_id);
+      tsne_net_ = PolicyNetwork(ckpt, announced.path, config_.env_id);
       tsne_record_ = record;
       best_tsne_mean_ = record.mean;
     } catch (const std::exception& e) {
@@ -465,11 +487,12 @@ bool EvaluatorService::MakeTsneMap() {
   return written;
 }
 
-void EvaluatorService::RecordVideo(const std::string& path, const EvalRecord& record) {
-  // One load serves the video and the frame grid.
+void EvaluatorService::RecordVideo(const nn::Checkpoint& ckpt, const std::string& path,
+                                   const EvalRecord& record) {
+  // One network serves the video and the frame grid.
   nn::Sequential net;
   try {
-    net = LoadPolicyNetwork(path, config_.env_id);
+    net = PolicyNetwork(ckpt, path, config_.env_id);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "evaluator: no video: %s\n", e.what());
     std::fflush(stderr);

@@ -6,6 +6,11 @@
 //   out: RL_EVAL (eval_result_t)            one per scored checkpoint
 //        RL_STATS_EVALUATOR (stats_evaluator_t), a few times per second
 //
+// An announced checkpoint is read only when it is a regular file of a bounded size directly in
+// the run's checkpoint folder, <out_dir>/checkpoints (announced_checkpoint.h); any other path
+// (a device, a FIFO, a symbolic link, a file elsewhere) is refused and counted, like a file that
+// does not load. Without an out_dir every announcement is refused.
+//
 // Only the newest announced checkpoint that is not scored yet is kept: when the learner writes
 // checkpoints faster than they are scored, the older unscored ones are skipped (and counted).
 // Scoring runs in the thread that calls Poll(), between Bus::Handle() calls.
@@ -81,6 +86,17 @@ inline constexpr double kTsneGoalSeconds = 15.0;
 nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env_id,
                                  nn::CheckpointMeta* meta = nullptr);
 
+/// The network of a loaded checkpoint (`path` names it in errors), checked against `env_id`.
+/// Throws std::runtime_error as LoadPolicyNetwork.
+nn::Sequential PolicyNetwork(const nn::Checkpoint& ckpt, const std::string& path,
+                             const std::string& env_id);
+
+/// ScoreCheckpointFile of a loaded checkpoint (`path` names it in the record and in errors).
+EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
+                           const std::string& env_id, int episodes, double epsilon,
+                           uint64_t first_seed, double gamma = kDefaultGamma,
+                           const std::function<void()>& after_episode = {});
+
 /// Loads a checkpoint file, builds its network and scores it on `env_id` (see ScorePolicy), with
 /// its value estimates against the returns (discount gamma).
 /// The record's update, env_steps and wall_seconds come from the file's metadata. Throws
@@ -120,9 +136,9 @@ class EvaluatorService {
 
   /// Rewrites out_dir/report/ (no-op without out_dir). Logs, never throws.
   void WriteReportNow();
-  /// Records report/best.webm, a greedy episode of the checkpoint at `path`, and for pixel envs
-  /// report/frames.png, its grid of camera frames.
-  void RecordVideo(const std::string& path, const EvalRecord& record);
+  /// Records report/best.webm, a greedy episode of the checkpoint `ckpt` (read from `path`), and
+  /// for pixel envs report/frames.png, its grid of camera frames.
+  void RecordVideo(const nn::Checkpoint& ckpt, const std::string& path, const EvalRecord& record);
   /// Whether a t-SNE map is due (a new best checkpoint not mapped yet, with config.tsne > 0).
   bool tsne_map_due() const { return tsne_net_.has_value(); }
   /// Seconds spent on t-SNE maps so far.
@@ -151,6 +167,9 @@ class EvaluatorService {
 
  private:
   void OnCheckpoint(const rlmsg::checkpoint_t& msg);
+  // <out_dir>/checkpoints, the only folder announced checkpoints are read from (empty without
+  // an out_dir: every announcement is refused).
+  std::string CheckpointFolder() const;
   // Makes report/tsne.png for the due network now, with progress lines and stats; logs failures.
   // Returns true when the map was written. A stop request during it leaves the map due.
   bool MakeTsneMap();

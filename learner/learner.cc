@@ -1,8 +1,12 @@
 #include "learner/learner.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include "common/channels.h"
 #include "common/clock.h"
@@ -26,6 +30,32 @@ std::unique_ptr<Algorithm> MakeAlgorithm(const LearnerConfig& c, const envs::Env
                                 "algorithm = td3)");
   }
   return std::make_unique<Dqn>(spec.observation_size, spec.num_actions, c.dqn);
+}
+
+// The checkpoint files ("ckpt-<update>.bin") in `dir`, by update, oldest first: what earlier
+// lives of the learner (a restart, a resumed run) left there.
+std::deque<std::string> CheckpointFiles(const std::filesystem::path& dir) {
+  std::vector<std::pair<int64_t, std::string>> found;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    constexpr std::string_view kPrefix = "ckpt-", kSuffix = ".bin";
+    if (!name.starts_with(kPrefix) || !name.ends_with(kSuffix)) continue;
+    const std::string digits =
+        name.substr(kPrefix.size(), name.size() - kPrefix.size() - kSuffix.size());
+    // Update counts of at most 18 digits (int64_t).
+    if (digits.empty() || digits.size() > 18 ||
+        digits.find_first_not_of("0123456789") != std::string::npos) {
+      continue;
+    }
+    std::error_code regular;
+    if (!entry.is_regular_file(regular)) continue;
+    found.emplace_back(std::stoll(digits), entry.path().string());
+  }
+  std::sort(found.begin(), found.end());
+  std::deque<std::string> files;
+  for (auto& [update, path] : found) files.push_back(std::move(path));
+  return files;
 }
 
 }  // namespace
@@ -57,6 +87,8 @@ Learner::Learner(LearnerConfig config, Bus* bus)
       sender_(bus->config().sender) {
   nn::SetNumThreads(config_.threads);
   std::filesystem::create_directories(std::filesystem::path(config_.out_dir) / "checkpoints");
+  // Earlier lives' checkpoints count towards keep_checkpoints, and go first.
+  written_ = CheckpointFiles(std::filesystem::path(config_.out_dir) / "checkpoints");
   if (config_.resume && std::filesystem::exists(StatePath())) {
     LoadState(StateFile::Load(StatePath(), StateKind()));
     resumed_ = true;
@@ -187,8 +219,10 @@ std::string Learner::Checkpoint() {
   algorithm_->policy().GetFlat(&ckpt.params);
   nn::SaveCheckpoint(path, ckpt);
   SaveState().Save(StatePath());
-  // Keep the newest keep_checkpoints files; older ones have been scored or skipped by now.
-  if (written_.empty() || written_.back() != path) written_.push_back(path);
+  // Keep the newest keep_checkpoints files (this life's last, earlier lives' before them); older
+  // ones have been scored or skipped by now.
+  written_.erase(std::remove(written_.begin(), written_.end(), path), written_.end());
+  written_.push_back(path);
   while (config_.keep_checkpoints > 0 &&
          static_cast<int>(written_.size()) > config_.keep_checkpoints) {
     std::error_code ignored;

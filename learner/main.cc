@@ -112,7 +112,8 @@ int Main(int argc, char** argv) {
       ("checkpoint-every", rl::po::value(&c.checkpoint_every)->default_value(c.checkpoint_every),
        "updates between checkpoints")  //
       ("keep-checkpoints", rl::po::value(&c.keep_checkpoints)->default_value(c.keep_checkpoints),
-       "newest checkpoint files kept on disk (0: all)")  //
+       "newest checkpoint files kept on disk, those earlier lives of the learner left in the "
+       "folder included (0: all)")  //
       ("threads", rl::po::value(&c.threads)->default_value(c.threads),
        "compute threads for the network (convolutions and large products are split; 1 leaves "
        "the other cores to the actors)")  //

@@ -83,6 +83,9 @@ int Main(int argc, char** argv) {
        "RL_FLOW messages per second (and at once on every change)")  //
       ("stats-hz", po::value(&options.stats_hz)->default_value(options.stats_hz),
        "RL_STATS_REPLAY messages per second")  //
+      ("max-actors", po::value(&options.max_actors)->default_value(options.max_actors),
+       "actor ids stored: 0 .. max-actors - 1 (at most 1024); batches of other ids are refused "
+       "and counted")  //
       ("snapshot", po::value(&snapshots.path),
        "snapshot file: loaded at the start when it exists, written every --snapshot-every "
        "seconds and at the end (none: no snapshots)")  //

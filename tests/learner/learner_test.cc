@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <set>
 #include <utility>
@@ -250,6 +251,33 @@ TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFiles) {
   // The learner's state (for a restart) is kept beside them.
   EXPECT_EQ(left, (std::vector<std::string>{"ckpt-000000040.bin", "ckpt-000000050.bin",
                                             "learner-state.bin"}));
+}
+
+// A restarted or resumed learner counts the checkpoint files of its earlier lives towards
+// keep_checkpoints (they go first), so they do not pile up; other files stay.
+TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFilesOfEveryLife) {
+  LearnerConfig c = ShortRun(8, 60, 10);
+  c.keep_checkpoints = 0;        // all: 10, 20, ..., 60
+  Learner first(c, bus_.get());  // alive to the end: the bus keeps its handler
+  first.Run();
+  bus_->Handle(0);
+  for (const char* name : {"ckpt-000000070.bin.tmp.77", "notes.txt", "ckpt-abc.bin"}) {
+    std::ofstream(dir_ / "checkpoints" / name) << "x";
+  }
+  c.keep_checkpoints = 3;
+  c.resume = true;
+  c.max_updates = 80;
+  Learner second(c, bus_.get());
+  ASSERT_TRUE(second.resumed());
+  second.Run();  // 70, 80
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir_ / "checkpoints")) {
+    left.push_back(e.path().filename().string());
+  }
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"ckpt-000000060.bin", "ckpt-000000070.bin",
+                                            "ckpt-000000070.bin.tmp.77", "ckpt-000000080.bin",
+                                            "ckpt-abc.bin", "learner-state.bin", "notes.txt"}));
 }
 
 TEST(LearnerConfigTest, RefusesBadSettings) {

@@ -546,6 +546,31 @@ TEST_F(ReplaySnapshotTest, AFailedSnapshotIsCountedAndKeepsTheService) {
   EXPECT_THROW(bad.Validate(), std::invalid_argument);
 }
 
+// Actor ids come from the network: a key holder may send any (2^31 - 1, or more distinct ones
+// than a snapshot holds). Ids from max_actors on are refused and counted, so the per-actor
+// counts stay bounded and the next snapshot loads; a replay told to take fewer ids refuses a
+// snapshot that holds more, saying so.
+TEST_F(ReplaySnapshotTest, ForgedActorIdsAreRefusedAndTheNextSnapshotLoads) {
+  ReplayServiceOptions options = Options(false, 100);
+  Replica saved(options);
+  saved.Publish(channels::kTransitions, FlatBatch(0, 2, std::numeric_limits<int32_t>::max()),
+                "actor-x");
+  constexpr int kIds = 66000;  // more than the 65536 a snapshot held before ids were bounded
+  for (int id = 0; id < kIds; ++id) {
+    saved.Publish(channels::kTransitions, FlatBatch(id, 1, id), "actor-x");
+  }
+  EXPECT_EQ(saved.service().total_inserts(), options.max_actors);
+  EXPECT_EQ(saved.service().counters().batches_refused, kIds - options.max_actors + 1);
+  const std::string bytes = saved.Snapshot();
+  Replica restored(options);
+  EXPECT_EQ(ErrorOf([&] { restored.service().RestoreSnapshot(bytes); }), "");
+  EXPECT_EQ(restored.service().total_inserts(), options.max_actors);
+  ReplayServiceOptions fewer = options;
+  fewer.max_actors = 8;
+  EXPECT_NE(LoadError(bytes, fewer).find("holds actor id 8, this replay stores ids below 8"),
+            std::string::npos);
+}
+
 TEST_F(ReplaySnapshotTest, AReplayThatHasServedRefusesToLoad) {
   Replica saved(Options(false));
   FillFlat(&saved);
