@@ -2,8 +2,9 @@
 // API.
 //
 // Eigen's general product reaches about 70 GFLOP/s on the 84x120 by 120x128 products of the DQN
-// MLP (about 36 us each); this kernel about 95 (about 26 us). It packs panels of up to 24 rows of
-// the left operand and keeps a 24 x 8 block of the result in registers (16 x 6 on the avx2 path)
+// MLP (about 36 us each); this kernel about 95 (about 26 us) with 8-float vectors. It packs panels
+// of up to 48 rows of the left operand and keeps a 48 x 8 block of the result in registers (16 x 6
+// on the avx2 path)
 // while it walks the shared dimension; products with at most 4 rows are computed as dot products
 // instead. Transposed operands are read through strides, so no transposed copy of a weight or
 // activation matrix is made, and the bias and a ReLU (or a ReLU's backward mask) are applied as

@@ -1,6 +1,6 @@
 // The avx512 path: the kernels compiled for AVX-512 (F, BW, DQ, VL, CD; x86-64-v4): 32 registers,
-// 8-float vectors in the products, 16-float ones with masks in the copies. bf16 products are
-// emulated (nn/gemm.cc).
+// 16-float vectors, masked loads and stores in the copies. bf16 products are emulated
+// (nn/gemm.cc).
 #include "nn/kernels_prelude.h"
 #include "nn/kernels_target.h"
 
