@@ -15,6 +15,7 @@
 #include "learner/algorithm_state.h"
 #include "nn/checkpoint.h"
 #include "nn/parallel.h"
+#include "nn/precision.h"
 #include "rlmsg/checkpoint_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
 #include "rlmsg/stats_learner_t.hpp"
@@ -23,13 +24,20 @@ namespace rl::learner {
 namespace {
 
 std::unique_ptr<Algorithm> MakeAlgorithm(const LearnerConfig& c, const envs::EnvSpec& spec) {
-  if (c.algorithm == "td3") return std::make_unique<Td3>(spec, c.td3);
+  const nn::Precision precision = nn::ParsePrecision(c.precision);
+  if (c.algorithm == "td3") {
+    Td3Config td3 = c.td3;
+    td3.precision = precision;
+    return std::make_unique<Td3>(spec, td3);
+  }
   if (spec.continuous()) {
     throw std::invalid_argument(spec.id +
                                 " has continuous actions; DQN needs discrete ones (use "
                                 "algorithm = td3)");
   }
-  return std::make_unique<Dqn>(spec.observation_size, spec.num_actions, c.dqn);
+  DqnConfig dqn = c.dqn;
+  dqn.precision = precision;
+  return std::make_unique<Dqn>(spec.observation_size, spec.num_actions, dqn);
 }
 
 // The checkpoint files ("ckpt-<update>.bin") in `dir`, by update, oldest first: what earlier
@@ -75,6 +83,7 @@ void LearnerConfig::Validate() const {
   if (keep_checkpoints < 0) throw std::invalid_argument("keep-checkpoints must be >= 0");
   if (!(stats_hz > 0)) throw std::invalid_argument("stats-hz must be > 0");
   if (threads < 1 || threads > 64) throw std::invalid_argument("threads must be in [1, 64]");
+  nn::ParsePrecision(precision);
 }
 
 Learner::Learner(LearnerConfig config, Bus* bus)
@@ -181,6 +190,7 @@ std::string Learner::StateKind() const { return "learner " + config_.algorithm; 
 StateFile Learner::SaveState() const {
   StateFile state(StateKind());
   state.PutText("learner.env", config_.env_id);
+  state.PutText("learner.precision", config_.precision);
   state.PutInt("learner.env_steps", env_steps_);
   state.PutText("learner.wall_seconds", std::to_string(MonoSeconds() - start_time_));
   PutRng(&state, "learner.shift_rng", decoder_.shift_rng());
@@ -195,6 +205,14 @@ void Learner::LoadState(const StateFile& state) {
   if (state.Text("learner.env") != config_.env_id) {
     throw std::runtime_error("the saved learner state is of env " + state.Text("learner.env") +
                              ", this run's is " + config_.env_id);
+  }
+  // States written before the option existed were trained in fp32.
+  const std::string precision =
+      state.Has("learner.precision") ? state.Text("learner.precision") : "fp32";
+  if (precision != config_.precision) {
+    throw std::runtime_error("the saved learner state was trained with precision " + precision +
+                             ", this run's is " + config_.precision +
+                             ": resume with the same precision, or start afresh");
   }
   algorithm_->LoadState(state);
   env_steps_ = state.Int("learner.env_steps");
@@ -215,7 +233,7 @@ std::string Learner::Checkpoint() {
   ckpt.meta.env_steps = env_steps_;
   ckpt.meta.wall_seconds = MonoSeconds() - start_time_;
   ckpt.meta.run_id = static_cast<uint64_t>(bus_->config().run_id);
-  ckpt.meta.note = config_.env_id;
+  ckpt.meta.note = "env = " + config_.env_id + "\nprecision = " + config_.precision;
   algorithm_->policy().GetFlat(&ckpt.params);
   nn::SaveCheckpoint(path, ckpt);
   SaveState().Save(StatePath());

@@ -45,7 +45,9 @@ struct LearnerConfig {
                                  // (0: all)
   bool prioritized = false;      // publish |TD errors| as priorities after every update
   int threads = 1;               // compute threads of the network library (nn::SetNumThreads)
-  std::string out_dir = ".";     // checkpoints go to <out_dir>/checkpoints/
+  // The networks' matrix products, "fp32" or "bf16" (nn/precision.h); kept in the learner state.
+  std::string precision = "fp32";
+  std::string out_dir = ".";  // checkpoints go to <out_dir>/checkpoints/
   // Continue from <out_dir>/checkpoints/learner-state.bin when it exists (written with every
   // checkpoint): networks, targets, optimizers, counters, generators, env steps and wall time.
   bool resume = false;

@@ -29,6 +29,7 @@ packages=(
   clang-14 libclang-rt-14-dev llvm-14  # fuzz/: clang, libFuzzer and sanitizers, symbolizer
   clang-tidy-14  # scripts/tidy.sh
   iproute2 util-linux procps
+  qemu-user  # tests/nn/haswell_test.sh: the binaries on a CPU without AVX-512
   slurm-wlm munge  # tests/cluster: a Slurm cluster in namespaces for the cluster tests
   chromium  # headless: the integration test that renders the report and compare pages
 )

@@ -2,8 +2,8 @@
 # The whole test suite, as CI runs it (.ci/run). Installs what is missing (scripts/setup.sh),
 # builds three trees from the presets of CMakePresets.json and runs, with ctest:
 #   1. clang-tidy (.clang-tidy) over the sources that the last commit changed (scripts/tidy.sh),
-#   2. the unit tests under ASan+UBSan (preset asan, build-asan/, clang), and nn's kernel tests
-#      once more per kernel path that can be forced (RL_NN_KERNEL_VAR, RL_NN_KERNEL_PATHS below),
+#   2. the unit tests under ASan+UBSan (preset asan, build-asan/, clang); nn's kernel tests run
+#      on every kernel path the CPU can run (tests/nn/kernel_paths.h),
 #   3. the multi-process tests labelled "sanitized" on the ASan+UBSan programs,
 #   4. the tests that run threads under ThreadSanitizer (preset tsan, build-tsan/),
 #   5. the unit tests on the Release build (preset release, build/), in parallel,
@@ -18,8 +18,7 @@
 # the end. The last line is "N passed, N failed" over every test, a failed build or clang-tidy
 # counting as one failure. Exit status 0 only when everything passed.
 #
-# Environment: RL_NN_KERNEL_VAR / RL_NN_KERNEL_PATHS override the kernel paths below;
-# RL_TIDY_ARGS replaces scripts/tidy.sh's arguments (e.g. --all).
+# Environment: RL_TIDY_ARGS replaces scripts/tidy.sh's arguments (e.g. --all).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -27,12 +26,6 @@ jobs=$(nproc)
 werror=OFF
 [ "${CI:-}" = "true" ] && werror=ON
 
-# nn/ forces a kernel path with an environment variable (nn/README.md): name it and its paths here
-# (e.g. RL_NN_KERNEL_VAR=VAR RL_NN_KERNEL_PATHS="avx512 avx2 generic"), and the kernel tests
-# run under ASan+UBSan once per path. Empty: once, on the path the CPU picks.
-kernel_var=${RL_NN_KERNEL_VAR:-}
-kernel_paths=${RL_NN_KERNEL_PATHS:-}
-kernel_tests='^(GemmTest|GemvTest|Conv2dTest|ParallelTest)\.'
 
 # Phase times: wall (s), CPU of everything the phase ran (user + system, from this shell's
 # reaped children), and the mean of the machine's 1-minute load, sampled every 5 s.
@@ -96,13 +89,6 @@ scripts/tidy.sh --build-dir build-asan --jobs "$jobs" ${RL_TIDY_ARGS:---changed}
 
 phase asan-unit
 run_ctest asan-unit build-asan --preset asan -j"$jobs"
-for path in $kernel_paths; do
-  [ -n "$kernel_var" ] || break
-  echo "test: nn's kernel tests with $kernel_var=$path"
-  ctest_env=("$kernel_var=$path")
-  run_ctest "asan-kernels-$path" build-asan --preset asan -j"$jobs" -R "$kernel_tests"
-  ctest_env=()
-done
 phase asan-processes
 run_ctest asan-processes build-asan --preset asan-integration
 phase tsan

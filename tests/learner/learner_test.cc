@@ -389,6 +389,30 @@ TEST_F(LearnerTest, Td3ResumesFromItsSavedStateAndNeverGoesBack) {
   ExpectResumes(c, bus_.get(), &versions_, &announced_);
 }
 
+// precision = bf16 reaches the networks, the checkpoint's note and the state: a resume keeps it
+// and one in another precision is refused, naming both.
+TEST_F(LearnerTest, Bf16ResumesInBf16AndRefusesAnotherPrecision) {
+  LearnerConfig c = ShortRun(16, 30, 10);
+  c.precision = "bf16";
+  Learner probe(c, bus_.get());  // alive to the end: the bus keeps its handler
+  EXPECT_EQ(probe.algorithm().policy().precision(), nn::Precision::kBf16);
+  ExpectResumes(c, bus_.get(), &versions_, &announced_);
+  EXPECT_NE(nn::LoadCheckpoint(announced_.back()).meta.note.find("precision = bf16"),
+            std::string::npos);
+  LearnerConfig fp32 = c;
+  fp32.precision = "fp32";
+  fp32.resume = true;
+  try {
+    Learner other(fp32, bus_.get());
+    ADD_FAILURE() << "a bf16 state was resumed in fp32";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("precision bf16, this run's is fp32"), std::string::npos)
+        << e.what();
+  }
+  c.precision = "fp16";
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
 TEST_F(LearnerTest, RefusesAStateOfAnotherRunOrATornOne) {
   Learner first(ShortRun(8, 10, 10), bus_.get());  // alive to the end: the bus keeps its handler
   first.Run();
