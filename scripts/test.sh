@@ -55,14 +55,12 @@ status=0
 failed_steps=()
 step_failed() { failed_steps+=("$1"); status=1; echo "test: FAILED: $1"; }
 junits=()
-# run_ctest NAME BUILD_DIR ARGS...: ctest with ARGS, per-test times in BUILD_DIR/junit-NAME.xml;
-# the variables of the array ctest_env (VAR=VALUE) set for it.
-ctest_env=()
+# run_ctest NAME BUILD_DIR ARGS...: ctest with ARGS, per-test times in BUILD_DIR/junit-NAME.xml.
 run_ctest() {
   local name=$1 junit="$root/$2/junit-$1.xml"
   shift 2
   rm -f "$junit"
-  if ! env ${ctest_env[@]+"${ctest_env[@]}"} ctest --no-tests=error --output-junit "$junit" "$@"; then
+  if ! ctest --no-tests=error --output-junit "$junit" "$@"; then
     status=1
     # A run that failed without a failing test in its XML (no tests found, ctest itself failed).
     grep -q 'failures="[1-9]' "$junit" 2>/dev/null || step_failed "ctest $name"
