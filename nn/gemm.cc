@@ -1,6 +1,7 @@
 #include "nn/gemm.h"
 
 #include <algorithm>
+#include <vector>
 
 #include "common/check.h"
 #include "nn/kernels.h"
@@ -27,10 +28,14 @@ Epilogue ShiftEpilogue(Epilogue e, const MutView& c, int i0, int j0) {
   return e;
 }
 
-// Scratch space of the tasks that do not run with the caller's workspace.
-Vector* TaskWorkspace() {
-  thread_local Vector workspace;
-  return &workspace;
+// Scratch space of the tasks that do not run with the caller's workspace, one per task index and
+// owned by the calling thread: whichever thread of the pool runs task t, it uses buffer t, so once
+// a product of a shape has run, the next one of that shape allocates nothing however the threads
+// share the tasks (buffers per running thread would grow again whenever a thread first ran a
+// task of a larger block).
+std::vector<Vector>* CallerTaskWorkspaces() {
+  thread_local std::vector<Vector> workspaces;
+  return &workspaces;
 }
 
 // The kernel that computes a product in `precision`: its functions and its blocking.
@@ -62,11 +67,13 @@ void SplitResult(const Product& kernel, int m, int n, int64_t work, Vector* work
   const int units = by_rows ? full_panels : n / kernel.nr;
   const int tasks = TasksFor(work, units);
   if (tasks <= 1) return piece(0, m, 0, n, workspace);
+  std::vector<Vector>* task_workspaces = CallerTaskWorkspaces();
+  if (static_cast<int>(task_workspaces->size()) < tasks) task_workspaces->resize(tasks);
   ParallelFor(tasks, [&](int task) {
     const int u0 = units * task / tasks;
     const int u1 = units * (task + 1) / tasks;
     const bool last = task == tasks - 1;
-    Vector* ws = task == 0 ? workspace : TaskWorkspace();
+    Vector* ws = task == 0 ? workspace : &(*task_workspaces)[task];
     if (by_rows) {
       const int i0 = u0 * kernel.panel_rows;
       piece(i0, (last ? m : u1 * kernel.panel_rows) - i0, 0, n, ws);
