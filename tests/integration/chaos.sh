@@ -21,31 +21,47 @@ scratch
 run="$dir/run"
 roles=(replay learner evaluator actor-0 actor-1)
 # What each writer leaves while it writes: PATH.tmp.<pid of the writer> (common/atomic_file.h).
-declare -A writes=([replay]="$run/replay-snapshot.bin.tmp." [learner]="$run/checkpoints/"
+declare -A writes=([replay]="$run/replay-snapshot.bin" [learner]="$run/checkpoints/"
                    [evaluator]="$run/report/")
 echo "chaos seed $seed, $kills kills (again: $again)"
 
-# The schedule, drawn before anything runs: a victim, a wait before the kill (ms) and whether it
-# aims at a write, for each kill. At least two of kills 2..N aim at a write.
+# The schedule, drawn before anything runs: for each kill a victim, a wait before it (ms), and
+# whether it aims at a write. Every kind of process is killed: the roles in a random order, then
+# random ones. Of kills 2..N, each writer aims at a write with odds 2 in 3, at least two do (the
+# order puts at least two writers there), and those come first, before the goal can end the run.
 RANDOM=$seed
-victim_draw=() delay_ms=() at_write=()
-writers=(replay learner evaluator)
+order=("${roles[@]}")
+for ((i = ${#order[@]} - 1; i > 0; i--)); do
+  j=$((RANDOM % (i + 1)))
+  swap=${order[i]} order[i]=${order[j]} order[j]=$swap
+done
+victims=() delay_ms=() at_write=()
 for ((k = 0; k < kills; k++)); do
-  delay_ms[k]=$((k == 0 ? 200 + RANDOM % 1800 : 300 + RANDOM % 2700))
-  if ((k > 0 && RANDOM % 2 == 0)); then
-    at_write[k]=1
-    victim_draw[k]=${writers[RANDOM % 3]}
-  else
-    at_write[k]=0
-    victim_draw[k]=$RANDOM
-  fi
+  victims[k]=${order[k]:-${roles[RANDOM % ${#roles[@]}]}}
+  delay_ms[k]=$((k == 0 ? 200 + RANDOM % 1800 : 100 + RANDOM % 900))
+  at_write[k]=0
+  if ((k > 0 && RANDOM % 3 > 0)) && [ -n "${writes[${victims[k]}]:-}" ]; then at_write[k]=1; fi
 done
 for ((n = 0, k = 1; k < kills; k++)); do n=$((n + at_write[k])); done
-for ((k = kills - 1; k > 0 && n < 2; k--)); do
-  if ((at_write[k] == 0)); then
-    at_write[k]=1 victim_draw[k]=${writers[k % 3]} n=$((n + 1))
-  fi
+for ((k = 1; k < kills && n < 2; k++)); do
+  if ((at_write[k] == 0)) && [ -n "${writes[${victims[k]}]:-}" ]; then at_write[k]=1 n=$((n + 1)); fi
 done
+# The kills aimed at a write first (a stable partition of kills 2..N).
+first=() rest=()
+for ((k = 1; k < kills; k++)); do
+  if ((at_write[k])); then first+=("${victims[k]}"); else rest+=("${victims[k]}"); fi
+done
+for ((k = 1; k < kills; k++)); do
+  at_write[k]=$((k <= ${#first[@]}))
+  victims[k]=${first[k - 1]:-${rest[k - 1 - ${#first[@]}]}}
+done
+plan=""
+for ((k = 0; k < kills; k++)); do
+  mark=""
+  ((at_write[k] == 0)) || mark=" writing"
+  plan="$plan${plan:+, }${delay_ms[k]} ms, ${victims[k]}$mark"
+done
+echo "the plan: $plan"
 
 now_ms() { echo $(($(date +%s%N) / 1000000)); }
 start_ms=$(now_ms)
@@ -55,18 +71,24 @@ starts_of() { grep -c "^$1 " "$run/pids" 2>/dev/null || true; }
 alive() { awk '$3 != "Z" { found = 1 } END { exit !found }' "/proc/$1/stat" 2>/dev/null; }
 going() { kill -0 "$launch_pid" 2>/dev/null; }
 
-# A process may be killed several times in a row: the launcher must not give up on it.
+# A process may be killed several times in a row: the launcher must not give up on it. A snapshot
+# every second, so that kills find one being written; a tenth of the preset's learning rate, so
+# that CartPole is not solved before the kills are made (it can be within 10 s).
 launch cartpole --out "$run" --actors 2 --seed 7 --time-budget 240 --max-restarts "$kills" \
-  --replay-args "--snapshot-every 1" > "$dir/launch.log" 2>&1 &
+  --replay-args "--snapshot-every 1" --learner-args "--learning-rate 0.0001" \
+  > "$dir/launch.log" 2>&1 &
 launch_pid=$!
 
 # Waits (bounded) until ROLE's next start (its START-th) is ready: its pid listed again, and the
 # last line of its log of either kind a ready line of its own (not the launcher's restart line).
 wait_back() {  # wait_back ROLE START
-  timeout 60 bash -c 'until [ "$(grep -c "^$1 " "$0")" -ge "$2" ]; do sleep 0.05; done' \
-    "$run/pids" "$1" "$2" || fail "$1 was not started again within 60 s"
-  timeout 60 bash -c 'until grep "^$1: ready\|^launch: $1 " "$0" | tail -1 | grep -q "^$1: ready"; do
-      sleep 0.05; done' "$run/logs/$1.log" "$1" || fail "$1 was not ready again within 60 s"
+  local until=$((SECONDS + 60))
+  until [ "$(starts_of "$1")" -ge "$2" ] &&
+    grep "^$1: ready\|^launch: $1 " "$run/logs/$1.log" | tail -1 | grep -q "^$1: ready"; do
+    going || fail "the run ended while $1 was down: $(tail -3 "$dir/launch.log")"
+    ((SECONDS < until)) || fail "$1 was not started again and ready within 60 s"
+    sleep 0.05
+  done
 }
 
 # Polls (tight, bounded) for a temporary file of ROLE's writer; prints its path.
@@ -82,17 +104,18 @@ find_write() {  # find_write ROLE SECONDS
 
 during_write=0 made=0 early=""
 for ((k = 0; k < kills; k++)); do
+  victim=${victims[k]}
   if ((k == 0)); then
-    # Within 2 s of the first start: one of the processes started so far.
+    # Within 2 s of the first start (or at its own start, when it starts later), while the run
+    # is still starting.
     timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.01; done' "$run/pids" ||
       fail "no process started within 60 s"
     first_ms=$(now_ms)
     sleep "$(awk -v ms="${delay_ms[0]}" 'BEGIN { print ms / 1000 }')"
-    mapfile -t started < <(awk '$1 != "monitor" && !seen[$1]++ {print $1}' "$run/pids")
-    victim=${started[victim_draw[0] % ${#started[@]}]}
+    timeout 60 bash -c 'until grep -q "^$1 " "$0"; do sleep 0.01; done' "$run/pids" "$victim" ||
+      fail "$victim did not start within 60 s"
   else
     sleep "$(awk -v ms="${delay_ms[k]}" 'BEGIN { print ms / 1000 }')"
-    if ((at_write[k])); then victim=${victim_draw[k]}; else victim=${roles[victim_draw[k] % 5]}; fi
   fi
   going || fail "the run ended after $made of $kills kills: $(tail -3 "$dir/launch.log")"
   starts=$(starts_of "$victim")
