@@ -4,8 +4,9 @@
 # first start (while the run is still starting), and some while the replay writes a snapshot, the
 # learner a checkpoint or its state, or the evaluator its report (the test waits for the writer's
 # temporary file and kills at once). Each kill waits until the process killed before it is back
-# and ready. The run must still reach its goal, with the report whole, one restart per kill, no
-# message dropped, no temporary file left behind, and no process of the run alive after it.
+# and ready (the run may reach its goal before the last kills, not before CHAOS_MIN_KILLS, 4). The
+# run must still reach its goal, with the report whole, one restart per kill, no message dropped,
+# no temporary file left behind, and no process of the run alive after it.
 #
 # Seeded: CHAOS_SEED (default 21) draws the victims, the moments and which kills aim at a write;
 # the seed is printed at the start and in every failure, with the command that runs it again.
@@ -15,6 +16,9 @@ source "$(dirname "$0")/lib.sh"
 isolate "$@"
 seed=${CHAOS_SEED:-21}
 kills=${CHAOS_KILLS:-6}
+# A run may reach its goal before the last kills (CartPole is quick on a quiet machine): it must
+# not before this many.
+min_kills=${CHAOS_MIN_KILLS:-4}
 again="CHAOS_SEED=$seed ctest --test-dir $build_dir -R integration.chaos --output-on-failure"
 fail() { echo "FAIL: $* (chaos seed $seed; again: $again)" >&2; exit 1; }
 scratch
@@ -85,7 +89,7 @@ wait_back() {  # wait_back ROLE START
   local until=$((SECONDS + 60))
   until [ "$(starts_of "$1")" -ge "$2" ] &&
     grep "^$1: ready\|^launch: $1 " "$run/logs/$1.log" | tail -1 | grep -q "^$1: ready"; do
-    going || fail "the run ended while $1 was down: $(tail -3 "$dir/launch.log")"
+    going || return 0  # the run reached its goal meanwhile
     ((SECONDS < until)) || fail "$1 was not started again and ready within 60 s"
     sleep 0.05
   done
@@ -117,7 +121,7 @@ for ((k = 0; k < kills; k++)); do
   else
     sleep "$(awk -v ms="${delay_ms[k]}" 'BEGIN { print ms / 1000 }')"
   fi
-  going || fail "the run ended after $made of $kills kills: $(tail -3 "$dir/launch.log")"
+  going || break
   starts=$(starts_of "$victim")
   pid=$(pid_of "$victim")
   [ -n "$pid" ] || fail "no pid for $victim"
@@ -139,6 +143,7 @@ for ((k = 0; k < kills; k++)); do
         what="just after a write of ${tmp#"$run"/} ended"
       fi
     else
+      going || break
       what="(no write seen within 20 s)"
     fi
   fi
@@ -149,7 +154,7 @@ for ((k = 0; k < kills; k++)); do
   # Back and ready before the next kill, so that each kill is one restart.
   wait_back "$victim" $((starts + 1))
 done
-echo "$made kills; $during_write during a write; the first: $early after the first start"
+echo "$made of $kills kills made; $during_write during a write; the first: $early after the first start"
 
 set +e
 wait "$launch_pid"
@@ -159,6 +164,7 @@ end=$(elapsed)
 tail -4 "$dir/launch.log"
 [ "$status" -eq 0 ] || fail "launch exited with $status"
 grep -q "goal of .* reached" "$dir/launch.log" || fail "no goal line"
+((made >= min_kills)) || fail "the run reached its goal after $made kills (at least $min_kills expected)"
 ((during_write >= 1)) || fail "no kill landed during a write"
 
 # One restart per kill, each by SIGKILL, counted on the progress line and in the report.
@@ -201,5 +207,5 @@ left=$(find "$run" -name '*.tmp.*' | sed "s|^$run/||")
 expect_all_ended "$run" 10
 others=$(pgrep -f -- "$run" || true)
 [ -z "$others" ] || fail "processes of the run still alive: $(ps -o pid,args -p "$(echo $others | tr ' ' ,)")"
-echo "PASS: chaos seed $seed: $made kills ($during_write during a write, the first $early in)," \
+echo "PASS: chaos seed $seed: $made of $kills kills ($during_write during a write, the first $early in)," \
   "the goal reached in $end, the report whole"
