@@ -126,6 +126,8 @@ for ((k = 0; k < kills; k++)); do
   pid=$(pid_of "$victim")
   [ -n "$pid" ] || fail "no pid for $victim"
   what=""
+  # Until a kill has cut a write short, every kill of a writer aims at a write (a retry).
+  if ((k > 0 && during_write == 0)) && [ -n "${writes[$victim]:-}" ]; then at_write[k]=1; fi
   if ((at_write[k])); then
     # Kill as soon as a temporary file of its writer shows.
     if tmp=$(find_write "$victim" 20); then
