@@ -48,7 +48,9 @@ for ((k = 0; k < kills; k++)); do
 done
 for ((n = 0, k = 1; k < kills; k++)); do n=$((n + at_write[k])); done
 for ((k = 1; k < kills && n < 2; k++)); do
-  if ((at_write[k] == 0)) && [ -n "${writes[${victims[k]}]:-}" ]; then at_write[k]=1 n=$((n + 1)); fi
+  if ((at_write[k] == 0)) && [ -n "${writes[${victims[k]}]:-}" ]; then
+    at_write[k]=1 n=$((n + 1))
+  fi
 done
 # The kills aimed at a write first (a stable partition of kills 2..N).
 first=() rest=()
@@ -69,7 +71,8 @@ echo "the plan: $plan"
 
 now_ms() { echo $(($(date +%s%N) / 1000000)); }
 start_ms=$(now_ms)
-elapsed() { awk -v ms=$(($(now_ms) - start_ms)) 'BEGIN { printf "%.1f s", ms / 1000 }'; }
+since() { awk -v ms=$(($(now_ms) - $1)) 'BEGIN { printf "%.1f s", ms / 1000 }'; }
+elapsed() { since "$start_ms"; }
 pid_of() { awk -v r="$1" '$1 == r {p = $2} END {print p}' "$run/pids" 2>/dev/null; }
 starts_of() { grep -c "^$1 " "$run/pids" 2>/dev/null || true; }
 alive() { awk '$3 != "Z" { found = 1 } END { exit !found }' "/proc/$1/stat" 2>/dev/null; }
@@ -136,8 +139,8 @@ for ((k = 0; k < kills; k++)); do
       [[ $writer =~ ^[0-9]+$ ]] || writer=$pid
       kill -KILL "$pid"
       # Once the writer is gone, its file is still there only when the kill cut the write short.
-      timeout 10 bash -c 'while awk '\''$3 != "Z" {f = 1} END {exit !f}'\'' "/proc/$0/stat" 2>/dev/null; do
-          sleep 0.01; done' "$writer" || fail "the writer $writer of $victim outlived it by 10 s"
+      for _ in $(seq 1000); do alive "$writer" || break; sleep 0.01; done
+      ! alive "$writer" || fail "the writer $writer of $victim outlived it by 10 s"
       if [ -e "$tmp" ]; then
         what="during a write of ${tmp#"$run"/}"
         during_write=$((during_write + 1))
@@ -151,12 +154,13 @@ for ((k = 0; k < kills; k++)); do
   fi
   alive "$pid" && kill -KILL "$pid"
   made=$((made + 1))
-  [ -n "$early" ] || early="$victim at $(awk -v ms=$(($(now_ms) - first_ms)) 'BEGIN { printf "%.1f s", ms / 1000 }')"
+  [ -n "$early" ] || early="$victim at $(since "$first_ms")"
   echo "kill $made at $(elapsed): $victim (pid $pid)${what:+ $what}"
   # Back and ready before the next kill, so that each kill is one restart.
   wait_back "$victim" $((starts + 1))
 done
-echo "$made of $kills kills made; $during_write during a write; the first: $early after the first start"
+echo "$made of $kills kills made; $during_write during a write;" \
+  "the first: $early after the first start"
 
 set +e
 wait "$launch_pid"
@@ -166,7 +170,8 @@ end=$(elapsed)
 tail -4 "$dir/launch.log"
 [ "$status" -eq 0 ] || fail "launch exited with $status"
 grep -q "goal of .* reached" "$dir/launch.log" || fail "no goal line"
-((made >= min_kills)) || fail "the run reached its goal after $made kills (at least $min_kills expected)"
+((made >= min_kills)) ||
+  fail "the run reached its goal after $made kills (at least $min_kills expected)"
 ((during_write >= 1)) || fail "no kill landed during a write"
 
 # One restart per kill, each by SIGKILL, counted on the progress line and in the report.
@@ -174,13 +179,15 @@ restarts=$(wc -l < "$run/restarts")
 [ "$restarts" -eq "$made" ] || fail "$restarts restarts for $made kills: $(cat "$run/restarts")"
 [ "$(grep -c " status 137 restart " "$run/restarts")" -eq "$made" ] ||
   fail "a restart was not of a SIGKILL: $(cat "$run/restarts")"
-grep -q "restarts $made" "$run/logs/monitor.log" || fail "the progress line does not count $made restarts"
+grep -q "restarts $made" "$run/logs/monitor.log" ||
+  fail "the progress line does not count $made restarts"
 
 # The report is whole: every section of a CartPole run, the goal reached, the restarts listed,
 # every picture and video it shows on disk, and the page complete.
 report="$run/report/index.html"
 [ -s "$report" ] || fail "no report"
-for section in Summary "Learning curves" Training "Greedy policy" Checkpoints Restarts "Run config"; do
+for section in Summary "Learning curves" Training "Greedy policy" Checkpoints Restarts \
+  "Run config"; do
   grep -q "<h2>$section</h2>" "$report" || fail "the report has no section $section"
 done
 grep -q 'badge yes">reached' "$report" || fail "the report does not say the goal was reached"
@@ -192,15 +199,20 @@ done
 awk '!/^\{.*\}$/ { print "line " NR ": " $0; bad = 1 } END { exit bad }' "$run/eval.jsonl" ||
   fail "eval.jsonl has a torn line"
 
-# Nothing dropped: no process refused a message of another (a state restored wrongly after a
-# restart shows as messages refused as invalid, stale or replayed), and the replay's last line
-# counts none.
+# Nothing dropped or lost: no process refused a message of another (a state restored wrongly
+# after a restart shows as messages refused as invalid, stale or replayed), and the replay's last
+# line counts none.
 if grep -h "dropped a" "$run"/logs/*.log | grep -v '^launch:' | head -5 | grep .; then
   fail "processes dropped messages"
 fi
 last=$(grep '^replay: size' "$run/logs/replay.log" | tail -1)
 echo "$last"
-echo "$last" | grep -q " dropped 0 " || fail "the replay dropped messages: $last"
+echo "$last" | grep -q " dropped 0 lost 0 " || fail "the replay dropped or lost messages: $last"
+# Nor lost (a gap in a live sender's sequence) or dropped by any process: the monitor's last
+# progress line sums every process's counts.
+last=$(grep '^\[ *[0-9.]*s\]' "$run/logs/monitor.log" | tail -1)
+echo "$last"
+echo "$last" | grep -q "  lost 0  dropped 0 " || fail "messages lost or dropped: $last"
 
 # Writers killed mid-write leave temporary files: their next start removes them.
 left=$(find "$run" -name '*.tmp.*' | sed "s|^$run/||")
@@ -208,6 +220,7 @@ left=$(find "$run" -name '*.tmp.*' | sed "s|^$run/||")
 # No process of the run outlives it (every pid it listed, and whatever names the run folder).
 expect_all_ended "$run" 10
 others=$(pgrep -f -- "$run" || true)
-[ -z "$others" ] || fail "processes of the run still alive: $(ps -o pid,args -p "$(echo $others | tr ' ' ,)")"
-echo "PASS: chaos seed $seed: $made of $kills kills ($during_write during a write, the first $early in)," \
-  "the goal reached in $end, the report whole"
+[ -z "$others" ] ||
+  fail "processes of the run still alive: $(ps -o pid,args -p "$(echo $others | tr ' ' ,)")"
+echo "PASS: chaos seed $seed: $made of $kills kills ($during_write during a write," \
+  "the first $early in), the goal reached in $end, the report whole"
