@@ -215,7 +215,7 @@ echo "$last"
 echo "$last" | grep -q "  lost 0  dropped 0 " || fail "messages lost or dropped: $last"
 
 # Writers killed mid-write leave temporary files: their next start removes them.
-left=$(find "$run" -name '*.tmp.*' | sed "s|^$run/||")
+left=$(find "$run" -name '*.tmp.*' | sed "s|^$run/||" | tr '\n' ' ')
 [ -z "$left" ] || fail "temporary files left in the run folder: $left"
 # No process of the run outlives it (every pid it listed, and whatever names the run folder).
 expect_all_ended "$run" 10
