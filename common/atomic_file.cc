@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 
 namespace rl {
@@ -121,6 +122,27 @@ void WriteFileAtomically(const std::string& path, std::string_view bytes, const 
   if (!out.Open() || !out.Write(bytes.data(), bytes.size()) || !out.Commit()) {
     throw std::runtime_error(out.ErrorMessage(what));
   }
+}
+
+int RemoveStaleTemporaries(const std::string& dir, std::string_view prefix) {
+  namespace fs = std::filesystem;
+  constexpr std::string_view kInfix = ".tmp.";
+  const std::string own = std::to_string(::getpid());
+  int removed = 0;
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(dir, error)) {
+    const std::string name = entry.path().filename().string();
+    const size_t infix = name.rfind(kInfix);
+    if (infix == std::string::npos || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string_view pid = std::string_view(name).substr(infix + kInfix.size());
+    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string_view::npos ||
+        pid == own) {
+      continue;
+    }
+    std::error_code ignored;
+    if (entry.is_regular_file(ignored) && fs::remove(entry.path(), ignored)) ++removed;
+  }
+  return removed;
 }
 
 void RenameIntoPlace(const std::string& tmp, const std::string& path, const std::string& what) {

@@ -27,6 +27,13 @@ void RenameIntoPlace(const std::string& tmp, const std::string& path,
 /// The temporary name WriteFileAtomically uses for `path` (with the caller's pid).
 std::string TemporaryPathFor(const std::string& path);
 
+/// Removes the temporary files that writers killed mid-write left in `dir`: every regular file
+/// named <name>.tmp.<digits> whose <name> starts with `prefix` (any name for an empty prefix),
+/// except this process's own. For a process that is the only writer of those names, as it starts
+/// and before it writes there. Errors are ignored (a file that stays is only litter). Returns the
+/// number of files removed. Cost: one pass over the folder.
+int RemoveStaleTemporaries(const std::string& dir, std::string_view prefix = {});
+
 /// The same atomic write, streamed: for files too large to build in memory, and for writers that
 /// must not allocate, lock or throw (the child of fork() in a process with other threads, which
 /// writes a copy-on-write snapshot). The constructor prepares every name (it allocates); Open(),

@@ -14,6 +14,7 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "common/atomic_file.h"
 #include "common/channels.h"
 #include "common/clock.h"
 #include "common/shutdown.h"
@@ -183,6 +184,9 @@ EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* 
     }
     jsonl_path_ = (std::filesystem::path(config_.out_dir) / "eval.jsonl").string();
     report_dir_ = (std::filesystem::path(config_.out_dir) / "report").string();
+    // An earlier life killed while it wrote a report file or a video left its temporary file.
+    RemoveStaleTemporaries(report_dir_);
+    std::filesystem::remove(VideoTemporaryPath(report_dir_ + "/" + kBestVideo), ec);
     run_name_ = config_.run_name.empty() ? FolderName(config_.out_dir) : config_.run_name;
     int skipped_lines = 0;
     records_ = LoadJsonLines(jsonl_path_, &skipped_lines);

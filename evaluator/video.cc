@@ -14,6 +14,8 @@
 
 namespace rl::evaluator {
 
+std::string VideoTemporaryPath(const std::string& path) { return path + ".tmp.webm"; }
+
 VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, uint64_t seed,
                               int width, int height, double fps, const std::string& path) {
   auto env = envs::MakeEnv(env_id);
@@ -23,7 +25,7 @@ VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, ui
   // The encoder wants even frame sizes.
   width += width % 2;
   height += height % 2;
-  const std::string tmp = path + ".tmp.webm";
+  const std::string tmp = VideoTemporaryPath(path);
   cv::VideoWriter writer(tmp, cv::CAP_FFMPEG, cv::VideoWriter::fourcc('V', 'P', '8', '0'), fps,
                          cv::Size(width, height));
   if (!writer.isOpened()) {

@@ -15,6 +15,11 @@ struct VideoResult {
   int width = 0, height = 0;
 };
 
+/// The temporary file RecordGreedyVideo writes before it renames it to `path`: path + ".tmp.webm"
+/// (the encoder takes the container from the extension). An evaluator killed while it encodes a
+/// video leaves it behind.
+std::string VideoTemporaryPath(const std::string& path);
+
 /// Plays one episode of `env_id` reset with `seed`, acting greedily with `net` (epsilon 0),
 /// renders every frame at width x height and writes it to `path` as WebM at `fps` frames per
 /// second, atomically (a temporary file next to it, then rename). Throws std::runtime_error when

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/channels.h"
 #include "common/clock.h"
 #include "common/shutdown.h"
@@ -96,6 +97,8 @@ Learner::Learner(LearnerConfig config, Bus* bus)
       sender_(bus->config().sender) {
   nn::SetNumThreads(config_.threads);
   std::filesystem::create_directories(std::filesystem::path(config_.out_dir) / "checkpoints");
+  // An earlier life killed while it wrote a checkpoint or the state left its temporary file.
+  RemoveStaleTemporaries((std::filesystem::path(config_.out_dir) / "checkpoints").string());
   // Earlier lives' checkpoints count towards keep_checkpoints, and go first.
   written_ = CheckpointFiles(std::filesystem::path(config_.out_dir) / "checkpoints");
   if (config_.resume && std::filesystem::exists(StatePath())) {

@@ -16,6 +16,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "common/atomic_file.h"
 #include "common/clock.h"
 
 namespace rl::replay {
@@ -100,18 +101,9 @@ Snapshotter::~Snapshotter() { Wait(); }
 void Snapshotter::RemoveStaleTemporaries() const {
   if (options_.path.empty()) return;
   // Writers die with their process, leaving their temporary file: PATH.tmp.<pid>.
-  namespace fs = std::filesystem;
-  const fs::path path(options_.path);
-  const std::string stem = path.filename().string() + ".tmp.";
-  std::error_code error;
-  const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  for (const fs::directory_entry& entry : fs::directory_iterator(dir, error)) {
-    const std::string name = entry.path().filename().string();
-    if (name.rfind(stem, 0) == 0 && name.size() > stem.size() &&
-        name.find_first_not_of("0123456789", stem.size()) == std::string::npos) {
-      fs::remove(entry.path(), error);
-    }
-  }
+  const std::filesystem::path path(options_.path);
+  rl::RemoveStaleTemporaries(path.has_parent_path() ? path.parent_path().string() : ".",
+                             path.filename().string() + ".tmp.");
 }
 
 bool Snapshotter::Tick(double now) {

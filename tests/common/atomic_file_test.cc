@@ -105,5 +105,31 @@ TEST_F(AtomicFileTest, AStreamCommitsWholeOrLeavesTheOldFile) {
   EXPECT_NE(what.find("No such file or directory"), std::string::npos) << what;
 }
 
+TEST_F(AtomicFileTest, RemovesTheTemporaryFilesOfKilledWritersAndNothingElse) {
+  const auto touch = [&](const std::string& name) { std::ofstream(dir_ / name) << "x"; };
+  // What writers killed mid-write leave, in a folder with files that must stay.
+  for (const char* name : {"ckpt-000000500.bin.tmp.4242", "learner-state.bin.tmp.4243",
+                           "replay-snapshot.bin.tmp.17"}) {
+    touch(name);
+  }
+  const std::string own = "index.html.tmp." + std::to_string(getpid());
+  for (const std::string& name : {std::string("ckpt-000000500.bin"), std::string("a.tmp."),
+                                  std::string("b.tmp.12x"), std::string("c.tmp.webm"), own}) {
+    touch(name);
+  }
+  fs::create_directories(dir_ / "sub.tmp.99");
+  EXPECT_EQ(RemoveStaleTemporaries(dir_.string(), "replay-snapshot.bin.tmp."), 1);
+  EXPECT_FALSE(fs::exists(dir_ / "replay-snapshot.bin.tmp.17"));
+  EXPECT_TRUE(fs::exists(dir_ / "learner-state.bin.tmp.4243"));
+  EXPECT_EQ(RemoveStaleTemporaries(dir_.string()), 2);
+  for (const std::string& kept :
+       {std::string("ckpt-000000500.bin"), std::string("a.tmp."), std::string("b.tmp.12x"),
+        std::string("c.tmp.webm"), own, std::string("sub.tmp.99")}) {
+    EXPECT_TRUE(fs::exists(dir_ / kept)) << kept;
+  }
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator{}), 6);
+  EXPECT_EQ(RemoveStaleTemporaries((dir_ / "missing").string()), 0);
+}
+
 }  // namespace
 }  // namespace rl
