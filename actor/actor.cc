@@ -37,7 +37,10 @@ uint64_t TrainingSeed(uint64_t run_seed, int actor_id, int env_index) {
          static_cast<uint64_t>(env_index);
 }
 
-Actor::Actor(ActorConfig config, Bus* bus) : config_(std::move(config)), bus_(bus) {
+Actor::Actor(ActorConfig config, Bus* bus)
+    : config_(std::move(config)),
+      bus_(bus),
+      assembler_([this](const std::string& architecture) { return WeightsSize(architecture); }) {
   config_.Validate();
   for (int j = 0; j < config_.envs_per_actor; ++j) {
     auto env = envs::MakeEnv(config_.env_id);
@@ -76,17 +79,20 @@ Actor::Actor(ActorConfig config, Bus* bus) : config_(std::move(config)), bus_(bu
 }
 
 void Actor::OnFlow(const rlmsg::flow_control_t& f) {
+  // Counts far beyond any run's (2^62) are capped, so that no sum below overflows.
+  constexpr int64_t kMaxCount = int64_t{1} << 62;
+  int64_t stored = 0;
+  for (size_t i = 0; i < f.actor_id.size(); ++i) {
+    if (f.actor_id[i] == config_.actor_id) stored = std::min(f.actor_inserts[i], kMaxCount);
+  }
+  if (!counted_) TakeUpCount(stored);
   insert_allowed_ = f.insert_allowed != 0;
   if (f.insert_credit < 0) {
     insert_limit_ = std::numeric_limits<int64_t>::max();
     return;
   }
   const int64_t actors = std::max(config_.num_actors, 1);
-  const int64_t share = (f.insert_credit + actors - 1) / actors;
-  int64_t stored = 0;
-  for (size_t i = 0; i < f.actor_id.size(); ++i) {
-    if (f.actor_id[i] == config_.actor_id) stored = f.actor_inserts[i];
-  }
+  const int64_t share = (std::min(f.insert_credit, kMaxCount) + actors - 1) / actors;
   // A restarted replay (from its snapshot, or empty) stores less than it did: what this actor
   // published until now is stored or lost, not on the way.
   if (stored < last_stored_) lost_ = std::max<int64_t>(0, published_ - stored);
@@ -97,26 +103,74 @@ void Actor::OnFlow(const rlmsg::flow_control_t& f) {
   insert_limit_ = published_ + std::max<int64_t>(0, share - on_the_way);
 }
 
+int64_t Actor::WeightsSize(const std::string& architecture) {
+  if (policy_->has_network() && architecture == policy_->network().Architecture()) {
+    return policy_->network().FlatSize();
+  }
+  if (candidate_ && candidate_->Architecture() == architecture) return candidate_->FlatSize();
+  // Built within nn's limits (sequential.h), as large as the network the policy would hold.
+  std::string why;
+  try {
+    std::mt19937 init_rng(0);
+    nn::Sequential net = nn::BuildFromArchitecture(architecture, &init_rng);
+    why = policy_->CheckNetwork(net);
+    if (why.empty()) candidate_ = std::move(net);
+  } catch (const std::invalid_argument& e) {
+    why = e.what();
+  }
+  if (!why.empty()) {
+    if (assembler_.refused() < 10) {
+      std::fprintf(stderr, "[actor-%d] refused weights '%.200s': %s\n", config_.actor_id,
+                   architecture.c_str(), why.c_str());
+    }
+    return -1;
+  }
+  return candidate_->FlatSize();
+}
+
+void Actor::TakeUpCount(int64_t stored) {
+  counted_ = true;
+  last_stored_ = stored;
+  if (stored <= env_steps_) return;
+  // Every step became one transition (a stopping actor flushes its episodes), so the earlier
+  // lives of this actor id took at least `stored` steps and published as many.
+  env_steps_ = stored;
+  published_ = std::max(published_, stored);
+  std::printf(
+      "actor-%d: continuing at step %lld (the replay holds %lld transitions of "
+      "actor %d), %s %.5f\n",
+      config_.actor_id, static_cast<long long>(env_steps_), static_cast<long long>(stored),
+      config_.actor_id, spec_.continuous() ? "sigma" : "epsilon", exploration());
+  std::fflush(stdout);
+}
+
+void Actor::FlushEpisodes() {
+  for (EnvSlot& s : slots_) {
+    const int64_t episode_id = s.episode_id;
+    if (pixels_) {
+      s.frame_nstep.Flush([this, episode_id](const FrameTransition& t) { Append(t, episode_id); });
+    } else {
+      s.nstep.Flush([this, episode_id](const Transition& t) { Append(t, episode_id); });
+    }
+  }
+}
+
 void Actor::OnWeights(const rlmsg::weights_chunk_t& chunk) {
   if (!assembler_.Add(chunk)) return;
   std::optional<Weights> w = assembler_.Take();
   if (!w) return;
   if (!policy_->has_network() || w->architecture != policy_->network().Architecture()) {
-    std::string why;
-    try {
-      std::mt19937 init_rng(0);
-      nn::Sequential net = nn::BuildFromArchitecture(w->architecture, &init_rng);
-      why = policy_->CheckNetwork(net);
-      if (why.empty()) policy_->SetNetwork(std::move(net));
-    } catch (const std::invalid_argument& e) {
-      why = e.what();
+    // The candidate built for this architecture, or (when another one replaced it meanwhile)
+    // the same network built again.
+    if (!candidate_ || candidate_->Architecture() != w->architecture) {
+      candidate_.reset();
+      if (WeightsSize(w->architecture) < 0) {
+        ++weights_refused_;
+        return;
+      }
     }
-    if (!why.empty()) {
-      ++weights_refused_;
-      std::fprintf(stderr, "[actor-%d] refused weights '%s': %s\n", config_.actor_id,
-                   w->architecture.c_str(), why.c_str());
-      return;
-    }
+    policy_->SetNetwork(std::move(*candidate_));
+    candidate_.reset();
   }
   policy_->network().SetFlat(w->params.data(), w->params.size());
   weights_version_ = w->version;
@@ -230,8 +284,9 @@ void Actor::PublishStats() {
 
 void Actor::Run() {
   const double stats_period = 1.0 / config_.stats_hz;
-  double next_stats = MonoSeconds();
-  double next_log = MonoSeconds() + 5.0;
+  const double start = MonoSeconds();
+  double next_stats = start;
+  double next_log = start + 5.0;
   while (!StopRequested()) {
     if (config_.max_steps > 0 && env_steps_ >= config_.max_steps) break;
     if (!paused()) {
@@ -244,7 +299,8 @@ void Actor::Run() {
     }
     const double now = MonoSeconds();
     if (now >= next_stats) {
-      PublishStats();
+      // Until the step count is taken up, a stats message would show a count from 0.
+      if (counted_ || now - start >= kStatsHoldSeconds) PublishStats();
       next_stats = now + stats_period;
     }
     if (now >= next_log) {
@@ -257,8 +313,11 @@ void Actor::Run() {
       next_log = now + 5.0;
     }
   }
+  // Every step taken goes out: the count a restarted actor takes up from the replay is then
+  // this one.
+  FlushEpisodes();
   PublishBatch();
-  PublishStats();
+  if (counted_ || MonoSeconds() - start >= kStatsHoldSeconds) PublishStats();
 }
 
 }  // namespace rl::actor

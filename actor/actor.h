@@ -8,6 +8,13 @@
 // with an actor-local id, and transitions name their stacks by frame id. While the replay's rate
 // limiter says so (RL_FLOW), it pauses. It publishes stats_actor_t a few times per second.
 //
+// Its step count, which drives the exploration schedule (epsilon annealing, sigma annealing,
+// the random start), carries on across restarts: an actor takes no step before the replay's
+// first flow message, and takes up from it the transitions the replay holds from its actor id,
+// one per step of its earlier lives (a stopping actor flushes its unfinished n-step returns as
+// truncations, so every step goes out). A restarted actor, a resumed run and a requeued one on
+// another host all continue the schedule where it was.
+//
 // Single-threaded: the thread that calls Run() also handles LCM.
 #pragma once
 
@@ -15,6 +22,7 @@
 #include <deque>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +55,12 @@ struct ActorConfig {
   void Validate() const;
 };
 
+// Seconds a starting actor withholds its stats while it waits for the replay's first flow
+// message, which gives it the step count it continues from (Actor::OnFlow), so that its stats
+// never show a count restarting at 0. After that it publishes them anyway (their drop counters
+// say why no flow message arrives).
+inline constexpr double kStatsHoldSeconds = 10.0;
+
 // Seed of the first reset of environment `env_index` of actor `actor_id`: distinct for every
 // env of every actor of a run, and below 10^9, where the evaluator's seeds begin.
 uint64_t TrainingSeed(uint64_t run_seed, int actor_id, int env_index);
@@ -67,12 +81,17 @@ class Actor {
 
   void PublishStats();
 
+  /// Env steps of this actor id, earlier lives included once the first flow message came.
   int64_t env_steps() const { return env_steps_; }
+  /// Whether the replay's first flow message came and the step count was taken up from it.
+  bool count_taken_up() const { return counted_; }
   int64_t episodes() const { return episodes_; }
   int64_t weights_version() const { return weights_version_; }
   // The exploration scale now: epsilon, or the noise sigma (1 during the random start).
   double exploration() const { return policy_->exploration(env_steps_); }
-  int64_t weights_refused() const { return weights_refused_; }
+  /// Weights versions refused: of a network that does not build or fit the env, or whose
+  /// chunks claim another size than that network's (actor/weights_assembler.h).
+  int64_t weights_refused() const { return assembler_.refused() + weights_refused_; }
   /// Transitions published so far.
   int64_t published() const { return published_; }
   /// Whether the replay's flow control holds this actor: no flow message yet, insert_allowed is
@@ -89,6 +108,14 @@ class Actor {
   // transitions that goes back means a restarted replay (from its snapshot, or empty): what
   // was published until then is taken as lost, not as on the way.
   void OnFlow(const rlmsg::flow_control_t& f);
+  // At the first flow message: carries on the step count of this actor id's earlier lives (a
+  // restart, a resumed run, a requeue on another host). The replay has stored `stored`
+  // transitions of this id, one per step taken, so the schedules (exploration, random start)
+  // and the step count continue from there instead of starting again at 0. Never lowers
+  // the count.
+  void TakeUpCount(int64_t stored);
+  // Emits the pending n-step transitions of every env as truncated (the actor stops).
+  void FlushEpisodes();
 
   struct EnvSlot {
     std::unique_ptr<envs::Env> env;
@@ -105,6 +132,10 @@ class Actor {
   };
 
   void OnWeights(const rlmsg::weights_chunk_t& chunk);
+  // The assembler's SizeOf: the parameter floats of a network of `architecture` that fits the
+  // env (the policy's own, or a candidate built now and kept for when its version completes),
+  // or -1 with the reason logged.
+  int64_t WeightsSize(const std::string& architecture);
   // Appends a transition (flat observations, or stacks of frame ids) to the batch.
   template <class T>
   void Append(const BasicTransition<T>& t, int64_t episode_id);
@@ -120,6 +151,9 @@ class Actor {
   std::vector<EnvSlot> slots_;
   std::unique_ptr<Policy> policy_;
   WeightsAssembler assembler_;
+  // A network of an architecture other than the policy's, built when the first chunk of its
+  // version arrived; the policy takes it when the version completes.
+  std::optional<nn::Sequential> candidate_;
   int64_t weights_version_ = -1;
   int64_t weights_refused_ = 0;
 
@@ -128,6 +162,8 @@ class Actor {
   // replay has read enough to tell it to stop.
   bool insert_allowed_ = true;
   int64_t insert_limit_ = 0;
+  // Whether the first flow message came (and the step count was taken up from it).
+  bool counted_ = false;
   int64_t env_steps_ = 0;
   int64_t episodes_ = 0;
   int64_t published_ = 0;

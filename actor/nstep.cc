@@ -39,10 +39,15 @@ void BasicNStepAccumulator<T>::Add(std::span<const T> obs, std::span<const float
   if (terminated) {
     while (count_ > 0) EmitOldest(/*bootstrap=*/false, sink);
   } else if (truncated) {
-    while (count_ > 0) EmitOldest(/*bootstrap=*/true, sink);
+    Flush(sink);
   } else if (count_ == n_) {
     EmitOldest(/*bootstrap=*/true, sink);
   }
+}
+
+template <class T>
+void BasicNStepAccumulator<T>::Flush(const Sink& sink) {
+  while (count_ > 0) EmitOldest(/*bootstrap=*/true, sink);
 }
 
 template <class T>

@@ -4,7 +4,8 @@
 // k = n while the episode goes on (d_t = gamma^n); at a termination every pending step is
 // emitted with d_t = 0; at a time-limit truncation (not a terminal) every pending step is emitted
 // with k the steps left before the cut and d_t = gamma^k, bootstrapping from the last
-// observation. With n = 1 this is the one-step transition of DQN.
+// observation. With n = 1 this is the one-step transition of DQN. Every step becomes exactly one
+// transition (Flush() emits the pending ones of an episode cut short).
 //
 // Observations are float vectors (BasicNStepAccumulator<float>, flat envs) or, for pixel envs,
 // the frame ids of a stack (BasicNStepAccumulator<int64_t>): the frames themselves travel once.
@@ -37,6 +38,10 @@ class BasicNStepAccumulator {
   // emits every transition that is now complete.
   void Add(std::span<const T> obs, std::span<const float> action, double reward,
            std::span<const T> next_obs, bool terminated, bool truncated, const Sink& sink);
+
+  // Emits every pending step as a time-limit truncation would (discount gamma^k, bootstrapping
+  // from the last observation): the episode is cut here, e.g. because the actor stops.
+  void Flush(const Sink& sink);
 
   // Steps waiting for their n-step return.
   int pending() const { return count_; }

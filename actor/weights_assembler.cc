@@ -1,13 +1,30 @@
 #include "actor/weights_assembler.h"
 
 #include <algorithm>
+#include <utility>
 
 #include "common/crc32.h"
 
 namespace rl::actor {
 
+WeightsAssembler::WeightsAssembler(SizeOf size_of) : size_of_(std::move(size_of)) {}
+
+bool WeightsAssembler::Plausible(const rlmsg::weights_chunk_t& chunk) {
+  if (sized_architecture_ != chunk.architecture) {
+    sized_floats_ = size_of_(chunk.architecture);
+    sized_architecture_ = chunk.architecture;
+  }
+  return sized_floats_ > 0 && chunk.total_size == sized_floats_ &&
+         chunk.num_chunks <= chunk.total_size;
+}
+
 bool WeightsAssembler::Add(const rlmsg::weights_chunk_t& chunk) {
   if (chunk.version <= complete_version_) return false;
+  if (partial_.count(chunk.version) == 0 && !Plausible(chunk)) {
+    if (chunk.version != last_refused_version_) ++refused_;
+    last_refused_version_ = chunk.version;
+    return false;
+  }
   auto [it, inserted] = partial_.try_emplace(chunk.version);
   Partial& p = it->second;
   if (inserted) {

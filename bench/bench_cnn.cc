@@ -1,22 +1,31 @@
-// Pixel networks at 1 and 2 threads (nn::SetNumThreads), beside the PyTorch peer's micro.py modes
-// `nature`, `small` and `latency`:
+// Pixel networks at 1 and 2 threads (nn::SetNumThreads), in fp32 and bf16 (nn/precision.h),
+// beside the PyTorch peer's micro.py modes `nature`, `small` and `latency`:
 //
 //   learner_updates_nature_cnn, learner_updates_grasp_cnn (updates/s): DQN updates of
 //     MakeNatureCnn(7) on 4x84x84 and MakeGraspCnn(7) on 4x40x40 uint8 frames at batch 32, the
 //     work micro.py's `nature` and `small` modes time (see kUpdateWork).
 //   inference_latency_nature_cnn, inference_latency_grasp_cnn (ms): one uint8 observation to a
-//     greedy action, median over calls, as micro.py's `latency` (which has the Nature CNN only).
+//     greedy action, median over calls, as micro.py's `latency` (which has the Nature CNN only);
+//     inference_latency_td3_car_actor, inference_latency_td3_drq_actor: one observation to an
+//     action through the TD3 CarRacing article's actor and through the drq policy (the shared
+//     encoder and its actor head), what a car_racing_td3 actor computes per step.
 //   conv_gflops_nature_cnn, conv_gflops_grasp_cnn (GFLOP/s): the convolution layers of the
 //     network alone, at batch 32: "forward", "backward" (weight gradients, and input gradients
 //     of all but the first layer, as in an update) and "update" (two forward passes and one
 //     backward pass, the convolution work of one update). FLOPs are 2 x multiply-adds, counted
-//     from the layer shapes.
+//     from the layer shapes, in either precision.
 //   peak_fp32_gflops (GFLOP/s): the FMA throughput of the machine, measured with independent
-//     chains of vector FMAs (per core at 1 thread; at 2 threads the sum of two cores).
+//     chains of vector FMAs of the widest width the CPU has (per core at 1 thread; at 2 threads
+//     the sum of two cores); "gflops_256bit" with 256-bit FMAs.
+//   peak_bf16_gflops (GFLOP/s): the same with vdpbf16ps (AVX512_BF16: per 32-bit lane two bf16
+//     products added to an fp32 sum, 4 FLOPs), 512-bit, and "gflops_256bit"; only on CPUs with
+//     AVX512_BF16.
 //
 // Every line has "threads" (the SetNumThreads() setting) and "threads_used": the setting if the
 // measured operation ran parallel sections ("parallel_sections_per_call"), else 1 (a
-// single observation is too small to be split, so its latency is the 1-thread path).
+// single observation is too small to be split, so its latency is the 1-thread path); the network
+// lines have "precision", "kernels" (the kernel path, nn/precision.h) and "bf16_native" (false:
+// bf16 emulated on this CPU).
 //
 // Usage: bench_cnn [repeats (5)] [seconds per measurement (1.0)] [thread counts ("1,2")]
 #include <algorithm>
@@ -33,18 +42,18 @@
 #include <thread>
 #include <vector>
 
-#if defined(__AVX512F__) || defined(__FMA__)
 #include <immintrin.h>
-#endif
 
 #include "bench/bench_util.h"
 #include "nn/activations.h"
 #include "nn/conv2d.h"
+#include "nn/kernels_target.h"
 #include "nn/linear.h"
 #include "nn/losses.h"
 #include "nn/optimizers.h"
 #include "nn/parallel.h"
 #include "nn/pixels.h"
+#include "nn/precision.h"
 #include "nn/presets.h"
 #include "nn/sequential.h"
 
@@ -191,7 +200,7 @@ class DqnUpdate {
 // it too), fed random inputs of the right shapes.
 class ConvStack {
  public:
-  ConvStack(const Sequential& net, int batch, std::mt19937* rng) {
+  ConvStack(const Sequential& net, int batch, rl::nn::Precision precision, std::mt19937* rng) {
     std::normal_distribution<float> normal;
     std::uniform_real_distribution<float> unit;
     auto is_relu = [&net](int i) {
@@ -205,6 +214,7 @@ class ConvStack {
       auto layer = std::make_unique<rl::nn::Conv2d>(in.channels, conv->output_shape().channels,
                                                     conv->kernel(), conv->stride(), conv->padding(),
                                                     in.height, in.width, rng);
+      layer->set_precision(precision);
       if (is_relu(i + 1)) layer->FuseOutputRelu();
       if (is_relu(i - 1)) layer->FuseInputReluGrad();
       Matrix x(in.size(), batch);
@@ -239,20 +249,22 @@ class ConvStack {
   std::vector<bool> first_;
 };
 
-// Median time of one greedy action for a uint8 observation, including its conversion to x/255
-// (micro.py's latency: from_numpy, forward with x.float() / 255, argmax, item), timing each call.
+// Median time of one action for a uint8 observation, including its conversion to x/255
+// (micro.py's latency: from_numpy, forward with x.float() / 255, argmax, item), timing each call:
+// the greedy action of a Q network (`greedy`), or the actor's output (Predict).
 struct Latency {
   double median_ms = 0;
   double mean_ms = 0;
 };
 
-Latency MeasureLatency(Sequential* net, const std::vector<uint8_t>& obs, double seconds) {
+Latency MeasureLatency(Sequential* net, const std::vector<uint8_t>& obs, bool greedy,
+                       double seconds) {
   const int size = net->InputSize();
   Matrix x;
   int sink = 0;
   auto act = [&] {
     rl::nn::PixelsToMatrix(obs.data(), size, 1, &x);
-    sink += net->Argmax(x.data(), size);
+    sink += greedy ? net->Argmax(x.data(), size) : net->Predict(x.data(), size)(0, 0) > 0.0f;
   };
   for (int i = 0; i < 3; ++i) act();
   std::vector<double> ms;
@@ -272,80 +284,109 @@ Latency MeasureLatency(Sequential* net, const std::vector<uint8_t>& obs, double 
   return l;
 }
 
-// Peak FP32 throughput of one core: kChains independent chains of vector FMAs (more than the FMA
-// latency times the number of FMA pipes of current x86 cores, 4 x 2), so that only throughput
-// limits them. Each chain computes acc = acc * m + a, which converges to 1 without denormals.
-template <class V, V (*kSet)(float), V (*kFma)(V, V, V), int kLanes>
-double FmaGflops(double seconds) {
-  constexpr int kChains = 16;
-  constexpr int64_t kInner = 1 << 14;
-  V acc[kChains];
-  for (int c = 0; c < kChains; ++c) acc[c] = kSet(1.0f + 0.001f * static_cast<float>(c));
-  const V mul = kSet(0.999999f);
-  const V add = kSet(1e-6f);
-  int64_t fmas = 0;
-  const auto start = Clock::now();
-  double elapsed = 0;
-  do {
-    for (int64_t i = 0; i < kInner; ++i) {
-#pragma GCC unroll 16
-      for (int c = 0; c < kChains; ++c) acc[c] = kFma(acc[c], mul, add);
-    }
-    fmas += kInner * kChains;
-    elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-  } while (elapsed < seconds);
-  float sum = 0;
-  for (int c = 0; c < kChains; ++c) {
-    alignas(64) float lanes[kLanes];
-    std::memcpy(lanes, &acc[c], sizeof(lanes));
-    for (float v : lanes) sum += v;
-  }
-  if (sum < 0) std::printf("%g\n", static_cast<double>(sum));  // Keeps the chains.
-  return 2.0 * kLanes * static_cast<double>(fmas) / elapsed / 1e9;
+// The peak loop compiled for the baseline (256-bit FMA) and, below, for AVX-512 with
+// AVX512_BF16 (called only on CPUs that have them: nn::RunnableKernelPaths()).
+namespace baseline {
+#include "bench/peak_loop.h"
+
+double Fma256Gflops(double seconds) {
+  const __m256 mul = _mm256_set1_ps(0.999999f);
+  const __m256 add = _mm256_set1_ps(1e-6f);
+  return ChainGflops<8>(
+      _mm256_set1_ps(1.0f), [&](__m256 x) { return _mm256_fmadd_ps(x, mul, add); }, 2, seconds);
+}
+}  // namespace baseline
+
+RL_NN_TARGET_BEGIN("avx2,fma,avx512f,avx512vl,avx512bf16")
+namespace wide {
+#include "bench/peak_loop.h"
+
+double Fma512Gflops(double seconds) {
+  const __m512 mul = _mm512_set1_ps(0.999999f);
+  const __m512 add = _mm512_set1_ps(1e-6f);
+  return ChainGflops<16>(
+      _mm512_set1_ps(1.0f), [&](__m512 x) { return _mm512_fmadd_ps(x, mul, add); }, 2, seconds);
 }
 
-#if defined(__AVX512F__)
-__m512 Set512(float x) { return _mm512_set1_ps(x); }
-__m512 Fma512(__m512 a, __m512 b, __m512 c) { return _mm512_fmadd_ps(a, b, c); }
-#endif
-#if defined(__FMA__)
-__m256 Set256(float x) { return _mm256_set1_ps(x); }
-__m256 Fma256(__m256 a, __m256 b, __m256 c) { return _mm256_fmadd_ps(a, b, c); }
-// With 256-bit vectors, the width the product kernel of nn/gemm.cc uses.
-double Fma256Gflops(double seconds) { return FmaGflops<__m256, Set256, Fma256, 8>(seconds); }
-#endif
-
-// GFLOP/s of the widest FMA this build has (512-bit or 256-bit), and its width in bits; 0 when
-// the build has no FMA instructions.
-double WidestFmaGflops(double seconds, int* bits) {
-#if defined(__AVX512F__)
-  *bits = 512;
-  return FmaGflops<__m512, Set512, Fma512, 16>(seconds);
-#elif defined(__FMA__)
-  *bits = 256;
-  return Fma256Gflops(seconds);
-#else
-  *bits = 0;
-  static_cast<void>(seconds);
-  return 0;
-#endif
+// acc += 1 * 2^-20 + 1 * 2^-20 per lane (bf16 pairs 0x3F80 = 1 and 0x3580 = 2^-20).
+double Bf16Dot512Gflops(double seconds) {
+  const auto ones = (__m512bh)_mm512_set1_epi32(0x3F803F80);
+  const auto tiny = (__m512bh)_mm512_set1_epi32(0x35803580);
+  return ChainGflops<16>(
+      _mm512_setzero_ps(), [&](__m512 x) { return _mm512_dpbf16_ps(x, ones, tiny); }, 4, seconds);
 }
 
-// The sum over `threads` threads running the FMA loop at the same time.
-double ParallelFmaGflops(int threads, double seconds, int* bits) {
+double Bf16Dot256Gflops(double seconds) {
+  const auto ones = (__m256bh)_mm256_set1_epi32(0x3F803F80);
+  const auto tiny = (__m256bh)_mm256_set1_epi32(0x35803580);
+  return ChainGflops<8>(
+      _mm256_setzero_ps(), [&](__m256 x) { return _mm256_dpbf16_ps(x, ones, tiny); }, 4, seconds);
+}
+}  // namespace wide
+RL_NN_TARGET_END
+
+bool CpuRuns(const std::string& path) {
+  const std::vector<std::string> paths = rl::nn::RunnableKernelPaths();
+  return std::find(paths.begin(), paths.end(), path) != paths.end();
+}
+
+// The sum of `measure` over `threads` threads running it at the same time.
+double OnThreads(int threads, const std::function<double()>& measure) {
   std::vector<double> rates(static_cast<size_t>(threads));
   std::vector<std::thread> pool;
   for (int t = 1; t < threads; ++t) {
-    pool.emplace_back([&, t] {
-      int unused = 0;
-      rates[static_cast<size_t>(t)] = WidestFmaGflops(seconds, &unused);
-    });
+    pool.emplace_back([&, t] { rates[static_cast<size_t>(t)] = measure(); });
   }
-  rates[0] = WidestFmaGflops(seconds, bits);
+  rates[0] = measure();
   for (std::thread& t : pool) t.join();
   double sum = 0;
   for (double r : rates) sum += r;
   return sum;
+}
+
+// The peak rows of one thread count (see the top of this file); returns the fp32 and bf16 peaks
+// (0 where the CPU has no bf16 instruction).
+struct Peaks {
+  double fp32 = 0;
+  double bf16 = 0;
+};
+Peaks MeasurePeaks(int threads, int repeats, double seconds) {
+  const double s = std::min(seconds, 0.5);
+  auto emit = [&](const char* name, int bits, double (*wide_fn)(double),
+                  double (*narrow_fn)(double), const std::string& method) {
+    std::vector<double> v, narrow;
+    for (int r = 0; r < repeats; ++r) {
+      v.push_back(OnThreads(threads, [&] { return wide_fn(s); }));
+      if (threads == 1) narrow.push_back(narrow_fn(s));
+    }
+    const rl::bench::Summary peak = rl::bench::Summarize(v);
+    rl::bench::Emit(
+        name, "GFLOP/s", peak, repeats,
+        "\"threads\": " + std::to_string(threads) + ", \"threads_used\": " +
+            std::to_string(threads) + ", \"cores\": " + std::to_string(threads) +
+            ", \"per_core\": " + Num(peak.median / threads) +
+            ", \"vector_bits\": " + std::to_string(bits) + ", \"method\": \"16 " +
+            "independent chains of " + std::to_string(bits) + "-bit " + method + " on each of " +
+            std::to_string(threads) + " threads at once\"" +
+            (narrow.empty() ? ""
+                            : ", \"gflops_256bit\": " + Num(rl::bench::Summarize(narrow).median)));
+    return peak.median;
+  };
+  Peaks p;
+  if (CpuRuns("avx512")) {
+    p.fp32 = emit("peak_fp32_gflops", 512, &wide::Fma512Gflops, &baseline::Fma256Gflops,
+                  "FMA instructions; 2 FLOPs per lane and FMA");
+  } else {
+    p.fp32 = emit("peak_fp32_gflops", 256, &baseline::Fma256Gflops, &baseline::Fma256Gflops,
+                  "FMA instructions; 2 FLOPs per lane and FMA");
+  }
+  if (CpuRuns("avx512_bf16")) {
+    p.bf16 = emit("peak_bf16_gflops", 512, &wide::Bf16Dot512Gflops, &wide::Bf16Dot256Gflops,
+                  "vdpbf16ps instructions; 4 FLOPs per 32-bit lane (two bf16 products added)");
+  } else {
+    std::fprintf(stderr, "bench_cnn: no AVX512_BF16 on this CPU: no peak_bf16_gflops row\n");
+  }
+  return p;
 }
 
 // The "threads" fields of a measurement at `threads` threads whose operation ran `sections`
@@ -374,6 +415,100 @@ std::vector<int> ParseThreads(const char* arg) {
   return out;
 }
 
+// The fields of a network line: its name, batch, precision and kernels.
+std::string NetFields(const std::string& net, int batch, rl::nn::Precision precision) {
+  return "\"net\": \"" + net + "\", \"batch\": " + std::to_string(batch) + ", \"precision\": \"" +
+         rl::nn::PrecisionName(precision) + "\", \"kernels\": \"" + rl::nn::KernelPath() +
+         "\", \"bf16_native\": " + (rl::nn::NativeBf16() ? "true" : "false");
+}
+
+// 1. DQN updates per second.
+void BenchUpdates(const NetSpec& spec, const Sequential& net, rl::nn::Precision precision,
+                  int threads, int repeats, double seconds, std::mt19937* rng) {
+  const Flops flops = CountFlops(net, kBatch);
+  DqnUpdate update(net, kBatch, rng);
+  for (int i = 0; i < 3; ++i) update.Run();
+  const int64_t sections = SectionsOf([&] { update.Run(); });
+  const rl::bench::Summary s = rl::bench::Repeat(
+      repeats, [&] { return rl::bench::Rate([&] { update.Run(); }, 1, seconds, 1); });
+  rl::bench::Emit(
+      "learner_updates_" + spec.name, "updates/s", s, repeats,
+      NetFields(spec.name, kBatch, precision) + ", \"actions\": " + std::to_string(kActions) +
+          ", " + ThreadFields(threads, sections) +
+          ", \"loss\": \"huber\", \"optimizer\": \"adam\"" + ", \"gflop_per_update\": " +
+          Num(flops.Update() / 1e9) + ", \"gflops\": " + Num(flops.Update() / 1e9 * s.median) +
+          ", \"conv_gflop_per_update\": " + Num(flops.ConvUpdate() / 1e9) +
+          ", \"peer_mode\": \"micro.py " + (spec.name == "nature_cnn" ? "nature" : "small") +
+          "\", \"work\": \"" + kUpdateWork + "\"");
+}
+
+// 2. Latency of one action for one observation: the greedy action of a Q network, or an actor's
+// output.
+void BenchLatency(const std::string& name, const Sequential& net, bool greedy, bool peer,
+                  rl::nn::Precision precision, int threads, int repeats, double seconds) {
+  Sequential actor = net;
+  std::mt19937 obs_rng(0);
+  const std::vector<uint8_t> obs = RandomPixels(static_cast<size_t>(actor.InputSize()), &obs_rng);
+  const int64_t sections = SectionsOf([&] {
+    Matrix x;
+    rl::nn::PixelsToMatrix(obs.data(), actor.InputSize(), 1, &x);
+    actor.Predict(x.data(), actor.InputSize());
+  });
+  std::vector<double> medians;
+  double mean = 0;
+  for (int r = 0; r < repeats; ++r) {
+    const Latency l = MeasureLatency(&actor, obs, greedy, seconds);
+    medians.push_back(l.median_ms);
+    mean += l.mean_ms / repeats;
+  }
+  rl::bench::Emit(
+      "inference_latency_" + name, "ms", rl::bench::Summarize(medians), repeats,
+      NetFields(name, 1, precision) + ", " + ThreadFields(threads, sections) +
+          ", \"statistic\": \"median over calls (per repeat)\", \"mean_ms\": " + Num(mean) +
+          ", \"work\": \"uint8 observation to x/255 (PixelsToMatrix), forward in evaluation "
+          "mode, " +
+          (greedy ? "argmax (Sequential::Argmax)" : "the action (Sequential::Predict)") + "\"" +
+          (peer ? ", \"peer_mode\": \"micro.py latency\"" : ""));
+}
+
+// 3. GFLOP/s of the convolution layers alone.
+void BenchConvPasses(const NetSpec& spec, const Sequential& net, rl::nn::Precision precision,
+                     const Peaks& peaks, int threads, int repeats, double seconds,
+                     std::mt19937* rng) {
+  const Flops flops = CountFlops(net, kBatch);
+  ConvStack convs(net, kBatch, precision, rng);
+  convs.Forward();
+  convs.Backward();
+  struct Pass {
+    const char* name;
+    double flops;
+    std::function<void()> run;
+  };
+  const Pass passes[] = {
+      {"forward", flops.conv_forward, [&] { convs.Forward(); }},
+      {"backward", flops.conv_backward, [&] { convs.Backward(); }},
+      {"update", flops.ConvUpdate(),
+       [&] {
+         convs.Forward();
+         convs.Forward();
+         convs.Backward();
+       }},
+  };
+  const double peak =
+      precision == rl::nn::Precision::kBf16 && peaks.bf16 > 0 ? peaks.bf16 : peaks.fp32;
+  for (const Pass& pass : passes) {
+    const int64_t sections = SectionsOf(pass.run);
+    const rl::bench::Summary s = rl::bench::Repeat(
+        repeats, [&] { return pass.flops / 1e9 * rl::bench::Rate(pass.run, 1, seconds, 1); });
+    rl::bench::Emit(
+        "conv_gflops_" + spec.name, "GFLOP/s", s, repeats,
+        NetFields(spec.name, kBatch, precision) + ", " + ThreadFields(threads, sections) +
+            ", \"pass\": \"" + pass.name + "\", \"gflop_per_call\": " + Num(pass.flops / 1e9) +
+            ", \"peak_gflops\": " + Num(peak) + ", \"fraction_of_peak\": " + Num(s.median / peak) +
+            ", \"fraction_of_fp32_peak\": " + Num(s.median / peaks.fp32));
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -390,116 +525,38 @@ int main(int argc, char** argv) {
       {"grasp_cnn", "small_cnn_bn",
        [](std::mt19937* rng) { return rl::nn::MakeGraspCnn(kActions, rng); }},
   };
+  // The CarRacing actors of TD3 (3-d actions: steering, gas, brake), for their latency.
+  const std::vector<float> low = {-1.0f, 0.0f, 0.0f};
+  const std::vector<float> high = {1.0f, 1.0f, 1.0f};
+  const std::vector<std::pair<std::string, std::string>> actors = {
+      {"td3_car_actor", rl::nn::Td3CarActorArchitecture(low, high)},
+      {"td3_drq_actor",
+       rl::nn::CarEncoderArchitecture() + "," + rl::nn::DrqActorHeadArchitecture(256, low, high)},
+  };
+  const rl::nn::Precision precisions[] = {rl::nn::Precision::kFp32, rl::nn::Precision::kBf16};
 
   for (int threads : thread_counts) {
     rl::nn::SetNumThreads(threads);
-
-    // The machine's peak, for reference.
-    int bits = 0;
-    std::vector<double> peaks;
-    for (int r = 0; r < repeats; ++r) {
-      peaks.push_back(ParallelFmaGflops(threads, std::min(seconds, 0.5), &bits));
-    }
-    const rl::bench::Summary peak = rl::bench::Summarize(peaks);
-    std::string narrow;
-#if defined(__FMA__)
-    if (threads == 1) {
-      std::vector<double> v;
-      for (int r = 0; r < repeats; ++r) v.push_back(Fma256Gflops(std::min(seconds, 0.5)));
-      narrow = ", \"gflops_256bit\": " + Num(rl::bench::Summarize(v).median);
-    }
-#endif
-    rl::bench::Emit("peak_fp32_gflops", "GFLOP/s", peak, repeats,
-                    "\"threads\": " + std::to_string(threads) + ", \"threads_used\": " +
-                        std::to_string(threads) + ", \"cores\": " + std::to_string(threads) +
-                        ", \"per_core\": " + Num(peak.median / threads) +
-                        ", \"vector_bits\": " + std::to_string(bits) +
-                        ", \"method\": \"16 independent chains of " + std::to_string(bits) +
-                        "-bit FMA instructions on each of " + std::to_string(threads) +
-                        " threads at once; 2 FLOPs per lane and FMA\"" + narrow);
-
+    const Peaks peaks = MeasurePeaks(threads, repeats, seconds);
     for (const NetSpec& spec : nets) {
-      std::mt19937 rng(1);
-      Sequential net = spec.make(&rng);
-      const Flops flops = CountFlops(net, kBatch);
-      const std::string net_fields = "\"net\": \"" + spec.name +
-                                     "\", \"batch\": " + std::to_string(kBatch) +
-                                     ", \"actions\": " + std::to_string(kActions);
-
-      // 1. DQN updates per second.
-      {
-        DqnUpdate update(net, kBatch, &rng);
-        for (int i = 0; i < 3; ++i) update.Run();
-        const int64_t sections = SectionsOf([&] { update.Run(); });
-        const rl::bench::Summary s = rl::bench::Repeat(
-            repeats, [&] { return rl::bench::Rate([&] { update.Run(); }, 1, seconds, 1); });
-        rl::bench::Emit("learner_updates_" + spec.name, "updates/s", s, repeats,
-                        net_fields + ", " + ThreadFields(threads, sections) +
-                            ", \"loss\": \"huber\", \"optimizer\": \"adam\"" +
-                            ", \"gflop_per_update\": " + Num(flops.Update() / 1e9) +
-                            ", \"conv_gflop_per_update\": " + Num(flops.ConvUpdate() / 1e9) +
-                            ", \"peer_mode\": \"micro.py " +
-                            (spec.name == "nature_cnn" ? "nature" : "small") + "\", \"work\": \"" +
-                            kUpdateWork + "\"");
+      for (const rl::nn::Precision precision : precisions) {
+        std::mt19937 rng(1);
+        Sequential net = spec.make(&rng);
+        net.set_precision(precision);
+        BenchUpdates(spec, net, precision, threads, repeats, seconds, &rng);
+        BenchLatency(spec.name, net, /*greedy=*/true, spec.peer_net == "nature_cnn", precision,
+                     threads, repeats, seconds);
+        BenchConvPasses(spec, net, precision, peaks, threads, repeats, seconds, &rng);
       }
-
-      // 2. Latency of one greedy action.
-      {
-        Sequential actor = net;
-        std::mt19937 obs_rng(0);
-        const std::vector<uint8_t> obs =
-            RandomPixels(static_cast<size_t>(actor.InputSize()), &obs_rng);
-        const int64_t sections = SectionsOf([&] {
-          Matrix x;
-          rl::nn::PixelsToMatrix(obs.data(), actor.InputSize(), 1, &x);
-          actor.Argmax(x.data(), actor.InputSize());
-        });
-        std::vector<double> medians;
-        double mean = 0;
-        for (int r = 0; r < repeats; ++r) {
-          const Latency l = MeasureLatency(&actor, obs, seconds);
-          medians.push_back(l.median_ms);
-          mean += l.mean_ms / repeats;
-        }
-        rl::bench::Emit(
-            "inference_latency_" + spec.name, "ms", rl::bench::Summarize(medians), repeats,
-            "\"net\": \"" + spec.name + "\", \"batch\": 1, " + ThreadFields(threads, sections) +
-                ", \"statistic\": \"median over calls (per repeat)\", \"mean_ms\": " + Num(mean) +
-                ", \"work\": \"uint8 observation to x/255 (PixelsToMatrix), forward in "
-                "evaluation mode, argmax (Sequential::Argmax)\"" +
-                (spec.peer_net == "nature_cnn" ? ", \"peer_mode\": \"micro.py latency\"" : ""));
-      }
-
-      // 3. GFLOP/s of the convolution layers alone.
-      {
-        ConvStack convs(net, kBatch, &rng);
-        convs.Forward();
-        convs.Backward();
-        struct Pass {
-          const char* name;
-          double flops;
-          std::function<void()> run;
-        };
-        const Pass passes[] = {
-            {"forward", flops.conv_forward, [&] { convs.Forward(); }},
-            {"backward", flops.conv_backward, [&] { convs.Backward(); }},
-            {"update", flops.ConvUpdate(),
-             [&] {
-               convs.Forward();
-               convs.Forward();
-               convs.Backward();
-             }},
-        };
-        for (const Pass& pass : passes) {
-          const int64_t sections = SectionsOf(pass.run);
-          const rl::bench::Summary s = rl::bench::Repeat(
-              repeats, [&] { return pass.flops / 1e9 * rl::bench::Rate(pass.run, 1, seconds, 1); });
-          rl::bench::Emit("conv_gflops_" + spec.name, "GFLOP/s", s, repeats,
-                          net_fields + ", " + ThreadFields(threads, sections) + ", \"pass\": \"" +
-                              pass.name + "\", \"gflop_per_call\": " + Num(pass.flops / 1e9) +
-                              ", \"peak_gflops\": " + Num(peak.median) +
-                              ", \"fraction_of_peak\": " + Num(s.median / peak.median));
-        }
+    }
+    for (const auto& [name, arch] : actors) {
+      for (const rl::nn::Precision precision : precisions) {
+        std::mt19937 rng(1);
+        Sequential net = rl::nn::BuildFromArchitecture(arch, &rng);
+        net.set_precision(precision);
+        net.set_training(false);
+        BenchLatency(name, net, /*greedy=*/false, /*peer=*/false, precision, threads, repeats,
+                     seconds);
       }
     }
   }

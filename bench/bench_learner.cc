@@ -9,7 +9,10 @@
 //                        TD3 CarRacing article's networks on 4 x 84 x 84 stacks, 3-d action, batch
 //                        128). One call is one critic update; every 2nd also updates the actor and
 //                        the targets (policy delay 2), as the peer's. Also the GFLOP/s this
-//                        reaches, from the forward multiply-adds of the networks (see Td3Flops).
+//                        reaches, from the forward multiply-adds of the networks (see Td3Flops),
+//                        and "td3_car_drq": the car_racing_td3 preset's network (drq), batch 128.
+// Every row is measured in fp32 and in bf16 (nn/precision.h) and says which ("precision"), on
+// which kernel path ("kernels") and whether bf16 ran on the CPU's instructions ("bf16_native").
 #include <random>
 #include <string>
 #include <vector>
@@ -21,6 +24,7 @@
 #include "nn/conv2d.h"
 #include "nn/linear.h"
 #include "nn/pixels.h"
+#include "nn/precision.h"
 
 namespace {
 
@@ -120,28 +124,41 @@ rl::learner::Batch View(const Data& d, int batch, int width) {
   return b;
 }
 
+// The fields every row has after its measurement's own.
+std::string PrecisionFields(rl::nn::Precision precision) {
+  return std::string(", \"precision\": \"") + rl::nn::PrecisionName(precision) +
+         "\", \"kernels\": \"" + rl::nn::KernelPath() +
+         "\", \"bf16_native\": " + (rl::nn::NativeBf16() ? "true" : "false");
+}
+
+const rl::nn::Precision kPrecisions[] = {rl::nn::Precision::kFp32, rl::nn::Precision::kBf16};
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
   const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
-  for (int batch : {32, 64, 128}) {
-    rl::learner::DqnConfig c;
-    c.hidden = {120, 84};
-    c.loss = "mse";
-    c.learning_rate = 2.5e-4f;
-    c.double_dqn = false;
-    c.max_grad_norm = 0;
-    c.target_update_period = 1 << 30;
-    rl::learner::Dqn dqn(4, 2, c);
-    const std::vector<Data> data = MakeData(rl::envs::CartPoleSpec(), batch, false);
-    size_t k = 0;
-    const auto s = rl::bench::Repeat(repeats, [&] {
-      return rl::bench::Rate([&] { dqn.Update(View(data[k++ % data.size()], batch, 1)); }, 1,
-                             seconds, 20);
-    });
-    rl::bench::Emit("learner_updates_mlp", "updates/s", s, repeats,
-                    "\"batch\": " + std::to_string(batch) + ", \"threads\": 1");
+  for (const rl::nn::Precision precision : kPrecisions) {
+    for (int batch : {32, 64, 128}) {
+      rl::learner::DqnConfig c;
+      c.hidden = {120, 84};
+      c.loss = "mse";
+      c.learning_rate = 2.5e-4f;
+      c.double_dqn = false;
+      c.max_grad_norm = 0;
+      c.target_update_period = 1 << 30;
+      c.precision = precision;
+      rl::learner::Dqn dqn(4, 2, c);
+      const std::vector<Data> data = MakeData(rl::envs::CartPoleSpec(), batch, false);
+      size_t k = 0;
+      const auto s = rl::bench::Repeat(repeats, [&] {
+        return rl::bench::Rate([&] { dqn.Update(View(data[k++ % data.size()], batch, 1)); }, 1,
+                               seconds, 20);
+      });
+      rl::bench::Emit(
+          "learner_updates_mlp", "updates/s", s, repeats,
+          "\"batch\": " + std::to_string(batch) + ", \"threads\": 1" + PrecisionFields(precision));
+    }
   }
 
   struct Td3Case {
@@ -164,26 +181,29 @@ int main(int argc, char** argv) {
       {"td3_car_drq", car_spec, "drq", 128, 2.5e-4f, 1e-3f, 0.05f, true},
   };
   for (const Td3Case& t : cases) {
-    rl::learner::Td3Config c;
-    c.network = t.network;
-    c.hidden = {256, 256};
-    c.actor_learning_rate = t.actor_lr;
-    c.critic_learning_rate = t.critic_lr;
-    c.tau = t.tau;
-    rl::learner::Td3 td3(t.spec, c);
-    const std::vector<Data> data = MakeData(t.spec, t.batch, t.pixels);
-    const int width = t.spec.action_width();
-    size_t k = 0;
-    const auto s = rl::bench::Repeat(repeats, [&] {
-      return rl::bench::Rate([&] { td3.Update(View(data[k++ % data.size()], t.batch, width)); }, 1,
-                             seconds, 4);
-    });
-    const double gflop = Td3UpdateFlops(td3, t.batch) / 1e9;
-    rl::bench::Emit("learner_updates_td3", "updates/s", s, repeats,
-                    "\"net\": \"" + std::string(t.name) +
-                        "\", \"batch\": " + std::to_string(t.batch) +
-                        ", \"threads\": 1, \"gflop_per_update\": " + std::to_string(gflop) +
-                        ", \"gflops\": " + std::to_string(gflop * s.median));
+    for (const rl::nn::Precision precision : kPrecisions) {
+      rl::learner::Td3Config c;
+      c.network = t.network;
+      c.hidden = {256, 256};
+      c.actor_learning_rate = t.actor_lr;
+      c.critic_learning_rate = t.critic_lr;
+      c.tau = t.tau;
+      c.precision = precision;
+      rl::learner::Td3 td3(t.spec, c);
+      const std::vector<Data> data = MakeData(t.spec, t.batch, t.pixels);
+      const int width = t.spec.action_width();
+      size_t k = 0;
+      const auto s = rl::bench::Repeat(repeats, [&] {
+        return rl::bench::Rate([&] { td3.Update(View(data[k++ % data.size()], t.batch, width)); },
+                               1, seconds, 4);
+      });
+      const double gflop = Td3UpdateFlops(td3, t.batch) / 1e9;
+      rl::bench::Emit(
+          "learner_updates_td3", "updates/s", s, repeats,
+          "\"net\": \"" + std::string(t.name) + "\", \"batch\": " + std::to_string(t.batch) +
+              ", \"threads\": 1, \"gflop_per_update\": " + std::to_string(gflop) +
+              ", \"gflops\": " + std::to_string(gflop * s.median) + PrecisionFields(precision));
+    }
   }
   return 0;
 }

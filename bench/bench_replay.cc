@@ -28,8 +28,14 @@
 //
 // Authenticated messages (common/message_auth.h):
 //   mac_aes256_gmac_{pixel_batch,4mb}  checking the MAC of a 230 KB and of a 4 MB message, MB/s
-//                             (mac_aes256_gmac_openssl_*: OpenSSL's AES-GCM whole over the same
-//                             bytes; mac_hmac_sha256_*: HMAC-SHA256; both for comparison).
+//                             (mac_hmac_sha256_*: HMAC-SHA256 over the same bytes, for
+//                             comparison).
+//   bus_receive_real_{flat,pixel}, bus_drop_forged_{flat,pixel}  what a keyed bus spends on one
+//                             message from its arrival to its handler (Bus::Deliver, no
+//                             transport), µs: a real CartPole or pixel batch (header, MAC,
+//                             freshness, decode, Validate) against a forged one of the same size
+//                             (a wrong MAC, a sender name and incarnation of its own each: dropped
+//                             after the MAC check); the forged row gives the ratio.
 //   pixel_replay_insert_mac   pixel_replay_insert with the run's key on both sides (the actor
 //                             signs, the replay checks), on two more ports: compare its rate and
 //                             replay_cpu_us_per_transition with pixel_replay_insert's.
@@ -89,7 +95,6 @@
 #include "common/channels.h"
 #include "common/check.h"
 #include "common/clock.h"
-#include "common/gmac.h"
 #include "common/message_auth.h"
 #include "replay/pixel_table.h"
 #include "replay/prioritized_sampler.h"
@@ -367,10 +372,42 @@ static_assert(std::atomic<double>::is_always_lock_free && std::atomic<int64_t>::
               "a ServiceProbe is shared with a forked service process");
 
 // The MAC a bus with `key` signs and checks with, for the rows' "mac" field.
-const char* MacName(const std::string& key) {
-  if (key.empty()) return "none";
-  return rl::Gmac::Accelerated() ? "AES-256-GMAC, kernel GHASH" : "AES-256-GMAC, OpenSSL GHASH";
-}
+const char* MacName(const std::string& key) { return key.empty() ? "none" : "AES-256-GMAC"; }
+
+// OpenSSL's AES-256-GCM with nothing encrypted (GMAC, as common/message_auth.h uses it) under one
+// key, for MACs computed and dropped: what an unkeyed actor does to load the machine as a keyed
+// one does.
+class LooseGmac {
+ public:
+  LooseGmac() : ctx_(EVP_CIPHER_CTX_new()) {
+    const std::string key(32, 's');
+    if (ctx_ == nullptr ||
+        EVP_EncryptInit_ex(ctx_, EVP_aes_256_gcm(), nullptr,
+                           reinterpret_cast<const unsigned char*>(key.data()), nullptr) != 1) {
+      std::fprintf(stderr, "bench_replay: no AES-256-GCM from OpenSSL\n");
+      std::abort();
+    }
+  }
+  LooseGmac(const LooseGmac&) = delete;
+  LooseGmac& operator=(const LooseGmac&) = delete;
+  ~LooseGmac() { EVP_CIPHER_CTX_free(ctx_); }
+
+  // The tag of `size` bytes under a nonce made of `seq`.
+  void Tag(int64_t seq, const uint8_t* data, size_t size, unsigned char* tag) {
+    unsigned char nonce[12] = {};
+    std::memcpy(nonce, &seq, sizeof(seq));
+    int out = 0;
+    if (EVP_EncryptInit_ex(ctx_, nullptr, nullptr, nullptr, nonce) != 1 ||
+        EVP_EncryptUpdate(ctx_, nullptr, &out, data, static_cast<int>(size)) != 1 ||
+        EVP_EncryptFinal_ex(ctx_, tag, &out) != 1 ||
+        EVP_CIPHER_CTX_ctrl(ctx_, EVP_CTRL_GCM_GET_TAG, 16, tag) != 1) {
+      std::abort();
+    }
+  }
+
+ private:
+  EVP_CIPHER_CTX* ctx_;
+};
 
 void PinTo(int cpu) {
   cpu_set_t set;
@@ -541,12 +578,7 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
   const bool pin = first_cpu >= 0 && last_cpu > first_cpu;
   // The unkeyed side's actor computes a MAC too (over its batch's frames, nearly all of its
   // bytes) and drops it, so that the actor's load on the machine is the same on both sides.
-  rl::Gmac unkeyed_signer;
-  const std::string signer_key(rl::Gmac::kKeyBytes, 's');
-  if (!unkeyed_signer.SetKey(reinterpret_cast<const uint8_t*>(signer_key.data()))) {
-    std::fprintf(stderr, "bench_replay: no AES-256 from OpenSSL\n");
-    return 1;
-  }
+  LooseGmac unkeyed_signer;
   int64_t unkeyed_seq = 0;
   Side sides[2];
   sides[0].port = port;
@@ -624,11 +656,8 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
         rlmsg::transition_batch_t* m = sims[i]->Next();
         bus->Publish(rl::channels::kTransitions, m);
         if (i == 0) {
-          uint8_t nonce[rl::Gmac::kNonceBytes] = {}, tag[rl::Gmac::kTagBytes];
-          std::memcpy(nonce, &++unkeyed_seq, sizeof(unkeyed_seq));
-          unkeyed_signer.Start(nonce);
-          unkeyed_signer.Update(m->frames.data(), m->frames.size());
-          if (!unkeyed_signer.Finish(tag)) std::abort();
+          unsigned char tag[16];
+          unkeyed_signer.Tag(++unkeyed_seq, m->frames.data(), m->frames.size(), tag);
         }
         sent += m->count;
         next += kBatch / rate;
@@ -1088,24 +1117,15 @@ void FlatSnapshots(int repeats) {
 
 }  // namespace
 
-// mac_aes256_gmac: checking (common/message_auth.h) messages of a pixel batch's size (32
-// transitions with their frames) and of a sample reply's (4 MB), MB/s, with the GHASH of
-// common/gmac.h (its kernel where the build has it: "ghash" says which); for comparison, over the
-// same bytes, mac_aes256_gmac_openssl: OpenSSL's AES-256-GCM whole (what the bus used before the
-// kernel, and still uses where the build has none), and mac_hmac_sha256: the MAC used before
-// GMAC, HMAC-SHA256 (OpenSSL).
+// mac_aes256_gmac: checking (common/message_auth.h: OpenSSL's AES-256-GCM as GMAC) messages of a
+// pixel batch's size (32 transitions with their frames) and of a sample reply's (4 MB), MB/s; for
+// comparison, over the same bytes, mac_hmac_sha256: HMAC-SHA256 (OpenSSL), the MAC used before
+// GMAC.
 void MacRows(int repeats) {
   rl::MessageAuthenticator auth(std::string(rl::kKeyBytes, 'k'));
   const std::string key(rl::kKeyBytes, 'k');
   const std::string sender = "actor-1";
   const size_t at = rl::MacOffset(sender.size());
-  EVP_CIPHER_CTX* gcm = EVP_CIPHER_CTX_new();
-  if (gcm == nullptr ||
-      EVP_EncryptInit_ex(gcm, EVP_aes_256_gcm(), nullptr,
-                         reinterpret_cast<const unsigned char*>(key.data()), nullptr) != 1) {
-    std::abort();
-  }
-  enum class Mac { kGmac, kOpenSslGcm, kHmac };
   for (const size_t size : {size_t{230'000}, size_t{4'000'000}}) {
     // Header bytes as MacOffset() lays them out: the sender's length and name, MAC zero.
     std::vector<uint8_t> msg(size, 0x5a);
@@ -1116,51 +1136,113 @@ void MacRows(int repeats) {
     std::fill(msg.begin() + static_cast<std::ptrdiff_t>(at),
               msg.begin() + static_cast<std::ptrdiff_t>(at + rl::kMacBytes), 0);
     if (!auth.Sign("RL_TRANSITIONS", msg.data(), msg.size(), at)) std::abort();
-    for (const Mac mac : {Mac::kGmac, Mac::kOpenSslGcm, Mac::kHmac}) {
+    for (const bool gmac : {true, false}) {
       std::vector<double> rates;
       for (int r = 0; r < repeats; ++r) {
         int64_t n = 0;
         const double start = rl::MonoSeconds();
         while (rl::MonoSeconds() - start < 0.3) {
           unsigned char md[32];
-          if (mac == Mac::kGmac) {
-            if (auth.Verify("RL_TRANSITIONS", msg.data(), msg.size(), at) != nullptr) std::abort();
-          } else if (mac == Mac::kOpenSslGcm) {
-            unsigned char nonce[12] = {};
-            std::memcpy(nonce, &n, sizeof(n));
-            int out = 0;
-            if (EVP_EncryptInit_ex(gcm, nullptr, nullptr, nullptr, nonce) != 1 ||
-                EVP_EncryptUpdate(gcm, nullptr, &out, msg.data(), static_cast<int>(size)) != 1 ||
-                EVP_EncryptFinal_ex(gcm, md, &out) != 1 ||
-                EVP_CIPHER_CTX_ctrl(gcm, EVP_CTRL_GCM_GET_TAG, 16, md) != 1) {
-              std::abort();
-            }
-          } else {
-            unsigned int md_size = 0;
-            if (HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), msg.data(), msg.size(),
-                     md, &md_size) == nullptr) {
-              std::abort();
-            }
+          unsigned int md_size = 0;
+          if (gmac ? auth.Verify("RL_TRANSITIONS", msg.data(), msg.size(), at) != nullptr
+                   : HMAC(EVP_sha256(), key.data(), static_cast<int>(key.size()), msg.data(),
+                          msg.size(), md, &md_size) == nullptr) {
+            std::abort();
           }
           ++n;
         }
         rates.push_back(static_cast<double>(n) * static_cast<double>(size) / 1e6 /
                         (rl::MonoSeconds() - start));
       }
-      char extra[160];
-      std::snprintf(extra, sizeof(extra), "\"message_bytes\": %zu, \"mac_bytes\": %zu%s", size,
-                    rl::kMacBytes,
-                    mac != Mac::kGmac         ? ""
-                    : rl::Gmac::Accelerated() ? ", \"ghash\": \"kernel\""
-                                              : ", \"ghash\": \"OpenSSL\"");
-      const char* prefix = mac == Mac::kGmac         ? "mac_aes256_gmac_"
-                           : mac == Mac::kOpenSslGcm ? "mac_aes256_gmac_openssl_"
-                                                     : "mac_hmac_sha256_";
-      const std::string name = prefix + std::string(size < 1'000'000 ? "pixel_batch" : "4mb");
-      rl::bench::Emit(name.c_str(), "MB/s", rl::bench::Summarize(rates), repeats, extra);
+      char extra[96];
+      std::snprintf(extra, sizeof(extra), "\"message_bytes\": %zu, \"mac_bytes\": %zu", size,
+                    rl::kMacBytes);
+      const std::string name = std::string(gmac ? "mac_aes256_gmac_" : "mac_hmac_sha256_") +
+                               (size < 1'000'000 ? "pixel_batch" : "4mb");
+      rl::bench::Emit(name, "MB/s", rl::bench::Summarize(rates), repeats, extra);
     }
   }
-  EVP_CIPHER_CTX_free(gcm);
+}
+
+// bus_receive_real_*, bus_drop_forged_*: see the top of the file. Each repeat delivers `count`
+// real messages (a new incarnation each repeat, so none is replayed) and as many forged ones.
+void BusReceiveRows(int repeats) {
+  const std::string key(rl::kKeyBytes, 'k');
+  rl::MessageAuthenticator signer(key);
+  for (const bool pixels : {false, true}) {
+    rl::BusConfig config = rl::InProcessBusConfig(77, "replay");
+    config.key = key;
+    rl::Bus bus(config);
+    int64_t handled = 0;
+    bus.Subscribe<rlmsg::transition_batch_t>(
+        rl::channels::kTransitions, [&handled](const rlmsg::transition_batch_t&) { ++handled; });
+    PixelActorSim sim(0, 1);
+    rlmsg::transition_batch_t m = pixels ? *sim.Next() : Batch();
+    m.header.run_id = 77;
+    m.header.sender = "actor-0";
+    const size_t at = rl::MacOffset(m.header.sender.size());
+    const int count = pixels ? 128 : 20'000;
+    std::vector<std::vector<uint8_t>> real(static_cast<size_t>(count)), forged(real.size());
+    std::vector<double> real_us, forged_us, ratio;
+    int64_t incarnation = rl::WallMicros() - 1'000'000;
+    for (int r = 0; r < repeats; ++r) {
+      const int64_t now = rl::WallMicros();
+      ++incarnation;
+      for (int i = 0; i < count; ++i) {
+        std::vector<uint8_t>& bytes = real[static_cast<size_t>(i)];
+        m.header.incarnation = incarnation;
+        m.header.seq = i;
+        m.header.utime = now;
+        bytes.resize(static_cast<size_t>(m.getEncodedSize()));
+        if (m.encode(bytes.data(), 0, static_cast<int>(bytes.size())) !=
+                static_cast<int>(bytes.size()) ||
+            !signer.Sign(rl::channels::kTransitions, bytes.data(), bytes.size(), at)) {
+          std::abort();
+        }
+        // A forger's: a sender name and an incarnation of its own, a MAC it had to guess.
+        std::vector<uint8_t>& f = forged[static_cast<size_t>(i)];
+        f = bytes;
+        char name[8];
+        std::snprintf(name, sizeof(name), "f%06d", i % 1'000'000);
+        std::memcpy(f.data() + 20, name, 7);
+        f[at - 1] ^= static_cast<uint8_t>(i);
+        f[at - 2] ^= static_cast<uint8_t>(i >> 8);
+        f[at] ^= 1;
+      }
+      const int64_t handled_before = handled;
+      double start = rl::MonoSeconds();
+      for (const auto& bytes : real) {
+        bus.Deliver(rl::channels::kTransitions, bytes.data(), bytes.size(), now);
+      }
+      real_us.push_back((rl::MonoSeconds() - start) * 1e6 / count);
+      const int64_t refused_before = bus.counters().unauthenticated;
+      start = rl::MonoSeconds();
+      for (const auto& bytes : forged) {
+        bus.Deliver(rl::channels::kTransitions, bytes.data(), bytes.size(), now);
+      }
+      forged_us.push_back((rl::MonoSeconds() - start) * 1e6 / count);
+      ratio.push_back(forged_us.back() / real_us.back());
+      if (handled - handled_before != count ||
+          bus.counters().unauthenticated - refused_before != count) {
+        std::fprintf(stderr, "bench_replay: the bus took a forged message or refused a real one\n");
+        std::abort();
+      }
+    }
+    const std::string kind = pixels ? "pixel" : "flat";
+    char extra[256];
+    std::snprintf(extra, sizeof(extra), "\"message_bytes\": %zu, \"messages\": %d, \"mac\": \"%s\"",
+                  real[0].size(), count, MacName(key));
+    rl::bench::Emit("bus_receive_real_" + kind, "us/message", rl::bench::Summarize(real_us),
+                    repeats, extra);
+    const auto r = rl::bench::Summarize(ratio);
+    std::snprintf(extra, sizeof(extra),
+                  "\"message_bytes\": %zu, \"messages\": %d, \"mac\": \"%s\", "
+                  "\"forged_over_real_median\": %.3f, \"forged_over_real_min\": %.3f, "
+                  "\"forged_over_real_max\": %.3f",
+                  real[0].size(), count, MacName(key), r.median, r.min, r.max);
+    rl::bench::Emit("bus_drop_forged_" + kind, "us/message", rl::bench::Summarize(forged_us),
+                    repeats, extra);
+  }
 }
 
 // pixel_replay_insert_cpu's paced rate: a third of what one actor publishing back to back gets
@@ -1178,6 +1260,7 @@ int main(int argc, char** argv) {
       return rc;
     }
     MacRows(repeats);
+    BusReceiveRows(repeats);
     if (const int rc = RunPixelLcm(repeats, seconds, port + 2, "", /*insert_only=*/true); rc != 0) {
       return rc;
     }
@@ -1200,6 +1283,7 @@ int main(int argc, char** argv) {
   if (const int rc = RunFlat(repeats, seconds, port); rc != 0) return rc;
   if (const int rc = RunPixelLcm(repeats, seconds, port + 2); rc != 0) return rc;
   MacRows(repeats);
+  BusReceiveRows(repeats);
   if (const int rc = RunPixelLcm(repeats, seconds, port + 4, std::string(rl::kKeyBytes, 'k'));
       rc != 0) {
     return rc;

@@ -3,18 +3,41 @@
 // It owns two LCM instances, one for the main port (small, high-rate messages) and one for the
 // bulk port (weights, sample replies), so that bulk traffic never starves the rest. Publish()
 // fills the header (run id, sender, incarnation, per-channel sequence number, time) and, when the
-// run has a key, the MAC (common/message_auth.h). Subscribe() installs a typed handler behind a
-// checking decoder, and a message reaches the handler only when it passes every check, in this
-// order, each drop counted by its reason:
-//   malformed        does not decode as the channel's type (foreign type, torn or forged lengths)
+// run has a key, the MAC (common/message_auth.h). Subscribe() installs a typed handler behind the
+// checks, and a message reaches the handler only when it passes every one, in this order, each
+// drop counted by its reason:
+//   malformed        its header cannot be read from the raw bytes (too short, a sender name that
+//                    is empty, over 64 bytes or not printable), it is another type (fingerprint),
+//                    or later it does not decode (torn or forged lengths: Prescan, lcm-gen)
 //   foreign          another run's id
 //   unauthenticated  no MAC or a wrong one (with a key; a bus without one checks none)
-//   replayed         an incarnation of its sender older than one already heard, or a sequence
-//                    number of the sender's incarnation on this channel already passed
+//   invalid          a negative sequence number or incarnation
+//   stale            its time (header.utime) is more than max_message_age before the packet
+//                    reached this host, or more than max_clock_skew after it; or its incarnation
+//                    is later than its time (plus the skew): no process publishes before it starts
+//   replayed         an incarnation of its sender older than one heard, or a sequence number of
+//                    the sender's incarnation on this channel already passed
+//   malformed        (as above) the decoder refuses it (Prescan, then lcm-gen's decoder)
 //   invalid          fails Validate() (or the handler threw)
-// Gaps in a sender incarnation's sequence are counted as lost; a newer incarnation (a restarted
-// sender) starts a new sequence. Handlers must not throw; if one does, the exception is caught,
-// logged and counted as invalid.
+// The header is read from the raw bytes and every check up to the replay check runs before any
+// decoding, so a forged, stale or replayed message costs its MAC check (one GMAC pass over its
+// bytes, no key derivation: message_auth.h) and nothing more. A message that decodes takes its
+// sender's position, also when Validate() then refuses it.
+//
+// Freshness: "the packet reached this host" is LCM's receive time (the kernel's timestamp of the
+// packet, taken before any queueing in this process), so a process busy for minutes (an evaluator
+// scoring, a learner writing a checkpoint) never ages the messages waiting in its queue. Each
+// subscription keeps the last position (incarnation, sequence number, time) it accepted from each
+// sender (of at most kMaxSenders senders; past them, the one heard longest ago goes); a position
+// whose time is older than max_message_age guards nothing any more (every message it would
+// refuse is stale) and gives way to the sender's next message, so a forged message with a later
+// incarnation or a huge sequence number silences its sender for at most max_message_age +
+// max_clock_skew. Gaps in a sender incarnation's sequence are counted as lost; a newer
+// incarnation (a restarted sender) starts a new sequence. Positions() / LoadPositions() export
+// and restore them, so that a restarted process (the replay from its snapshot, the learner from
+// its state) still refuses recorded traffic older than its saved state.
+//
+// Handlers must not throw; if one does, the exception is caught, logged and counted as invalid.
 //
 // Not thread-safe: one thread constructs, publishes and calls Handle().
 #pragma once
@@ -27,8 +50,8 @@
 #include <iterator>
 #include <map>
 #include <memory>
-#include <set>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -43,6 +66,15 @@ inline constexpr char kDefaultLcmUrl[] = "udpm://239.255.76.67:7667?ttl=0&recv_b
 inline constexpr char kDefaultLcmBulkUrl[] =
     "udpm://239.255.76.67:7668?ttl=0&recv_buf_size=4194304";
 
+// The freshness window's defaults (BusConfig, --max-message-age and --max-clock-skew). A message's
+// age is its sender's clock at publication against this host's at the packet's arrival, before
+// any queueing in the receiving process; what is left in it is the network (milliseconds on a
+// LAN) and the difference between two hosts' clocks, milliseconds under NTP or chrony, which
+// cluster nodes run. 60 s behind and 10 s ahead leave room for a node whose clock has drifted for
+// a few days with neither, and still refuse a recording played back a minute after it was made.
+inline constexpr int64_t kDefaultMaxMessageAgeMicros = 60'000'000;
+inline constexpr int64_t kDefaultMaxClockSkewMicros = 10'000'000;
+
 struct BusConfig {
   std::string url = kDefaultLcmUrl;           // main port
   std::string bulk_url = kDefaultLcmBulkUrl;  // bulk port
@@ -50,6 +82,9 @@ struct BusConfig {
   std::string sender;                         // header.sender of what we publish
   std::string key;  // the run's secret key (kKeyBytes), or empty: no MACs written or checked
   int queue_capacity = 10000;  // per-subscription LCM queue (LCM's default: 30)
+  // Freshness window (see the top of this file), microseconds, both > 0.
+  int64_t max_message_age = kDefaultMaxMessageAgeMicros;
+  int64_t max_clock_skew = kDefaultMaxClockSkewMicros;
 };
 
 /// An in-process bus (LCM's memq:// provider on both ports): only this process receives what it
@@ -69,20 +104,41 @@ struct BusCounters {
   int64_t foreign = 0;          // another run's messages
   int64_t invalid = 0;          // decoded but failed Validate(), or the handler threw
   int64_t unauthenticated = 0;  // no MAC, or a wrong one
+  int64_t stale = 0;            // outside the freshness window, or an incarnation after its time
   int64_t replayed = 0;         // an older incarnation, or a sequence number already passed
   int64_t lost = 0;             // sequence gaps
   // Time spent signing and checking MACs (a monotonic clock; a preempted check counts its wait),
   // what authentication costs this process (bench_replay's pixel_replay_insert_cpu_mac row).
   int64_t mac_nanos = 0;
 
-  int64_t dropped() const { return malformed + foreign + invalid + unauthenticated + replayed; }
+  int64_t dropped() const {
+    return malformed + foreign + invalid + unauthenticated + stale + replayed;
+  }
 };
+
+// The last message a subscription accepted from one sender on one channel (Bus::Positions()).
+struct StreamPosition {
+  std::string channel;
+  std::string sender;
+  int64_t incarnation = 0;
+  int64_t seq = 0;
+  int64_t utime = 0;  // its header.utime
+};
+
+/// Positions as text, one per line: "CHANNEL SENDER INCARNATION SEQ UTIME" (for state files).
+std::string FormatPositions(const std::vector<StreamPosition>& positions);
+/// The inverse. Throws std::runtime_error naming the line and what is wrong: not five fields, a
+/// channel or sender name that is empty, too long or not printable, a number that is not one or
+/// negative (incarnation, seq), or more than kMaxStoredPositions lines.
+std::vector<StreamPosition> ParsePositions(std::string_view text);
+inline constexpr size_t kMaxStoredPositions = 65536;
 
 enum class Port { kMain, kBulk };
 
 class Bus {
  public:
-  // Throws std::runtime_error naming the URL when LCM cannot start on it.
+  // Throws std::runtime_error naming the URL when LCM cannot start on it, std::invalid_argument
+  // when the sender name is not ValidSenderName() or the freshness window is not positive.
   explicit Bus(BusConfig config);
   Bus(const Bus&) = delete;
   Bus& operator=(const Bus&) = delete;
@@ -99,10 +155,28 @@ class Bus {
     return lcm(port).publish(channel, data, static_cast<unsigned>(size)) == 0;
   }
 
-  // Calls handler(msg) for every good message of type Msg on `channel`.
+  // Calls handler(msg) for every good message of type Msg on `channel`. The subscription starts
+  // from the positions restored for its channel (LoadPositions()).
   template <class Msg>
   void Subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
                  Port port = Port::kMain);
+
+  // Handles `size` bytes as if LCM had received them on `channel` at recv_utime (microseconds
+  // since the Unix epoch): every subscription of the channel checks them (for tests, benchmarks
+  // and fuzzing, which need no transport and choose the receive time).
+  void Deliver(const std::string& channel, const uint8_t* data, size_t size, int64_t recv_utime);
+
+  // The last position accepted from each sender on each channel, the newest over a channel's
+  // subscriptions, with those restored for channels not subscribed; without positions that have
+  // aged out of the window. Sorted by channel and sender.
+  std::vector<StreamPosition> Positions() const;
+  // Makes every subscription of a position's channel, now and later, refuse what is not newer
+  // than it (a position it holds already wins when newer). Gaps after a restored position are not
+  // counted as lost.
+  void RestorePositions(const std::vector<StreamPosition>& positions);
+  std::string SavePositions() const { return FormatPositions(Positions()); }
+  // ParsePositions(text), then RestorePositions (throws as ParsePositions does).
+  void LoadPositions(std::string_view text) { RestorePositions(ParsePositions(text)); }
 
   // Waits at most timeout_ms (0: no wait) for traffic on either port, then dispatches every
   // pending message. Returns the number of messages dispatched.
@@ -121,41 +195,56 @@ class Bus {
     s->dropped_foreign = counters_.foreign;
     s->dropped_invalid = counters_.invalid;
     s->dropped_unauthenticated = counters_.unauthenticated;
+    s->dropped_stale = counters_.stale;
     s->dropped_replayed = counters_.replayed;
     s->lost = counters_.lost;
   }
 
  private:
+  // A sender's last accepted message on one subscription.
+  struct Position {
+    int64_t incarnation = 0;
+    int64_t seq = 0;
+    int64_t utime = 0;
+    bool restored = false;  // from LoadPositions, nothing heard since: no gap counted after it
+  };
+  using SenderPositions = std::map<std::string, Position, std::less<>>;  // by sender
+  // Senders whose positions one subscription keeps; past it, the one heard longest ago goes.
+  static constexpr size_t kMaxSenders = 1024;
+
   struct RawSubscription {
     std::string channel;
-    std::function<void(const uint8_t*, size_t)> on_bytes;
-    Bus* bus;
+    int64_t fingerprint = 0;  // the type's
+    // Decodes a message that passed the header checks into the subscription's object (nullptr,
+    // or why it does not decode); then validates it and hands it to the handler.
+    std::function<const char*(const uint8_t*, size_t)> decode;
+    std::function<void()> handle;
+    Bus* bus = nullptr;
+    // Only the channel's first subscription counts gaps, so that a channel subscribed twice does
+    // not count them twice.
+    bool counts_lost = false;
+    SenderPositions heard;
   };
 
   lcm::LCM& lcm(Port port) { return port == Port::kMain ? *main_ : *bulk_; }
-  void SubscribeRaw(const std::string& channel, Port port,
-                    std::function<void(const uint8_t*, size_t)> on_bytes);
+  void SubscribeRaw(const std::string& channel, Port port, int64_t fingerprint,
+                    std::function<const char*(const uint8_t*, size_t)> decode,
+                    std::function<void()> handle);
   static void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
                     RawSubscription* sub);
+  // Every check (see the top of this file), decoding, and the handler.
+  void Receive(RawSubscription* sub, const uint8_t* data, size_t size, int64_t recv_utime);
+  // Why a message is stale, or nullptr.
+  const char* Stale(const WireHeader& h, int64_t recv_utime) const;
+  // Why a message is replayed (not newer than its sender's position, which has not aged out), or
+  // nullptr. Changes nothing.
+  const char* Replayed(const RawSubscription& sub, const WireHeader& h, int64_t recv_utime) const;
+  // Takes a message's position (one Replayed() passed, and that decoded), counting a gap in its
+  // sender incarnation's sequence as lost.
+  void Take(RawSubscription* sub, const WireHeader& h);
   // Signs an encoded message of ours published on `channel` (no-op without a key).
   bool Sign(const std::string& channel, uint8_t* data, size_t size, const rlmsg::header_t& header);
-  struct SenderPosition {
-    int64_t incarnation;
-    int64_t seq;
-  };
-  // What one subscription has taken from each sender. Each subscription keeps its own, since LCM
-  // hands every message to every subscription of its channel; only the channel's first
-  // subscription counts gaps, so that a channel subscribed twice does not count them twice.
-  struct Heard {
-    bool counts_lost = false;
-    std::map<std::string, SenderPosition> by_sender;
-  };
-
-  // Checks run id, MAC and freshness of a decoded message; returns false (and counts) when the
-  // message is to be dropped.
-  bool AcceptHeader(const std::string& channel, const rlmsg::header_t& header, const uint8_t* data,
-                    size_t size, Heard* heard);
-  void LogDrop(const std::string& channel, const char* kind, const char* reason);
+  void Drop(const std::string& channel, int64_t* counter, const char* kind, const char* reason);
 
   BusConfig config_;
   int64_t incarnation_;
@@ -163,8 +252,8 @@ class Bus {
   std::unique_ptr<lcm::LCM> main_;
   std::unique_ptr<lcm::LCM> bulk_;
   std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
-  std::map<std::string, int64_t> publish_seq_;  // by channel
-  std::set<std::string> subscribed_;            // channels with a subscription
+  std::map<std::string, int64_t> publish_seq_;                    // by channel
+  std::map<std::string, SenderPositions, std::less<>> restored_;  // by channel (LoadPositions)
   std::vector<uint8_t> encode_buffer_;
   BusCounters counters_;
   int64_t drops_logged_ = 0;
@@ -189,31 +278,22 @@ template <class Msg>
 void Bus::Subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
                     Port port) {
   auto decoded = std::make_shared<Msg>();
-  auto heard = std::make_shared<Heard>();
-  heard->counts_lost = subscribed_.insert(channel).second;
-  SubscribeRaw(channel, port,
-               [this, channel, handler = std::move(handler), decoded, heard](const uint8_t* data,
-                                                                             size_t size) {
-                 Msg& msg = *decoded;
-                 if (const char* why = Decode(data, size, &msg)) {
-                   ++counters_.malformed;
-                   LogDrop(channel, "malformed", why);
-                   return;
-                 }
-                 if (!AcceptHeader(channel, msg.header, data, size, heard.get())) return;
-                 if (const char* why = Validate(msg)) {
-                   ++counters_.invalid;
-                   LogDrop(channel, "invalid", why);
-                   return;
-                 }
-                 try {
-                   handler(msg);
-                   ++counters_.received;
-                 } catch (const std::exception& e) {
-                   ++counters_.invalid;
-                   LogDrop(channel, "invalid", e.what());
-                 }
-               });
+  SubscribeRaw(
+      channel, port, Msg::getHash(),
+      [decoded](const uint8_t* data, size_t size) { return Decode(data, size, decoded.get()); },
+      [this, channel, handler = std::move(handler), decoded] {
+        const Msg& msg = *decoded;
+        if (const char* why = Validate(msg)) {
+          Drop(channel, &counters_.invalid, "invalid", why);
+          return;
+        }
+        try {
+          handler(msg);
+          ++counters_.received;
+        } catch (const std::exception& e) {
+          Drop(channel, &counters_.invalid, "invalid", e.what());
+        }
+      });
 }
 
 }  // namespace rl

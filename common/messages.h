@@ -57,7 +57,7 @@ const char* Decode(const uint8_t* data, size_t size, Msg* msg) {
 template <class Stats>
 int64_t Dropped(const Stats& s) {
   return s.dropped_malformed + s.dropped_foreign + s.dropped_invalid + s.dropped_unauthenticated +
-         s.dropped_replayed;
+         s.dropped_stale + s.dropped_replayed;
 }
 
 const char* Validate(const rlmsg::transition_batch_t& m);

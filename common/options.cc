@@ -6,8 +6,19 @@
 #include <iostream>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 namespace rl {
+namespace {
+
+bool IsConfigSection(const std::string& name) {
+  for (const char* section : kConfigSections) {
+    if (name == section) return true;
+  }
+  return false;
+}
+
+}  // namespace
 
 BusConfig CommonOptions::MakeBusConfig(const std::string& sender) const {
   BusConfig c;
@@ -15,6 +26,15 @@ BusConfig CommonOptions::MakeBusConfig(const std::string& sender) const {
   c.bulk_url = lcm_bulk_url;
   c.run_id = run_id;
   c.sender = sender;
+  // A day bounds the window far above any use and keeps the microseconds far from overflow.
+  for (const auto& [name, seconds] : {std::pair{"max-message-age", max_message_age},
+                                      std::pair{"max-clock-skew", max_clock_skew}}) {
+    if (!(seconds > 0 && seconds <= 86400)) {
+      throw std::invalid_argument(std::string("--") + name + " must be in (0, 86400] seconds");
+    }
+  }
+  c.max_message_age = static_cast<int64_t>(max_message_age * 1e6);
+  c.max_clock_skew = static_cast<int64_t>(max_clock_skew * 1e6);
   if (!key_file.empty()) c.key = ReadKeyFile(key_file);
   return c;
 }
@@ -22,6 +42,9 @@ BusConfig CommonOptions::MakeBusConfig(const std::string& sender) const {
 void AddCommonOptions(po::options_description* desc, CommonOptions* common) {
   desc->add_options()                         //
       ("help,h", "print this help and exit")  //
+      ("list-options",
+       "print the names of the options a preset may set for this process, one a line, and "
+       "exit")  //
       ("config", po::value(&common->config_file),
        "INI preset (top-level keys and the keys of this process's section)")  //
       ("run-id", po::value(&common->run_id)->default_value(common->run_id),
@@ -32,7 +55,14 @@ void AddCommonOptions(po::options_description* desc, CommonOptions* common) {
       ("lcm-url", po::value(&common->lcm_url)->default_value(common->lcm_url),
        "LCM URL of the main port (small, high-rate messages)")  //
       ("lcm-bulk-url", po::value(&common->lcm_bulk_url)->default_value(common->lcm_bulk_url),
-       "LCM URL of the bulk port (weights, sample replies)");
+       "LCM URL of the bulk port (weights, sample replies)")  //
+      ("max-message-age",
+       po::value(&common->max_message_age)->default_value(common->max_message_age),
+       "seconds a message may be old (its header time against its arrival here) before it is "
+       "dropped as stale; covers network delay and clock differences between hosts")  //
+      ("max-clock-skew", po::value(&common->max_clock_skew)->default_value(common->max_clock_skew),
+       "seconds a message's header time may be ahead of this host's clock before it is dropped as "
+       "stale");
 }
 
 bool ParseOptions(int argc, char** argv, const std::string& role, const std::string& usage,
@@ -40,6 +70,13 @@ bool ParseOptions(int argc, char** argv, const std::string& role, const std::str
   po::store(po::parse_command_line(argc, argv, desc), *vm);
   if (vm->count("help")) {
     std::cout << usage << "\n\n" << desc << "\n";
+    return false;
+  }
+  if (vm->count("list-options")) {
+    for (const auto& option : desc.options()) {
+      const std::string& name = option->long_name();
+      if (name != "help" && name != "config" && name != "list-options") std::cout << name << "\n";
+    }
     return false;
   }
   if (vm->count("config")) {
@@ -55,6 +92,15 @@ bool ParseOptions(int argc, char** argv, const std::string& role, const std::str
     std::set<std::string> in_section;
     for (po::option& opt : parsed.options) {
       const std::string& key = opt.string_key;
+      if (const size_t dot = key.find('.'); dot != std::string::npos) {
+        const std::string section = key.substr(0, dot);
+        if (section != role && !IsConfigSection(section)) {
+          throw std::runtime_error("config file '" + path + "': unknown section [" + section +
+                                   "] (key '" + key.substr(dot + 1) +
+                                   "'); the sections are [actor], [replay], [learner] and "
+                                   "[evaluator]");
+        }
+      }
       if (key.rfind(prefix, 0) != 0) continue;
       opt.string_key = key.substr(prefix.size());
       if (desc.find_nothrow(opt.string_key, false) == nullptr) {

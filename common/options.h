@@ -2,8 +2,10 @@
 //
 // Every process reads the same preset file (--config configs/cartpole.ini). Keys at the top of
 // the file apply to every process that knows them; keys in a section [actor], [replay],
-// [learner] or [evaluator] apply to that process only, and an unknown key in a process's own
-// section is an error (a typo must not pass silently). The command line wins over the file.
+// [learner] or [evaluator] apply to that process only; an unknown key in a process's own section
+// and a section of no process (a misspelled [lerner]) are errors (a typo must not pass silently).
+// The command line wins over the file. `PROCESS --list-options` prints the names a preset may
+// set for the process, which the launcher checks whole presets against (launch/preset.h).
 #pragma once
 
 #include <boost/program_options.hpp>
@@ -18,15 +20,23 @@ namespace rl {
 
 namespace po = boost::program_options;
 
-// Options every process has: --config, --run-id, --key-file, --lcm-url, --lcm-bulk-url.
+// The sections a preset may have: one per process that reads presets.
+inline constexpr const char* kConfigSections[] = {"actor", "replay", "learner", "evaluator"};
+
+// Options every process has: --config, --run-id, --key-file, --lcm-url, --lcm-bulk-url,
+// --max-message-age, --max-clock-skew, and --help and --list-options.
 struct CommonOptions {
   std::string config_file;
   int64_t run_id = 0;
   std::string key_file;  // the run's secret key (common/message_auth.h); empty: no MACs
   std::string lcm_url = kDefaultLcmUrl;
   std::string lcm_bulk_url = kDefaultLcmBulkUrl;
+  // The freshness window, seconds (common/lcm_bus.h: why these defaults).
+  double max_message_age = kDefaultMaxMessageAgeMicros * 1e-6;
+  double max_clock_skew = kDefaultMaxClockSkewMicros * 1e-6;
 
-  // Reads the key file, if any (throws std::runtime_error when it is unfit).
+  // Reads the key file, if any (throws std::runtime_error when it is unfit), and checks the
+  // window (std::invalid_argument naming the option when it is not in (0, 1 day]).
   BusConfig MakeBusConfig(const std::string& sender) const;
 };
 
@@ -34,8 +44,10 @@ void AddCommonOptions(po::options_description* desc, CommonOptions* common);
 
 // Parses argv and the --config file into *vm and notifies the bound variables. The command line
 // wins over the file, and in the file a key of `role`'s section wins over the same top-level
-// key. Returns false when --help was asked for (the help text has been printed). Throws on bad
-// options, with a message that names the option.
+// key; a section that is neither `role` nor one of kConfigSections is refused. Returns false when
+// --help or --list-options was asked for (the help text, or the names of the options a preset may
+// set, one a line: every option of `desc` but help, config and list-options, has been printed).
+// Throws on bad options, with a message that names the option.
 bool ParseOptions(int argc, char** argv, const std::string& role, const std::string& usage,
                   const po::options_description& desc, po::variables_map* vm);
 

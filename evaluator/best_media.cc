@@ -18,12 +18,13 @@ BestMedia::BestMedia(BestMediaConfig config) : config_(std::move(config)) {
   has_frames_ = envs::LookupSpec(config_.env_id).frame_height > 0;
 }
 
-void BestMedia::RecordIfBest(const std::string& path, const EvalRecord& record) {
+void BestMedia::RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path,
+                             const EvalRecord& record) {
   if (!(record.mean > best_mean_)) return;
-  // One load serves the video and the frame grid.
+  // One network serves the video and the frame grid.
   nn::Sequential net;
   try {
-    net = LoadPolicyNetwork(path, config_.env_id);
+    net = PolicyNetwork(ckpt, path, config_.env_id);
   } catch (const std::exception& e) {
     LogError(std::string("no video: ") + e.what());
     return;

@@ -9,6 +9,7 @@
 
 #include "evaluator/eval_history.h"
 #include "evaluator/report.h"
+#include "nn/checkpoint.h"
 
 namespace rl::evaluator {
 
@@ -28,9 +29,9 @@ class BestMedia {
   explicit BestMedia(BestMediaConfig config);
 
   /// When `record` is better than the best recorded so far, records the video of the checkpoint
-  /// at `path` and, for a pixel env, its frame grid. Failures are logged (stderr); a checkpoint
-  /// whose video failed stays a candidate for the next one.
-  void RecordIfBest(const std::string& path, const EvalRecord& record);
+  /// `ckpt` (read from `path`) and, for a pixel env, its frame grid. Failures are logged (stderr);
+  /// a checkpoint whose video failed stays a candidate for the next one.
+  void RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path, const EvalRecord& record);
 
   /// Names the written files and their captions in `info`.
   void AddTo(ReportInfo* info) const;

@@ -10,10 +10,9 @@
 
 namespace rl::evaluator {
 
-nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env_id,
-                                 nn::CheckpointMeta* meta) {
-  // Load and build; every failure is a refusal with a reason.
-  nn::Checkpoint ckpt = nn::LoadCheckpoint(path);
+nn::Sequential PolicyNetwork(const nn::Checkpoint& ckpt, const std::string& path,
+                             const std::string& env_id) {
+  // Build; every failure is a refusal with a reason.
   std::mt19937 init_rng(0);  // the initial weights are overwritten by the checkpoint's
   nn::Sequential net;
   try {
@@ -30,15 +29,28 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
   net.SetFlat(ckpt.params.data(), ckpt.params.size());
   const std::string misfit = CheckNetworkFitsEnv(net, envs::LookupSpec(env_id));
   if (!misfit.empty()) throw std::runtime_error("checkpoint " + path + ": " + misfit);
-  if (meta != nullptr) *meta = ckpt.meta;
   return net;
+}
+
+nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env_id,
+                                 nn::CheckpointMeta* meta) {
+  const nn::Checkpoint ckpt = nn::LoadCheckpoint(path);
+  if (meta != nullptr) *meta = ckpt.meta;
+  return PolicyNetwork(ckpt, path, env_id);
 }
 
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
                                double epsilon, uint64_t first_seed, double gamma,
                                const Tick& after_episode) {
-  nn::CheckpointMeta meta;
-  nn::Sequential net = LoadPolicyNetwork(path, env_id, &meta);
+  return ScoreCheckpoint(nn::LoadCheckpoint(path), path, env_id, episodes, epsilon, first_seed,
+                         gamma, after_episode);
+}
+
+EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
+                           const std::string& env_id, int episodes, double epsilon,
+                           uint64_t first_seed, double gamma, const Tick& after_episode) {
+  const nn::CheckpointMeta& meta = ckpt.meta;
+  nn::Sequential net = PolicyNetwork(ckpt, path, env_id);
 
   // Score.
   const double start = MonoSeconds();

@@ -12,6 +12,7 @@
 #include "common/shutdown.h"
 #include "common/text_format.h"
 #include "envs/specs.h"
+#include "evaluator/announced_checkpoint.h"
 #include "evaluator/tsne_map.h"
 #include "rlmsg/eval_result_t.hpp"
 #include "rlmsg/stats_evaluator_t.hpp"
@@ -152,6 +153,11 @@ bool EvaluatorService::goal_reached() const {
   return b != nullptr && b->mean >= report_.goal;
 }
 
+std::string EvaluatorService::CheckpointFolder() const {
+  if (config_.out_dir.empty()) return {};
+  return (fs::path(config_.out_dir) / "checkpoints").string();
+}
+
 bool EvaluatorService::Poll(int timeout_ms) {
   // Wait no longer than until the next stats message.
   const double until_stats = next_stats_time_ - MonoSeconds();
@@ -177,16 +183,20 @@ void EvaluatorService::Tick() {
   if (MonoSeconds() >= next_stats_time_) PublishStats();
 }
 
-std::optional<EvalRecord> EvaluatorService::Score(const rlmsg::checkpoint_t& announced) {
+std::optional<EvalRecord> EvaluatorService::Score(const rlmsg::checkpoint_t& announced,
+                                                  nn::Checkpoint* ckpt) {
   busy_ = true;
   PublishStats();
+  // A refused path or file is logged and counted. The file is read once, from the run's
+  // checkpoint folder only (announced_checkpoint.h), and serves every use of the checkpoint.
   EvalRecord record;
   try {
+    *ckpt = ReadAnnouncedCheckpoint(announced.path, CheckpointFolder());
     // Stats keep flowing during a long evaluation (KUKA: about a second per episode), so the
     // monitor never mistakes a busy evaluator for a dead one, and a stop request is honoured
     // after the current episode.
-    record = ScoreCheckpointFile(announced.path, config_.env_id, config_.episodes, config_.epsilon,
-                                 config_.seed_base, config_.gamma, [this] { Tick(); });
+    record = ScoreCheckpoint(*ckpt, announced.path, config_.env_id, config_.episodes,
+                             config_.epsilon, config_.seed_base, config_.gamma, [this] { Tick(); });
   } catch (const Interrupted&) {
     busy_ = false;
     std::printf("evaluator: stopped during an evaluation; %s is left unscored\n",
@@ -203,7 +213,7 @@ std::optional<EvalRecord> EvaluatorService::Score(const rlmsg::checkpoint_t& ann
   record.update = announced.update;
   record.env_steps = announced.env_steps;
   record.wall_seconds = announced.wall_seconds;
-  second_.ScoreIfBest(announced.path, &record, [this] { Tick(); });
+  second_.ScoreIfBest(*ckpt, announced.path, &record, [this] { Tick(); });
   busy_ = false;
   return record;
 }
@@ -211,7 +221,8 @@ std::optional<EvalRecord> EvaluatorService::Score(const rlmsg::checkpoint_t& ann
 bool EvaluatorService::ScorePending() {
   const std::optional<rlmsg::checkpoint_t> announced = queue_.Take();
   if (!announced) return false;
-  const std::optional<EvalRecord> record = Score(*announced);
+  nn::Checkpoint ckpt;
+  const std::optional<EvalRecord> record = Score(*announced, &ckpt);
   if (!record) return false;
   const bool reached = record->mean >= report_.goal;
   ++scored_;
@@ -221,8 +232,8 @@ bool EvaluatorService::ScorePending() {
   } catch (const std::exception& e) {
     LogError(e.what());
   }
-  if (config_.videos && !report_dir_.empty()) media_.RecordIfBest(announced->path, *record);
-  tsne_.OfferBest(announced->path, *record);
+  if (config_.videos && !report_dir_.empty()) media_.RecordIfBest(ckpt, announced->path, *record);
+  tsne_.OfferBest(ckpt, announced->path, *record);
   // At the goal the run may end as soon as the result is out: a quick map goes first.
   if (reached && tsne_.due() && tsne_.quick()) MakeTsneMap();
   WriteReportNow();

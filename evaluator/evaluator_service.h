@@ -6,6 +6,11 @@
 //   out: RL_EVAL (eval_result_t)            one per scored checkpoint
 //        RL_STATS_EVALUATOR (stats_evaluator_t), a few times per second
 //
+// An announced checkpoint is read only when it is a regular file of a bounded size directly in
+// the run's checkpoint folder, <out_dir>/checkpoints (announced_checkpoint.h); any other path
+// (a device, a FIFO, a symbolic link, a file elsewhere) is refused and counted, like a file that
+// does not load. Without an out_dir every announcement is refused.
+//
 // Only the newest announced checkpoint that is not scored yet is kept: when the learner writes
 // checkpoints faster than they are scored, the older unscored ones are skipped (and counted).
 // Scoring runs in the thread that calls Poll(), between Bus::Handle() calls.
@@ -68,10 +73,10 @@ struct EvaluatorConfig {
 
 /// The service. Not thread-safe: construct it, call Poll() or Run() and read it from one thread,
 /// the thread that uses `bus`. It is made of small pieces: the announcements wait in a
-/// CheckpointQueue, checkpoint files are loaded and scored by ScoreCheckpointFile
-/// (checkpoint_file.h), new best checkpoints get their SecondMetric, BestMedia (video and frame
-/// grid) and t-SNE map (TsneScheduler), and the history and report are the report library's
-/// (EvalHistory, WriteReport).
+/// CheckpointQueue, an announced file is read once (ReadAnnouncedCheckpoint) and scored by
+/// ScoreCheckpoint (checkpoint_file.h), new best checkpoints get their SecondMetric, BestMedia
+/// (video and frame grid) and t-SNE map (TsneScheduler) from the same read, and the history and
+/// report are the report library's (EvalHistory, WriteReport).
 class EvaluatorService {
  public:
   /// Subscribes to RL_CHECKPOINT on `bus` (not owned; must outlive the service). With an
@@ -127,11 +132,15 @@ class EvaluatorService {
   const std::string& report_dir() const { return report_dir_; }
 
  private:
-  // Loads and scores the announced checkpoint (with its second metric when a new best); nullopt
-  // when it was refused or a stop was requested.
-  std::optional<EvalRecord> Score(const rlmsg::checkpoint_t& announced);
+  // Reads the announced checkpoint (from the run's checkpoint folder only) into *ckpt and scores
+  // it (with its second metric when a new best); nullopt when it was refused or a stop was
+  // requested.
+  std::optional<EvalRecord> Score(const rlmsg::checkpoint_t& announced, nn::Checkpoint* ckpt);
   // Publishes the result of `record` on RL_EVAL and prints its progress line.
   void Announce(const rlmsg::checkpoint_t& announced, const EvalRecord& record, bool reached);
+  // <out_dir>/checkpoints, the only folder announced checkpoints are read from (empty without
+  // an out_dir: every announcement is refused).
+  std::string CheckpointFolder() const;
   // Makes the due t-SNE map now (busy, with stats). Returns true when it was written.
   bool MakeTsneMap();
   // MakeTsneMap() when a map is due and the time share allows it; rewrites the report after it.

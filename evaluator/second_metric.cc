@@ -6,13 +6,14 @@
 
 namespace rl::evaluator {
 
-void SecondMetric::ScoreIfBest(const std::string& path, EvalRecord* record, const Tick& tick) {
+void SecondMetric::ScoreIfBest(const nn::Checkpoint& ckpt, const std::string& path,
+                               EvalRecord* record, const Tick& tick) {
   if (!enabled() || !(record->mean > best_mean_)) return;
   best_mean_ = record->mean;
   EvalRecord second;
   try {
-    second = ScoreCheckpointFile(path, config_.env_id, config_.episodes, config_.epsilon,
-                                 config_.seed_base, config_.gamma, tick);
+    second = ScoreCheckpoint(ckpt, path, config_.env_id, config_.episodes, config_.epsilon,
+                             config_.seed_base, config_.gamma, tick);
   } catch (const Interrupted&) {
     return;
   } catch (const std::exception& e) {

@@ -10,6 +10,7 @@
 
 #include "evaluator/eval_history.h"
 #include "evaluator/progress.h"
+#include "nn/checkpoint.h"
 
 namespace rl::evaluator {
 
@@ -27,11 +28,13 @@ class SecondMetric {
   SecondMetric(SecondMetricConfig config, ProgressLog log)
       : config_(std::move(config)), log_(log) {}
 
-  /// When `record` (scored on the standard metric) is a new best, scores the checkpoint at
-  /// `path` on the second env into record's second_* fields and prints a progress line; nothing
-  /// otherwise or without a second env. A file that fails to score is logged, and a stop request
-  /// (Interrupted from `tick`, between episodes) ends the scoring: both leave the record as it is.
-  void ScoreIfBest(const std::string& path, EvalRecord* record, const Tick& tick);
+  /// When `record` (scored on the standard metric) is a new best, scores the checkpoint `ckpt`
+  /// (read from `path`) on the second env into record's second_* fields and prints a progress line;
+  /// nothing otherwise or without a second env. A file that fails to score is logged, and a stop
+  /// request (Interrupted from `tick`, between episodes) ends the scoring: both leave the record as
+  /// it is.
+  void ScoreIfBest(const nn::Checkpoint& ckpt, const std::string& path, EvalRecord* record,
+                   const Tick& tick);
 
   bool enabled() const { return !config_.env_id.empty(); }
 

@@ -52,10 +52,11 @@ std::string Caption(const EvalRecord& record, const StateSamples& samples, const
 TsneScheduler::TsneScheduler(TsneScheduleConfig config, ProgressLog log)
     : config_(std::move(config)), log_(log), start_time_(MonoSeconds()) {}
 
-void TsneScheduler::OfferBest(const std::string& path, const EvalRecord& record) {
+void TsneScheduler::OfferBest(const nn::Checkpoint& ckpt, const std::string& path,
+                              const EvalRecord& record) {
   if (config_.states <= 0 || config_.report_dir.empty() || !(record.mean > best_mean_)) return;
   try {
-    net_ = LoadPolicyNetwork(path, config_.env_id);
+    net_ = PolicyNetwork(ckpt, path, config_.env_id);
     record_ = record;
     best_mean_ = record.mean;
   } catch (const std::exception& e) {

@@ -10,6 +10,7 @@
 #include "evaluator/eval_history.h"
 #include "evaluator/progress.h"
 #include "evaluator/report.h"
+#include "nn/checkpoint.h"
 #include "nn/sequential.h"
 
 namespace rl::evaluator {
@@ -39,9 +40,10 @@ class TsneScheduler {
  public:
   TsneScheduler(TsneScheduleConfig config, ProgressLog log);
 
-  /// Makes the map of the checkpoint at `path` due when `record` is better than the last best
-  /// offered (replacing a due map not made yet). A file that does not load is logged.
-  void OfferBest(const std::string& path, const EvalRecord& record);
+  /// Makes the map of the checkpoint `ckpt` (read from `path`) due when `record` is better than
+  /// the last best offered (replacing a due map not made yet). A network that does not build is
+  /// logged.
+  void OfferBest(const nn::Checkpoint& ckpt, const std::string& path, const EvalRecord& record);
 
   /// Whether a map is due.
   bool due() const { return net_.has_value(); }

@@ -1,14 +1,18 @@
 // Fuzz target: the bus's whole receive path, as a daemon runs it on every packet of its port:
-// decode (rl::Decode), run id, MAC (common/message_auth.h), sender incarnation and sequence
-// freshness, Validate(), handler. Input: as fuzz_messages's (one byte selecting the type, then an
-// encoded message), published on that type's channel to a bus with a key and subscribed to every
-// type.
+// the header read from the raw bytes (ReadWireHeader), type, run id, MAC (common/message_auth.h),
+// freshness (the time window, the sender incarnation and sequence), then decode (rl::Decode),
+// Validate(), handler. Input: as fuzz_messages's (one byte selecting the type, then an encoded
+// message), delivered on that type's channel to a bus with a key and subscribed to every type.
 //
-// Each input goes in three times: as it is (its MAC, if any, is almost surely wrong: dropped as
-// unauthenticated or earlier), then signed with the bus's key when its header can be found, twice
-// (the first copy passes the MAC and reaches the freshness checks, Validate() and the handler; the
-// second is the same message again and must never reach the handler: replayed). A handler call
-// for the second copy, or counters that do not add up, abort.
+// Each input goes in three times, at a receive time of its own (a window later than the previous
+// input's, so that no position of an earlier input guards against this one): as it is (its MAC,
+// if any, is almost surely wrong: dropped as unauthenticated or earlier), then, when its header
+// can be read, with its time and incarnation moved near the receive time (the input's values
+// choose where: inside the window or out of it, an incarnation before its time or after) and
+// signed with the bus's key, twice (the first copy passes the MAC and reaches the freshness
+// checks, decoding, Validate() and the handler; the second is the same message again and must
+// never reach the handler: replayed). A handler call for the second copy, or counters that do
+// not add up, abort.
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -24,6 +28,12 @@
 namespace {
 
 constexpr int64_t kRunId = 42;
+constexpr int64_t kSecond = 1'000'000;
+constexpr int64_t kMaxAge = 60 * kSecond;
+constexpr int64_t kSkew = 10 * kSecond;
+// The first input's receive time (2025), and the step between two inputs' (past the window).
+constexpr int64_t kFirstReceive = 1'750'000'000'000'000;
+constexpr int64_t kStep = kMaxAge + kSkew + kSecond;
 
 [[noreturn]] void Fail(const char* what) {
   std::fprintf(stderr, "fuzz_bus: %s\n", what);
@@ -42,6 +52,8 @@ struct Harness {
   static rl::BusConfig Config() {
     rl::BusConfig c = rl::InProcessBusConfig(kRunId, "fuzz");
     c.key = Key();
+    c.max_message_age = kMaxAge;
+    c.max_clock_skew = kSkew;
     return c;
   }
 
@@ -49,14 +61,26 @@ struct Harness {
   rl::MessageAuthenticator auth;
   std::vector<std::string> channels;
   int64_t handled = 0;
+  int64_t inputs = 0;
 };
 
-// The header's sender length (after the 8-byte fingerprint and the 8-byte run id), or -1.
-int64_t SenderLength(const std::vector<uint8_t>& m) {
-  if (m.size() < 20) return -1;
-  const int64_t len =
-      (int64_t{m[16]} << 24) | (int64_t{m[17]} << 16) | (int64_t{m[18]} << 8) | int64_t{m[19]};
-  return len >= 1 ? len - 1 : -1;  // lcm strings count their NUL
+void WriteBigEndian(uint8_t* p, int64_t v) {
+  for (int i = 0; i < 8; ++i) p[i] = static_cast<uint8_t>(static_cast<uint64_t>(v) >> (56 - 8 * i));
+}
+
+// The input's time and incarnation, moved near `receive`: the time anywhere from 2 s before the
+// window to 2 s after it, the incarnation from 2 s before the time to 2 s past the time plus the
+// skew (a negative one stays as it is).
+void MoveNear(int64_t receive, const rl::WireHeader& h, uint8_t* data) {
+  const auto pick = [](int64_t v, int64_t span) {
+    return static_cast<int64_t>(static_cast<uint64_t>(v) % static_cast<uint64_t>(span));
+  };
+  const int64_t utime =
+      receive - kMaxAge - 2 * kSecond + pick(h.utime, kMaxAge + kSkew + 4 * kSecond);
+  const int64_t incarnation =
+      utime + kSkew + 2 * kSecond - pick(h.incarnation, kSkew + 4 * kSecond);
+  WriteBigEndian(data + h.mac_offset - 16, utime);
+  WriteBigEndian(data + h.mac_offset - 8, h.incarnation < 0 ? h.incarnation : incarnation);
 }
 
 }  // namespace
@@ -68,24 +92,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<uint8_t> msg(data + 1, data + size);
   const rl::BusCounters before = h->bus.counters();
   const int64_t handled_before = h->handled;
+  const int64_t receive = kFirstReceive + kStep * h->inputs++;
 
-  h->bus.PublishRaw(channel, msg.data(), msg.size());
-  h->bus.Handle(0);
-  const int64_t sender = SenderLength(msg);
+  h->bus.Deliver(channel, msg.data(), msg.size(), receive);
+  rl::WireHeader header;
   bool signed_twice = false;
-  if (sender >= 0) {
-    const size_t at = rl::MacOffset(static_cast<size_t>(sender));
-    if (at + rl::kMacBytes <= msg.size()) {
-      std::memset(msg.data() + at, 0, rl::kMacBytes);
-      if (!h->auth.Sign(channel, msg.data(), msg.size(), at)) Fail("cannot sign");
-      h->bus.PublishRaw(channel, msg.data(), msg.size());
-      h->bus.Handle(0);
-      const int64_t after_first = h->handled;
-      h->bus.PublishRaw(channel, msg.data(), msg.size());
-      h->bus.Handle(0);
-      if (h->handled != after_first) Fail("a message reached its handler twice");
-      signed_twice = true;
-    }
+  if (rl::ReadWireHeader(msg.data(), msg.size(), &header) == nullptr) {
+    MoveNear(receive, header, msg.data());
+    std::memset(msg.data() + header.mac_offset, 0, rl::kMacBytes);
+    if (!h->auth.Sign(channel, msg.data(), msg.size(), header.mac_offset)) Fail("cannot sign");
+    h->bus.Deliver(channel, msg.data(), msg.size(), receive);
+    const int64_t after_first = h->handled;
+    h->bus.Deliver(channel, msg.data(), msg.size(), receive);
+    if (h->handled != after_first) Fail("a message reached its handler twice");
+    signed_twice = true;
   }
   // Every packet is handled once or dropped once, by one reason.
   const rl::BusCounters& after = h->bus.counters();

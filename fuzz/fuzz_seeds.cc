@@ -1,24 +1,33 @@
 // Writes the generated seed corpora of the fuzz targets: valid messages of every type
 // (fuzz_messages), learner state files (fuzz_state_file) and policy checkpoints
-// (fuzz_checkpoint), made with the project's own encoders and writers, so that they follow the
-// current formats. Run by `scripts/fuzz.sh --seeds` after a change to lcmtypes/ or to a file
-// format. Every message written is checked to decode and validate.
+// (fuzz_checkpoint), inputs of the handler targets (weights chunks, sample replies, transition
+// batches, checkpoint announcements), made with the project's own encoders and writers, so that
+// they follow the current formats. Run by `scripts/fuzz.sh --seeds` after a change to lcmtypes/ or
+// to a file format. Every message written is checked to decode and validate.
 //
-// Usage: fuzz_seeds CORPUS_DIR   (rewrites CORPUS_DIR/{messages,state_file,checkpoint,snapshot}/,
-// keeping the reproducers of fixed bugs, named "repro-*")
+// Usage: fuzz_seeds CORPUS_DIR   (rewrites CORPUS_DIR/{messages,state_file,checkpoint,snapshot,
+// weights,batch_decoder,replay_insert,announced_checkpoint}/, keeping the reproducers of fixed
+// bugs, named "repro-*")
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "common/messages.h"
+#include "envs/specs.h"
+#include "fuzz/fuzz_support.h"
+#include "fuzz/handler_setup.h"
 #include "fuzz/learner_state.h"
 #include "fuzz/message_types.h"
+#include "learner/td3.h"
+#include "learner/weights_publisher.h"
 #include "nn/checkpoint.h"
 #include "nn/sequential.h"
 #ifdef RL_FUZZ_SNAPSHOT
@@ -336,9 +345,154 @@ void WriteCheckpoints(const fs::path& dir) {
   }
 }
 
+// ---- Handler targets: a selector byte, then records of encoded messages ----
+
+template <class Msg>
+std::string Encoded(const Msg& msg) {
+  std::string bytes(static_cast<size_t>(msg.getEncodedSize()), '\0');
+  if (msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())) !=
+      static_cast<int>(bytes.size())) {
+    std::fprintf(stderr, "fuzz_seeds: %s does not encode\n", Msg::getTypeName());
+    std::exit(1);
+  }
+  return bytes;
+}
+
+// Every chunk of `versions` versions of a network of `arch` (a new version each 1000 updates, the
+// parameters scaled a little), in chunks of `chunk_floats`.
+std::string WeightsInput(uint8_t selector, const std::string& arch, int versions,
+                         int chunk_floats) {
+  std::mt19937 rng(7);
+  const rl::nn::Sequential net = rl::nn::BuildFromArchitecture(arch, &rng);
+  std::vector<float> params;
+  net.GetFlat(&params);
+  std::string input(1, static_cast<char>(selector));
+  int64_t seq = 0;
+  for (int v = 1; v <= versions; ++v) {
+    for (float& p : params) p *= 0.9f;
+    for (rlmsg::weights_chunk_t& c :
+         rl::learner::MakeWeightChunks(1000 * v, arch, params, chunk_floats)) {
+      c.header = Header("learner", seq++);
+      rl::fuzz::AppendRecord(&input, Encoded(c));
+    }
+  }
+  return input;
+}
+
+void WriteWeights(const fs::path& dir) {
+  const std::string q_net = "linear(4,16),relu,linear(16,16),relu,linear(16,2)";
+  WriteFile(dir / "cartpole-one-chunk", WeightsInput(0, q_net, 1, 12000));
+  WriteFile(dir / "cartpole-chunks", WeightsInput(0, q_net, 2, 100));
+  rl::learner::Td3Config td3;
+  td3.hidden = {16, 16};
+  const std::string actor =
+      rl::learner::Td3ActorArchitecture(td3, rl::envs::LookupSpec("Pendulum-v1"));
+  WriteFile(dir / "pendulum-chunks", WeightsInput(1, actor, 2, 150));
+}
+
+// A reply of `count` transitions of `setup`'s env (its observation size or frames, its actions).
+rlmsg::sample_batch_t SampleReply(const rl::fuzz::DecoderSetup& setup, int count, int64_t id) {
+  const rl::envs::EnvSpec spec = rl::envs::LookupSpec(setup.env);
+  rlmsg::sample_batch_t m{};
+  m.header = Header("replay", id);
+  m.requester = "learner";
+  m.request_id = id;
+  m.count = count;
+  if (spec.frame_stack > 0) {
+    m.height = spec.frame_height;
+    m.width = spec.frame_width;
+    m.stack = spec.frame_stack;
+    m.num_bytes = count * m.stack * m.height * m.width;
+    for (int i = 0; i < m.num_bytes; ++i) {
+      m.obs_pixels.push_back(static_cast<uint8_t>(i * 7));
+      m.next_obs_pixels.push_back(static_cast<uint8_t>(i * 11));
+    }
+  } else {
+    m.obs_size = spec.observation_size;
+    m.num_values = count * m.obs_size;
+    for (int i = 0; i < m.num_values; ++i) {
+      m.obs.push_back(0.1f * static_cast<float>(i % 9) - 0.4f);
+      m.next_obs.push_back(0.1f * static_cast<float>(i % 7) - 0.3f);
+    }
+  }
+  m.action_width = spec.action_width();
+  m.num_action_values = count * m.action_width;
+  for (int i = 0; i < m.num_action_values; ++i) {
+    m.action.push_back(spec.continuous() ? 0.5f * static_cast<float>(i % 5 - 2)
+                                         : static_cast<float>(i % spec.num_actions));
+  }
+  for (int i = 0; i < count; ++i) {
+    m.reward.push_back(static_cast<float>(i % 3) - 1.0f);
+    m.discount.push_back(i % 4 == 3 ? 0.0f : 0.99f);
+    m.index.push_back(100 + i);
+    m.weight.push_back(1.0f - 0.1f * static_cast<float>(i % 3));
+  }
+  m.replay_size = 500;
+  m.total_inserts = 800;
+  return m;
+}
+
+void WriteBatchReplies(const fs::path& dir) {
+  const char* names[] = {"cartpole", "pendulum", "catch-pixels"};
+  for (size_t k = 0; k < std::size(rl::fuzz::kDecoderSetups); ++k) {
+    std::string input(1, static_cast<char>(k));
+    rl::fuzz::AppendRecord(&input, Encoded(SampleReply(rl::fuzz::kDecoderSetups[k], 4, 1)));
+    rl::fuzz::AppendRecord(&input, Encoded(SampleReply(rl::fuzz::kDecoderSetups[k], 7, 2)));
+    WriteFile(dir / names[k], input);
+  }
+}
+
+// An announcement of `path` and the file's bytes (fuzz_announced_checkpoint.cc).
+std::string Announcement(const std::string& path, const std::string& file) {
+  return std::string(1, static_cast<char>(path.size())) + path + file;
+}
+
+void WriteAnnouncements(const fs::path& dir) {
+  std::mt19937 rng(7);
+  const rl::nn::Sequential net = rl::nn::MakeMlp(4, {8}, 2, &rng);
+  rl::nn::Checkpoint ckpt;
+  ckpt.architecture = net.Architecture();
+  net.GetFlat(&ckpt.params);
+  ckpt.meta.update = 500;
+  ckpt.meta.note = "CartPole-v1";
+  const fs::path tmp = dir / ".checkpoint.tmp";
+  rl::nn::SaveCheckpoint(tmp.string(), ckpt);
+  std::ifstream in(tmp, std::ios::binary);
+  const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  fs::remove(tmp);
+  const std::pair<const char*, const char*> paths[] = {
+      {"good", "checkpoints/ckpt.bin"},
+      {"through-parent", "checkpoints/../checkpoints/ckpt.bin"},
+      {"through-link", "checkpoints/up/checkpoints/ckpt.bin"},
+      {"fifo", "checkpoints/fifo.bin"},
+      {"link-to-zero", "checkpoints/zero.bin"},
+      {"link-outside", "checkpoints/outside.bin"},
+      {"outside", "outside.bin"},
+      {"device", "/dev/zero"},
+  };
+  for (const auto& [name, path] : paths) WriteFile(dir / name, Announcement(path, file));
+}
+
 // ---- Replay snapshots ----
 
 #ifdef RL_FUZZ_SNAPSHOT
+// Batches of each replay configuration: the first of actors 0 and 2, a later one of actor 1
+// (naming frames the set-up batches sent), and one of an id above max_actors.
+void WriteTransitionBatches(const fs::path& dir) {
+  const char* kinds[] = {"flat", "prioritized", "pixels"};
+  for (int config = 0; config < rl::fuzz::kNumReplayConfigs; ++config) {
+    std::string input(1, static_cast<char>(config));
+    int64_t seq = 0;
+    for (const auto& [first, actor] :
+         {std::pair{0, 0}, std::pair{0, 2}, std::pair{6, 1}, std::pair{0, 5000}}) {
+      rlmsg::transition_batch_t m = rl::fuzz::SetupBatch(config, first, 4, actor);
+      m.header = Header("actor-fuzz", seq++);
+      rl::fuzz::AppendRecord(&input, Encoded(m));
+    }
+    WriteFile(dir / kinds[config], input);
+  }
+}
+
 // "<dir>/<kind>-<fill>": the configuration byte (replay_setup.h), then the snapshot file.
 void WriteSnapshots(const fs::path& dir) {
   const char* kinds[] = {"flat", "prioritized", "pixels"};
@@ -365,7 +519,8 @@ int main(int argc, char** argv) {
   }
   const fs::path root = argv[1];
   // Replaces the generated seeds; reproducers of fixed bugs ("repro-*") stay.
-  for (const char* target : {"messages", "state_file", "checkpoint", "snapshot"}) {
+  for (const char* target : {"messages", "state_file", "checkpoint", "snapshot", "weights",
+                             "batch_decoder", "replay_insert", "announced_checkpoint"}) {
     fs::create_directories(root / target);
     for (const fs::directory_entry& e : fs::directory_iterator(root / target)) {
       if (e.path().filename().string().rfind("repro-", 0) != 0) fs::remove(e.path());
@@ -374,8 +529,12 @@ int main(int argc, char** argv) {
   WriteMessages(root / "messages");
   WriteStateFiles(root / "state_file");
   WriteCheckpoints(root / "checkpoint");
+  WriteWeights(root / "weights");
+  WriteBatchReplies(root / "batch_decoder");
+  WriteAnnouncements(root / "announced_checkpoint");
 #ifdef RL_FUZZ_SNAPSHOT
   WriteSnapshots(root / "snapshot");
+  WriteTransitionBatches(root / "replay_insert");
 #endif
   std::printf("fuzz_seeds: wrote the seeds in %s\n", root.c_str());
   return 0;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common/channels.h"
+#include "fuzz/fuzz_support.h"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
@@ -80,6 +81,10 @@ replay::ReplayServiceOptions Options(int config) {
 
 }  // namespace
 
+rlmsg::transition_batch_t SetupBatch(int config, int first, int count, int32_t actor) {
+  return config == 2 ? PixelBatch(first, count, actor) : FlatBatch(first, count, actor);
+}
+
 Replica::Replica(int config) : config_(config), bus_(InProcessBusConfig(kRunId, "replay")) {
   bus_.Subscribe<rlmsg::sample_batch_t>(
       channels::kSamples, [this](const rlmsg::sample_batch_t& m) { replies_.push_back(m); },
@@ -92,19 +97,23 @@ void Replica::Publish(const std::string& channel, Msg m, const std::string& send
   m.header.run_id = kRunId;
   m.header.sender = sender;
   m.header.seq = seq_[sender]++;
-  m.header.utime = 1;
+  m.header.utime = WallMicros();
   std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   bus_.PublishRaw(channel, bytes.data(), bytes.size());
   bus_.Handle(0);
 }
 
+void Replica::DeliverTransitions(std::string_view bytes) {
+  Deliver<rlmsg::transition_batch_t>(&bus_, channels::kTransitions, bytes, "actor-fuzz",
+                                     &fuzz_seq_);
+}
+
 void Replica::Fill(int batches, int samples) {
   int next = 0;
   for (int k = 0; k < batches; ++k) {
     const int actor = k % 3;
-    const rlmsg::transition_batch_t m =
-        config_ == 2 ? PixelBatch(next, 5, actor) : FlatBatch(next, 5, actor);
+    const rlmsg::transition_batch_t m = SetupBatch(config_, next, 5, actor);
     Publish(channels::kTransitions, m, "actor-" + std::to_string(actor));
     next += 6;
   }

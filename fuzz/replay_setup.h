@@ -8,16 +8,23 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "common/lcm_bus.h"
 #include "replay/replay_service.h"
 #include "rlmsg/sample_batch_t.hpp"
+#include "rlmsg/transition_batch_t.hpp"
 
 namespace rl::fuzz {
 
 /// Service configurations; the first byte of a fuzz_snapshot input selects one (modulo).
 inline constexpr int kNumReplayConfigs = 3;
+
+/// The batches Fill() inserts: transitions first .. first + count - 1 of `actor`, of
+/// configuration `config`'s kind (2 x 1 floats and a width-1 action, or 2 x 2 frames in stacks of
+/// two with their new frames).
+rlmsg::transition_batch_t SetupBatch(int config, int first, int count, int32_t actor);
 
 class Replica {
  public:
@@ -31,6 +38,10 @@ class Replica {
   /// sends priorities for them.
   void Fill(int batches, int samples);
 
+  /// Delivers `bytes`, a transition batch's encoding, on RL_TRANSITIONS as fuzz::Deliver does
+  /// (with a valid header from sender "actor-fuzz" when it decodes).
+  void DeliverTransitions(std::string_view bytes);
+
  private:
   template <class Msg>
   void Publish(const std::string& channel, Msg m, const std::string& sender);
@@ -39,6 +50,7 @@ class Replica {
   Bus bus_;
   std::unique_ptr<replay::ReplayService> service_;
   std::map<std::string, int64_t> seq_;
+  int64_t fuzz_seq_ = 0;
   std::vector<rlmsg::sample_batch_t> replies_;
 };
 

@@ -81,6 +81,7 @@ Dqn::Dqn(int obs_size, int num_actions, DqnConfig config)
                                 std::to_string(online_.OutputSize()) + " outputs; the env has " +
                                 std::to_string(obs_size) + " and " + std::to_string(num_actions));
   }
+  online_.set_precision(config_.precision);
   target_ = online_;
   target_.set_training(false);  // the target network uses running statistics (BatchNorm)
   params_ = online_.Params();

@@ -37,6 +37,7 @@ struct DqnConfig {
   float tau = 1.0f;                // weight of the online network in a refresh
   float max_grad_norm = 10.0f;     // global gradient-norm clip (0: none)
   uint64_t seed = 0;               // initialisation seed
+  nn::Precision precision = nn::Precision::kFp32;  // the networks' products (nn/precision.h)
 
   // Throws std::invalid_argument naming the bad field.
   void Validate() const;

@@ -1,8 +1,12 @@
 #include "learner/learner.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include "common/channels.h"
 #include "common/clock.h"
@@ -11,6 +15,7 @@
 #include "learner/algorithm_state.h"
 #include "nn/checkpoint.h"
 #include "nn/parallel.h"
+#include "nn/precision.h"
 #include "rlmsg/checkpoint_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
 #include "rlmsg/stats_learner_t.hpp"
@@ -19,13 +24,46 @@ namespace rl::learner {
 namespace {
 
 std::unique_ptr<Algorithm> MakeAlgorithm(const LearnerConfig& c, const envs::EnvSpec& spec) {
-  if (c.algorithm == "td3") return std::make_unique<Td3>(spec, c.td3);
+  const nn::Precision precision = nn::ParsePrecision(c.precision);
+  if (c.algorithm == "td3") {
+    Td3Config td3 = c.td3;
+    td3.precision = precision;
+    return std::make_unique<Td3>(spec, td3);
+  }
   if (spec.continuous()) {
     throw std::invalid_argument(spec.id +
                                 " has continuous actions; DQN needs discrete ones (use "
                                 "algorithm = td3)");
   }
-  return std::make_unique<Dqn>(spec.observation_size, spec.num_actions, c.dqn);
+  DqnConfig dqn = c.dqn;
+  dqn.precision = precision;
+  return std::make_unique<Dqn>(spec.observation_size, spec.num_actions, dqn);
+}
+
+// The checkpoint files ("ckpt-<update>.bin") in `dir`, by update, oldest first: what earlier
+// lives of the learner (a restart, a resumed run) left there.
+std::deque<std::string> CheckpointFiles(const std::filesystem::path& dir) {
+  std::vector<std::pair<int64_t, std::string>> found;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    constexpr std::string_view kPrefix = "ckpt-", kSuffix = ".bin";
+    if (!name.starts_with(kPrefix) || !name.ends_with(kSuffix)) continue;
+    const std::string digits =
+        name.substr(kPrefix.size(), name.size() - kPrefix.size() - kSuffix.size());
+    // Update counts of at most 18 digits (int64_t).
+    if (digits.empty() || digits.size() > 18 ||
+        digits.find_first_not_of("0123456789") != std::string::npos) {
+      continue;
+    }
+    std::error_code regular;
+    if (!entry.is_regular_file(regular)) continue;
+    found.emplace_back(std::stoll(digits), entry.path().string());
+  }
+  std::sort(found.begin(), found.end());
+  std::deque<std::string> files;
+  for (auto& [update, path] : found) files.push_back(std::move(path));
+  return files;
 }
 
 }  // namespace
@@ -45,6 +83,7 @@ void LearnerConfig::Validate() const {
   if (keep_checkpoints < 0) throw std::invalid_argument("keep-checkpoints must be >= 0");
   if (!(stats_hz > 0)) throw std::invalid_argument("stats-hz must be > 0");
   if (threads < 1 || threads > 64) throw std::invalid_argument("threads must be in [1, 64]");
+  nn::ParsePrecision(precision);
 }
 
 Learner::Learner(LearnerConfig config, Bus* bus)
@@ -57,6 +96,8 @@ Learner::Learner(LearnerConfig config, Bus* bus)
       sender_(bus->config().sender) {
   nn::SetNumThreads(config_.threads);
   std::filesystem::create_directories(std::filesystem::path(config_.out_dir) / "checkpoints");
+  // Earlier lives' checkpoints count towards keep_checkpoints, and go first.
+  written_ = CheckpointFiles(std::filesystem::path(config_.out_dir) / "checkpoints");
   if (config_.resume && std::filesystem::exists(StatePath())) {
     LoadState(StateFile::Load(StatePath(), StateKind()));
     resumed_ = true;
@@ -149,9 +190,13 @@ std::string Learner::StateKind() const { return "learner " + config_.algorithm; 
 StateFile Learner::SaveState() const {
   StateFile state(StateKind());
   state.PutText("learner.env", config_.env_id);
+  state.PutText("learner.precision", config_.precision);
   state.PutInt("learner.env_steps", env_steps_);
   state.PutText("learner.wall_seconds", std::to_string(MonoSeconds() - start_time_));
   PutRng(&state, "learner.shift_rng", decoder_.shift_rng());
+  // The last reply heard from each replay, so that a restarted learner refuses recorded replies
+  // older than this state (common/lcm_bus.h).
+  state.PutText("learner.bus_positions", bus_->SavePositions());
   algorithm_->SaveState(&state);
   return state;
 }
@@ -161,10 +206,20 @@ void Learner::LoadState(const StateFile& state) {
     throw std::runtime_error("the saved learner state is of env " + state.Text("learner.env") +
                              ", this run's is " + config_.env_id);
   }
+  // States written before the option existed were trained in fp32.
+  const std::string precision =
+      state.Has("learner.precision") ? state.Text("learner.precision") : "fp32";
+  if (precision != config_.precision) {
+    throw std::runtime_error("the saved learner state was trained with precision " + precision +
+                             ", this run's is " + config_.precision +
+                             ": resume with the same precision, or start afresh");
+  }
   algorithm_->LoadState(state);
   env_steps_ = state.Int("learner.env_steps");
   resumed_wall_seconds_ = std::stod(state.Text("learner.wall_seconds"));
   GetRng(state, "learner.shift_rng", &decoder_.shift_rng());
+  // States written before the bus kept positions have none.
+  if (state.Has("learner.bus_positions")) bus_->LoadPositions(state.Text("learner.bus_positions"));
 }
 
 std::string Learner::Checkpoint() {
@@ -178,12 +233,14 @@ std::string Learner::Checkpoint() {
   ckpt.meta.env_steps = env_steps_;
   ckpt.meta.wall_seconds = MonoSeconds() - start_time_;
   ckpt.meta.run_id = static_cast<uint64_t>(bus_->config().run_id);
-  ckpt.meta.note = config_.env_id;
+  ckpt.meta.note = "env = " + config_.env_id + "\nprecision = " + config_.precision;
   algorithm_->policy().GetFlat(&ckpt.params);
   nn::SaveCheckpoint(path, ckpt);
   SaveState().Save(StatePath());
-  // Keep the newest keep_checkpoints files; older ones have been scored or skipped by now.
-  if (written_.empty() || written_.back() != path) written_.push_back(path);
+  // Keep the newest keep_checkpoints files (this life's last, earlier lives' before them); older
+  // ones have been scored or skipped by now.
+  written_.erase(std::remove(written_.begin(), written_.end(), path), written_.end());
+  written_.push_back(path);
   while (config_.keep_checkpoints > 0 &&
          static_cast<int>(written_.size()) > config_.keep_checkpoints) {
     std::error_code ignored;

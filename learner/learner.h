@@ -41,10 +41,13 @@ struct LearnerConfig {
   double request_timeout = 2.0;  // seconds before a request is sent again
   int weights_every = 100;       // updates between weight broadcasts
   int checkpoint_every = 1000;   // updates between checkpoints
-  int keep_checkpoints = 0;      // newest checkpoint files kept on disk (0: all)
+  int keep_checkpoints = 0;      // newest checkpoint files kept on disk, earlier lives' included
+                                 // (0: all)
   bool prioritized = false;      // publish |TD errors| as priorities after every update
   int threads = 1;               // compute threads of the network library (nn::SetNumThreads)
-  std::string out_dir = ".";     // checkpoints go to <out_dir>/checkpoints/
+  // The networks' matrix products, "fp32" or "bf16" (nn/precision.h); kept in the learner state.
+  std::string precision = "fp32";
+  std::string out_dir = ".";  // checkpoints go to <out_dir>/checkpoints/
   // Continue from <out_dir>/checkpoints/learner-state.bin when it exists (written with every
   // checkpoint): networks, targets, optimizers, counters, generators, env steps and wall time.
   bool resume = false;
@@ -117,7 +120,9 @@ class Learner {
   int64_t request_timeouts_ = 0;
   int64_t stale_replies_ = 0;
   std::vector<float> flat_;
-  std::deque<std::string> written_;  // checkpoint files on disk, oldest first
+  // Checkpoint files on disk, oldest first: those of earlier lives found at the start (by
+  // update), then this life's.
+  std::deque<std::string> written_;
 
   // Stats since the last stats message.
   double loss_sum_ = 0, q_sum_ = 0;

@@ -7,6 +7,7 @@
 #include "common/options.h"
 #include "common/shutdown.h"
 #include "learner/learner.h"
+#include "nn/precision.h"
 
 namespace {
 
@@ -112,7 +113,13 @@ int Main(int argc, char** argv) {
       ("checkpoint-every", rl::po::value(&c.checkpoint_every)->default_value(c.checkpoint_every),
        "updates between checkpoints")  //
       ("keep-checkpoints", rl::po::value(&c.keep_checkpoints)->default_value(c.keep_checkpoints),
-       "newest checkpoint files kept on disk (0: all)")  //
+       "newest checkpoint files kept on disk, those earlier lives of the learner left in the "
+       "folder included (0: all)")  //
+      ("precision", rl::po::value(&c.precision)->default_value(c.precision),
+       "the networks' matrix products: fp32, or bf16 (inputs rounded to bfloat16, sums in fp32; "
+       "weights, optimizer, activations and losses stay fp32). bf16 is fast on CPUs with "
+       "AVX512_BF16 and emulated, slower than fp32, elsewhere; the kernels follow the CPU, or "
+       "RL_KERNELS (avx512_bf16, avx512, avx2)")  //
       ("threads", rl::po::value(&c.threads)->default_value(c.threads),
        "compute threads for the network (convolutions and large products are split; 1 leaves "
        "the other cores to the actors)")  //
@@ -156,6 +163,15 @@ int Main(int argc, char** argv) {
     d.seed = seed;
   }
   c.seed = seed;
+  // The kernels the networks will run on (throws, naming the reason, when RL_KERNELS asks for a
+  // path this CPU cannot run).
+  std::string kernels = "precision " + c.precision + ", " + rl::nn::KernelPath() + " kernels";
+  if (c.precision == "bf16" && !rl::nn::NativeBf16()) {
+    kernels += ", bf16 emulated: no AVX512_BF16";
+    std::fprintf(stderr,
+                 "learner: warning: this CPU (or RL_KERNELS) gives no AVX512_BF16: bf16 products "
+                 "are emulated (the same rounding, slower than fp32)\n");
+  }
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("learner"));
   rl::learner::Learner learner(c, &bus);
@@ -169,8 +185,8 @@ int Main(int argc, char** argv) {
   } else if (c.resume) {
     resumed = ", nothing to resume: starting afresh";
   }
-  std::printf("learner: ready (%s)%s%s\n", learner.algorithm().Describe().c_str(), shifts.c_str(),
-              resumed.c_str());
+  std::printf("learner: ready (%s)%s, %s%s\n", learner.algorithm().Describe().c_str(),
+              shifts.c_str(), kernels.c_str(), resumed.c_str());
   std::fflush(stdout);
   learner.Run();
   std::printf("learner: stopped after %lld updates\n", static_cast<long long>(learner.updates()));

@@ -136,6 +136,8 @@ Td3::Td3(const envs::EnvSpec& spec, Td3Config config)
   }
   q1_ = BuildCritic(config_, spec_, &rng);
   q2_ = BuildCritic(config_, spec_, &rng);
+  for (nn::Sequential* net : {&encoder_, &actor_}) net->set_precision(config_.precision);
+  for (nn::ActionValueNet* net : {&q1_, &q2_}) net->set_precision(config_.precision);
   actor_target_ = actor_;
   q1_target_ = q1_;
   q2_target_ = q2_;

@@ -51,6 +51,7 @@ struct Td3Config {
   float target_noise_clip = 0.5f;  // its clip, relative to the half-range
   float max_grad_norm = 0.0f;      // global gradient-norm clip of each optimizer (0: none)
   uint64_t seed = 0;               // initialisation and target-noise seed
+  nn::Precision precision = nn::Precision::kFp32;  // the networks' products (nn/precision.h)
 
   // Throws std::invalid_argument naming the bad field.
   void Validate() const;

@@ -128,6 +128,10 @@ std::vector<Buffer> ActionValueNet::Buffers() {
   return Prefixed<Buffer>(Parts(), [](Sequential* s) { return s->Buffers(); });
 }
 
+void ActionValueNet::set_precision(Precision precision) {
+  for (Sequential* part : Parts()) part->set_precision(precision);
+}
+
 void ActionValueNet::set_training(bool training) {
   for (Sequential* part : Parts()) part->set_training(training);
 }

@@ -59,6 +59,8 @@ class ActionValueNet {
   std::vector<Param> Params();
   std::vector<Buffer> Buffers();
   void set_training(bool training);
+  /// The arithmetic of the three parts' products (nn/precision.h); copies keep it.
+  void set_precision(Precision precision);
   std::string Architecture() const;
   int64_t FlatSize() const;
   void GetFlat(std::vector<float>* out) const;

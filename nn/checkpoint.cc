@@ -147,6 +147,10 @@ void SaveCheckpoint(const std::string& path, const Checkpoint& ckpt) {
 
 Checkpoint LoadCheckpoint(const std::string& path) {
   const std::vector<char> bytes = ReadFile(path);
+  return ParseCheckpoint(std::string_view(bytes.data(), bytes.size()), path);
+}
+
+Checkpoint ParseCheckpoint(std::string_view bytes, const std::string& path) {
   auto fail = [&](const std::string& why) -> std::runtime_error {
     return std::runtime_error("checkpoint " + path + " " + why);
   };

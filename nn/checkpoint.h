@@ -13,6 +13,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace rl::nn {
@@ -46,5 +47,9 @@ void SaveCheckpoint(const std::string& path, const Checkpoint& ckpt);
 /// (checksum mismatch or inconsistent lengths), or a parameter count that does not match the
 /// architecture's FlatSize().
 Checkpoint LoadCheckpoint(const std::string& path);
+
+/// LoadCheckpoint() of a file already read into memory (`bytes`, the whole file); errors name
+/// `name` where LoadCheckpoint's name the path.
+Checkpoint ParseCheckpoint(std::string_view bytes, const std::string& name);
 
 }  // namespace rl::nn

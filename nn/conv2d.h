@@ -8,7 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "nn/kernels.h"
 #include "nn/layer.h"
+#include "nn/precision.h"
 #include "nn/tensor.h"
 
 namespace rl::nn {
@@ -58,6 +60,7 @@ class Conv2d : public Layer {
   int output_size() const override { return out_.size(); }
   ImageShape input_shape() const override { return in_; }
   ImageShape output_shape() const override { return out_; }
+  void set_precision(Precision precision) override { precision_ = precision; }
   bool FuseOutputRelu() override {
     fused_output_relu_ = true;
     return true;
@@ -78,23 +81,18 @@ class Conv2d : public Layer {
   const Matrix& bias_grad() const { return bias_grad_; }
 
  private:
-  // The blocks of dcols that add up to a phase plane, and their shifts (see PlaneGradient()).
-  struct Run {
-    const float* src;
-    int dy;
-    int dx;
-  };
   // Scratch space of one task of Forward()/Backward() (task t of a call with T tasks works on
   // samples [batch t / T, batch (t + 1) / T)), grown to the largest group it has seen.
   struct Scratch {
-    Vector planes;          // Phase planes of one group.
-    Vector padded_row;      // A zero-padded input row: plane_w_ * stride floats.
-    Vector cols;            // Unfolded group: (group * P) x taps, column-major or packed.
-    Vector group_out;       // (group * P) x out_channels: a product before it is scattered.
-    Vector dcols;           // Gradient of cols, after dcols_front_ floats of slack.
-    std::vector<Run> runs;  // (kernel / stride, rounded up)^2 entries.
-    Vector channel_grad;    // The gradient of the stride^2 phase planes of one channel.
-    Vector workspace;       // Scratch space of the product kernel.
+    Vector planes;      // Phase planes of one group.
+    Vector padded_row;  // A zero-padded input row: plane_w_ * stride floats.
+    Vector cols;        // Unfolded group: (group * P) x taps, column-major or packed.
+    Vector panel;       // One panel of the unfolding into bf16 pairs (Im2colPairsPanelFloats()).
+    Vector group_out;   // (group * P) x out_channels: a product before it is scattered.
+    Vector dcols;       // Gradient of cols, after dcols_front_ floats of slack.
+    std::vector<internal::GradientRun> runs;  // (kernel / stride, rounded up)^2 entries.
+    Vector channel_grad;  // The gradient of the stride^2 phase planes of one channel.
+    Vector workspace;     // Scratch space of the product kernel.
     // Tasks after the first: the parameter gradients of their samples, added to weight_grad_ and
     // bias_grad_ (in task order) once all tasks are done. The first task adds into those directly.
     Matrix weight_grad;
@@ -104,13 +102,12 @@ class Conv2d : public Layer {
   // Copies the phase planes of samples [b0, b0 + count) of x into s->planes, unless the input is
   // read in place (stride 1, no padding).
   void BuildPlanes(const Matrix& x, int b0, int count, Scratch* s) const;
-  // Pointer to the planes of the group's first sample; samples are plane_stride_ floats apart.
+  // Pointer to the planes of the group's first sample; samples are geo_.plane_stride floats apart.
   const float* GroupPlanes(const Matrix& x, int b0, const Scratch& s) const;
   // Unfolds `count` samples whose planes start at `planes` into s->cols ((count * P) x K):
-  // column-major, or packed in panels for internal::GemmPacked() when `panels`.
+  // column-major, or, when `panels`, packed in panels for internal::GemmPacked() (in bf16 on a
+  // path with the instructions: in the bf16 pairs of internal::GemmPackedPairs()).
   void Im2col(const float* planes, int count, bool panels, Scratch* s) const;
-  // The packed case of Im2col().
-  void Im2colPanels(const float* planes, int count, Scratch* s) const;
   // Writes d(loss)/d(x) of samples [b0, b0 + count) from their unfolded gradient s->dcols (the
   // transpose of Im2col(), as a gather: every input pixel sums the entries copied from it).
   void FoldGradient(const Matrix& x, int b0, int count, Scratch* s);
@@ -118,8 +115,10 @@ class Conv2d : public Layer {
   // (plane_h_ x plane_w_, row-major).
   void PlaneGradient(const float* dcols, int count, int t, int c, int py, int px, float* out,
                      Scratch* s) const;
-  // Samples per group for a batch of `batch`.
-  int GroupSize(int batch) const;
+  // Samples per group for a batch of `batch`, unfolded into floats or bf16 `pairs`.
+  int GroupSize(int batch, bool pairs) const;
+  // Whether Forward() unfolds straight into bf16 pairs (bf16 on a path with the instructions).
+  bool UnfoldsToPairs() const;
   // How many tasks to split a batch of `batch` into, with scratch_ grown to that many.
   int PrepareTasks(int batch);
   // Forward() of samples [begin, end) of x, in groups of `group`.
@@ -136,20 +135,13 @@ class Conv2d : public Layer {
   int kernel_;
   int stride_;
   int padding_;
-  int taps_;     // in_channels * kernel * kernel: rows of the weight.
-  int pixels_;   // out_h * out_w.
   bool direct_;  // Stride 1 and no padding: the input is its own (only) phase plane.
   bool dense_;   // The kernel covers the unpadded input: a fully connected layer on the image.
-  // Plane floats from the first to the last pixel of one output window, and, when that is at most
-  // 16, where each output pixel of the window is among them.
-  int window_span_;
-  std::array<int32_t, 16> window_index_{};
-  // Per tap (c, ky, kx): where its pixel for output pixel (0, 0) lies in a sample's planes.
-  std::vector<int64_t> tap_offset_;
-  int plane_h_;  // Rows and columns of one phase plane of the padded input.
-  int plane_w_;
-  int64_t plane_stride_;  // Floats per sample in the phase planes (or in the input if direct_).
-  int dcols_front_;       // Floats of slack in front of the unfolded gradient (Scratch::dcols).
+  // The shape as the kernels see it: taps (in_channels * kernel * kernel, the rows of the
+  // weight), pixels, the phase planes (one plane, the input itself, if direct_).
+  internal::ConvGeometry geo_;
+  int dcols_front_;  // Floats of slack in front of the unfolded gradient (Scratch::dcols).
+  Precision precision_ = Precision::kFp32;
 
   Matrix weight_;  // taps x out_channels.
   Matrix bias_;    // out_channels x 1.

@@ -117,8 +117,17 @@ std::string Dueling::Describe() const {
 }
 
 std::unique_ptr<Layer> Dueling::Clone() const {
-  return std::unique_ptr<Layer>(
+  std::unique_ptr<Dueling> copy(
       new Dueling(value_hidden_, value_out_, advantage_hidden_, advantage_out_));
+  copy->set_precision(precision_);
+  return copy;
+}
+
+void Dueling::set_precision(Precision precision) {
+  precision_ = precision;
+  for (Linear* layer : {&value_hidden_, &value_out_, &advantage_hidden_, &advantage_out_}) {
+    layer->set_precision(precision);
+  }
 }
 
 }  // namespace rl::nn

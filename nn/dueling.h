@@ -36,6 +36,7 @@ class Dueling : public Layer {
   int input_size() const override { return value_hidden_.input_size(); }
   int output_size() const override { return advantage_out_.output_size(); }
   bool FuseInputReluGrad() override;
+  void set_precision(Precision precision) override;
 
   Linear& value_hidden() { return value_hidden_; }
   Linear& value_out() { return value_out_; }
@@ -61,6 +62,7 @@ class Dueling : public Layer {
   Matrix grad_input_;
   const Matrix* grad_value_hidden_ = nullptr;
   const Matrix* grad_advantage_hidden_ = nullptr;
+  Precision precision_ = Precision::kFp32;
 };
 
 }  // namespace rl::nn

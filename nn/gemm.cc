@@ -1,609 +1,13 @@
 #include "nn/gemm.h"
 
 #include <algorithm>
-#include <array>
-#include <cstring>
-#include <utility>
 
 #include "common/check.h"
+#include "nn/kernels.h"
 #include "nn/parallel.h"
 
 namespace rl::nn::internal {
 namespace {
-
-// Register blocking. A micro-kernel keeps kMaxVecs x kNr vectors of kLanes floats in registers:
-// 24 accumulators when 32 vector registers exist (AVX-512), 12 when there are 16 (AVX2, SSE).
-// On AVX-512 we still use 8-float vectors: on Zen 4 they have the same FLOP throughput as 16-float
-// vectors and pad the 84- and 120-row layers of the DQN MLP less (84 -> 88 instead of 96).
-#if defined(__AVX512F__)
-constexpr int kLanes = 8;
-constexpr int kMaxVecs = 3;
-constexpr int kNr = 8;
-#elif defined(__AVX__)
-constexpr int kLanes = 8;
-constexpr int kMaxVecs = 2;
-constexpr int kNr = 6;
-#else
-constexpr int kLanes = 4;
-constexpr int kMaxVecs = 2;
-constexpr int kNr = 6;
-#endif
-constexpr int kMaxMr = kMaxVecs * kLanes;
-static_assert(kMaxMr == kPanelRows, "gemm.h promises panels of kPanelRows rows");
-// Depth of one packed panel: kMaxMr x kKc floats (24 KB at most) stay in L1 while B streams by.
-constexpr int kKc = 256;
-// Floats of packed A kept at once when whole blocks of panels are packed (512 KB, half of L2).
-constexpr int64_t kBlockFloats = 128 * 1024;
-// Columns of C ahead of the current block that PanelGemm prefetches when it accumulates.
-constexpr int kPrefetchAhead = 2 * kNr;
-// Products with at most this many rows use dot products (DotKernel) instead of panels.
-constexpr int kMaxSmallM = 4;
-// Columns of B per DotKernel call.
-constexpr int kDotColumns = 4;
-
-using Vec [[gnu::vector_size(kLanes * sizeof(float))]] = float;
-
-inline Vec Load(const float* p) {
-  Vec v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
-}
-inline void Store(float* p, Vec v) { std::memcpy(p, &v, sizeof(v)); }
-
-// The activation steps of an Epilogue for one element; `mask` points at the element's mask entry.
-inline float Activate(float r, bool relu, const float* mask) {
-  if (relu) r = std::max(r, 0.0f);
-  if (mask != nullptr && !(*mask > 0.0f)) r = 0.0f;
-  return r;
-}
-
-// What one micro-kernel call computes and where it stores it.
-struct Block {
-  const float* bias;      // kMr floats (padded) or null.
-  const float* col_bias;  // NR floats or null: added to column j of the block.
-  bool accumulate;
-  bool relu;
-  const float* mask;  // Laid out like c, or null.
-  float* c;
-  int64_t crs;
-  int64_t ccs;
-  int rows;  // Rows of the result to store, <= kMr.
-};
-
-// Computes the V*kLanes x NR block c (=|+=) bias + A_panel * B, then the activation steps. `ap` is
-// the panel: k steps of V*kLanes contiguous floats, `a_step` floats apart (packed, or A itself).
-// `b` points at B(0, 0) of the block.
-//
-// The loops over V and NR are fully unrolled so that the accumulators live in registers; a loop
-// left rolled would index `acc` at run time and force it into memory.
-template <int V, int NR>
-void MicroKernel(int k, const float* ap, int64_t a_step, const float* b, int64_t brs, int64_t bcs,
-                 const Block& out) {
-  constexpr int kMr = V * kLanes;
-  Vec acc[V][NR];
-#pragma GCC unroll 8
-  for (int i = 0; i < V; ++i) {
-    const Vec init = out.bias != nullptr ? Load(out.bias + i * kLanes) : Vec{};
-#pragma GCC unroll 16
-    for (int j = 0; j < NR; ++j) {
-      acc[i][j] = out.col_bias != nullptr ? init + out.col_bias[j] : init;
-    }
-  }
-  // Rank-1 updates: one column of the A panel times one row of B per step.
-  for (int p = 0; p < k; ++p) {
-    Vec a[V];
-#pragma GCC unroll 8
-    for (int i = 0; i < V; ++i) a[i] = Load(ap + i * kLanes);
-    ap += a_step;
-    const float* bp = b + p * brs;
-#pragma GCC unroll 16
-    for (int j = 0; j < NR; ++j) {
-      const float s = bp[j * bcs];
-#pragma GCC unroll 8
-      for (int i = 0; i < V; ++i) acc[i][j] += a[i] * s;
-    }
-  }
-  // Write back: whole vectors when the block is full and contiguous, element-wise otherwise.
-  if (out.crs == 1 && out.rows == kMr) {
-#pragma GCC unroll 16
-    for (int j = 0; j < NR; ++j) {
-#pragma GCC unroll 8
-      for (int i = 0; i < V; ++i) {
-        float* cp = out.c + j * out.ccs + i * kLanes;
-        Vec r = out.accumulate ? Load(cp) + acc[i][j] : acc[i][j];
-        if (out.relu) r = r > Vec{} ? r : Vec{};
-        if (out.mask != nullptr) r = Load(out.mask + j * out.ccs + i * kLanes) > Vec{} ? r : Vec{};
-        Store(cp, r);
-      }
-    }
-    return;
-  }
-  alignas(64) float tmp[NR][kMr];
-#pragma GCC unroll 16
-  for (int j = 0; j < NR; ++j) {
-#pragma GCC unroll 8
-    for (int i = 0; i < V; ++i) Store(&tmp[j][i * kLanes], acc[i][j]);
-  }
-  for (int j = 0; j < NR; ++j) {
-    for (int i = 0; i < out.rows; ++i) {
-      const int64_t at = i * out.crs + j * out.ccs;
-      const float r = out.accumulate ? out.c[at] + tmp[j][i] : tmp[j][i];
-      out.c[at] = Activate(r, out.relu, out.mask != nullptr ? out.mask + at : nullptr);
-    }
-  }
-}
-
-using KernelFn = void (*)(int, const float*, int64_t, const float*, int64_t, int64_t, const Block&);
-
-// kKernels[V - 1][NR] is MicroKernel<V, NR> (NR = 0 unused).
-template <int V, int... NR>
-constexpr std::array<KernelFn, kNr + 1> KernelRow(std::integer_sequence<int, NR...> /*unused*/) {
-  return {nullptr, &MicroKernel<V, NR + 1>...};
-}
-template <int... V>
-constexpr auto KernelTable(std::integer_sequence<int, V...> /*unused*/) {
-  return std::array<std::array<KernelFn, kNr + 1>, kMaxVecs>{
-      KernelRow<V + 1>(std::make_integer_sequence<int, kNr>{})...};
-}
-constexpr auto kKernels = KernelTable(std::make_integer_sequence<int, kMaxVecs>{});
-
-// Shuffle indices for one stage of an in-register kLanes x kLanes transpose: rows i and i + B
-// (i without bit B) swap their off-diagonal B x B blocks.
-template <int B, bool kSecond>
-constexpr std::array<int, kLanes> SwapBlockIndices() {
-  std::array<int, kLanes> idx{};
-  for (int l = 0; l < kLanes; ++l) {
-    if (!kSecond) {
-      idx[l] = (l & B) == 0 ? l : kLanes + l - B;
-    } else {
-      idx[l] = (l & B) == 0 ? l + B : kLanes + l;
-    }
-  }
-  return idx;
-}
-
-template <int B, bool kSecond, int... I>
-inline Vec SwapBlocks(Vec x, Vec y, std::integer_sequence<int, I...> /*unused*/) {
-  constexpr std::array<int, kLanes> kIdx = SwapBlockIndices<B, kSecond>();
-  return __builtin_shufflevector(x, y, kIdx[I]...);
-}
-
-template <int B>
-inline void TransposeStages(Vec* rows) {
-  if constexpr (B >= 1) {
-    constexpr auto kSeq = std::make_integer_sequence<int, kLanes>{};
-#pragma GCC unroll 16
-    for (int i = 0; i < kLanes; ++i) {
-      if ((i & B) != 0) continue;
-      const Vec x = rows[i];
-      const Vec y = rows[i | B];
-      rows[i] = SwapBlocks<B, false>(x, y, kSeq);
-      rows[i | B] = SwapBlocks<B, true>(x, y, kSeq);
-    }
-    TransposeStages<B / 2>(rows);
-  }
-}
-
-// Copies rows [i0, i0 + rows) and columns [p0, p0 + k) of `a` into `dst` as k steps of `mr` floats
-// (zero beyond `rows`).
-void PackPanel(const ConstView& a, int i0, int rows, int p0, int k, int mr, float* dst) {
-  if (a.row_stride == 1) {
-    // Columns of the panel are contiguous in `a`. Copy whole vectors (a call to memcpy per column
-    // costs more than the copy), then the ragged end.
-    const int full = rows / kLanes;
-    const float* src = a.data + i0 + p0 * a.col_stride;
-    for (int p = 0; p < k; ++p, src += a.col_stride) {
-      float* d = dst + static_cast<int64_t>(p) * mr;
-      for (int v = 0; v < full; ++v) Store(d + v * kLanes, Load(src + v * kLanes));
-      for (int i = full * kLanes; i < rows; ++i) d[i] = src[i];
-      for (int i = rows; i < mr; ++i) d[i] = 0.0f;
-    }
-    return;
-  }
-  // Transposed operand. With contiguous rows, transpose kLanes x kLanes tiles in registers...
-  int i_done = 0;
-  int p_done = 0;
-  if (a.col_stride == 1) {
-    i_done = rows - rows % kLanes;
-    p_done = k - k % kLanes;
-    for (int ib = 0; ib < i_done; ib += kLanes) {
-      const float* src = a.data + (i0 + ib) * a.row_stride + p0;
-      for (int pb = 0; pb < p_done; pb += kLanes) {
-        Vec tile[kLanes];
-#pragma GCC unroll 16
-        for (int r = 0; r < kLanes; ++r) tile[r] = Load(src + r * a.row_stride + pb);
-        TransposeStages<kLanes / 2>(tile);
-#pragma GCC unroll 16
-        for (int t = 0; t < kLanes; ++t)
-          Store(dst + static_cast<int64_t>(pb + t) * mr + ib, tile[t]);
-      }
-    }
-  }
-  // ... and copy what is left one element at a time, walking each source row contiguously.
-  for (int i = 0; i < rows; ++i) {
-    const float* src = a.data + (i0 + i) * a.row_stride + p0 * a.col_stride;
-    for (int p = i < i_done ? p_done : 0; p < k; ++p) {
-      dst[static_cast<int64_t>(p) * mr + i] = src[p * a.col_stride];
-    }
-  }
-  for (int i = rows; i < mr; ++i) {
-    for (int p = 0; p < k; ++p) dst[static_cast<int64_t>(p) * mr + i] = 0.0f;
-  }
-}
-
-// Copies panels [q0, q1) of rows of a column-major `a` (row_stride 1), columns [p0, p0 + k), into
-// `dst`: panel q at (q - q0) * kMaxMr * k, laid out as PackPanel() does. Walks each column of `a`
-// once across all the panels, so a large A streams from memory instead of being read in short
-// strided pieces.
-void PackPanelBlock(const ConstView& a, int q0, int q1, int p0, int k, float* dst) {
-  const int m = a.rows;
-  const float* src = a.data + p0 * a.col_stride;
-  for (int p = 0; p < k; ++p, src += a.col_stride) {
-    for (int q = q0; q < q1; ++q) {
-      const int i0 = q * kMaxMr;
-      const int rows = std::min(kMaxMr, m - i0);
-      const int mr = (rows + kLanes - 1) / kLanes * kLanes;
-      const int full = rows / kLanes;
-      float* d = dst + static_cast<int64_t>(q - q0) * kMaxMr * k + static_cast<int64_t>(p) * mr;
-      const float* s = src + i0;
-      for (int v = 0; v < full; ++v) Store(d + v * kLanes, Load(s + v * kLanes));
-      for (int i = full * kLanes; i < rows; ++i) d[i] = s[i];
-      for (int i = rows; i < mr; ++i) d[i] = 0.0f;
-    }
-  }
-}
-
-// The general case: panels of A times strided B, for any shapes with k > 0.
-// With `prepacked`, A is only a shape and its panels are read from there (see GemmPacked()).
-void PanelGemm(const ConstView& a, const ConstView& b, const MutView& c, bool accumulate,
-               const Epilogue& epilogue, Vector* workspace, const float* prepacked = nullptr) {
-  const int m = c.rows;
-  const int n = c.cols;
-  const int k = a.cols;
-  const int kc_max = std::min(k, kKc);
-  const int panels = (m + kMaxMr - 1) / kMaxMr;
-  // A large column-major A (a weight matrix that does not fit the L2 cache) used by several
-  // blocks of columns is packed a block of panels at a time (about half the L2 cache); otherwise
-  // one panel at a time, which then stays in L1, or not at all.
-  const bool pack_blocks = prepacked == nullptr && a.row_stride == 1 && n > kNr && panels > 1 &&
-                           static_cast<int64_t>(m) * k > 2 * kBlockFloats;
-  int block_panels = 1;
-  if (pack_blocks) {
-    const int max_panels =
-        std::max<int>(1, static_cast<int>(kBlockFloats / (static_cast<int64_t>(kMaxMr) * kc_max)));
-    const int blocks = (panels + max_panels - 1) / max_panels;
-    block_panels = (panels + blocks - 1) / blocks;
-  }
-  const int64_t packed_floats = static_cast<int64_t>(block_panels) * kMaxMr * kc_max;
-  if (workspace->size() < packed_floats + kMaxMr) workspace->resize(packed_floats + kMaxMr);
-  float* packed = workspace->data();
-  float* bias_panel = packed + packed_floats;
-
-  for (int p0 = 0; p0 < k; p0 += kKc) {
-    const int kc = std::min(kKc, k - p0);
-    // Only the first slice of the shared dimension may overwrite c or add the bias, and only the
-    // last one applies the activation steps.
-    const bool first = p0 == 0;
-    const bool last = p0 + kc == k;
-    for (int q0 = 0; q0 < panels; q0 += block_panels) {
-      const int q1 = std::min(panels, q0 + block_panels);
-      if (pack_blocks) PackPanelBlock(a, q0, q1, p0, kc, packed);
-      // While this block is multiplied, prefetch the part of A that the next one packs (a large
-      // A comes from memory; without this, packing waits for it).
-      int next_p0 = p0;
-      int next_q0 = q0 + block_panels;
-      if (next_q0 >= panels) {
-        next_p0 = p0 + kKc;
-        next_q0 = 0;
-      }
-      const bool prefetch = pack_blocks && next_p0 < k;
-      const int next_kc = prefetch ? std::min(kKc, k - next_p0) : 0;
-      const int next_i0 = next_q0 * kMaxMr;
-      const int next_i1 = std::min(m, (next_q0 + block_panels) * kMaxMr);
-      const int calls = (q1 - q0) * ((n + kNr - 1) / kNr);
-      int call = 0;
-      for (int q = q0; q < q1; ++q) {
-        const int i0 = q * kMaxMr;
-        const int rows = std::min(kMaxMr, m - i0);
-        const int vecs = (rows + kLanes - 1) / kLanes;
-        const int mr = vecs * kLanes;
-        const float* ap = packed + static_cast<int64_t>(q - q0) * kMaxMr * kc;
-        int64_t a_step = mr;
-        if (prepacked != nullptr) {
-          ap = prepacked + (static_cast<int64_t>(q) * k + p0) * kMaxMr;
-          a_step = kMaxMr;
-        } else if (!pack_blocks) {
-          // With a single block of columns each panel is used once, so packing costs more than
-          // it saves; full panels of a column-major A are then read in place.
-          if (n <= kNr && a.row_stride == 1 && rows == mr) {
-            ap = a.data + i0 + p0 * a.col_stride;
-            a_step = a.col_stride;
-          } else {
-            PackPanel(a, i0, rows, p0, kc, mr, packed);
-          }
-        }
-        Block out{nullptr,
-                  nullptr,
-                  accumulate || !first,
-                  last && epilogue.relu,
-                  nullptr,
-                  c.data + i0 * c.row_stride,
-                  c.row_stride,
-                  c.col_stride,
-                  rows};
-        if (first && epilogue.row_bias != nullptr) {
-          std::copy(epilogue.row_bias + i0, epilogue.row_bias + i0 + rows, bias_panel);
-          std::fill(bias_panel + rows, bias_panel + mr, 0.0f);
-          out.bias = bias_panel;
-        }
-        const float* mask_rows = nullptr;
-        if (last && epilogue.mask != nullptr) mask_rows = epilogue.mask + i0 * c.row_stride;
-        const std::array<KernelFn, kNr + 1>& kernels = kKernels[vecs - 1];
-        const float* b_slice = b.data + p0 * b.row_stride;
-        float* c_rows = out.c;
-        // Blocks of kNr columns, then one narrower block for the remainder.
-        for (int j0 = 0; j0 < n; j0 += kNr) {
-          const int nr = std::min(kNr, n - j0);
-          out.c = c_rows + j0 * c.col_stride;
-          out.mask = mask_rows != nullptr ? mask_rows + j0 * c.col_stride : nullptr;
-          out.col_bias = first && epilogue.col_bias != nullptr ? epilogue.col_bias + j0 : nullptr;
-          if (prefetch) {
-            // Columns [c0, c1) of the next block, one call's share.
-            const int c0 = next_p0 + static_cast<int>(static_cast<int64_t>(next_kc) * call / calls);
-            const int c1 =
-                next_p0 + static_cast<int>(static_cast<int64_t>(next_kc) * (call + 1) / calls);
-            for (int col = c0; col < c1; ++col) {
-              const float* from = a.data + static_cast<int64_t>(col) * a.col_stride + next_i0;
-              const float* to = from + (next_i1 - next_i0);
-              for (const float* line = from; line < to; line += 16) {
-                __builtin_prefetch(line, 0, 2);
-              }
-            }
-            ++call;
-          }
-          if (out.accumulate && c.row_stride == 1 && j0 + kPrefetchAhead < n) {
-            // The block of C stored kPrefetchAhead columns later: a large C (a weight gradient)
-            // is read from memory.
-            float* ahead = c_rows + (j0 + kPrefetchAhead) * c.col_stride;
-            const int cols = std::min(kNr, n - j0 - kPrefetchAhead);
-            for (int j = 0; j < cols; ++j) {
-              __builtin_prefetch(ahead + j * c.col_stride, 1, 2);
-              __builtin_prefetch(ahead + j * c.col_stride + rows - 1, 1, 2);
-            }
-          }
-          kernels[nr](kc, ap, a_step, b_slice + j0 * b.col_stride, b.row_stride, b.col_stride, out);
-        }
-      }
-    }
-  }
-}
-
-constexpr int BitReverse(int x, int bits) {
-  int r = 0;
-  for (int i = 0; i < bits; ++i) r |= ((x >> i) & 1) << (bits - 1 - i);
-  return r;
-}
-constexpr int Log2(int x) { return x <= 1 ? 0 : 1 + Log2(x / 2); }
-
-// Shuffle indices that pick, from the concatenation of x and y, the first (kHigh false) or second
-// halves of every group of G lanes: for each group q, G/2 lanes of x then G/2 lanes of y.
-template <int G, bool kHigh>
-constexpr std::array<int, kLanes> FoldIndices() {
-  std::array<int, kLanes> idx{};
-  const int shift = kHigh ? G / 2 : 0;
-  for (int q = 0; q < kLanes / G; ++q) {
-    for (int t = 0; t < G / 2; ++t) {
-      idx[q * G + t] = q * G + t + shift;
-      idx[q * G + G / 2 + t] = kLanes + q * G + t + shift;
-    }
-  }
-  return idx;
-}
-
-template <int G, bool kHigh, int... I>
-inline Vec FoldShuffle(Vec x, Vec y, std::integer_sequence<int, I...> /*unused*/) {
-  constexpr std::array<int, kLanes> kIdx = FoldIndices<G, kHigh>();
-  return __builtin_shufflevector(x, y, kIdx[I]...);
-}
-
-// Groups of G lanes of x and y become groups of G/2 lanes holding pairwise sums.
-template <int G>
-inline Vec Fold(Vec x, Vec y) {
-  constexpr auto kSeq = std::make_integer_sequence<int, kLanes>{};
-  return FoldShuffle<G, false>(x, y, kSeq) + FoldShuffle<G, true>(x, y, kSeq);
-}
-
-// Folds kCount vectors of groups of G lanes into kCount / 2 vectors of groups of G / 2, down to
-// single lanes.
-template <int G, int kCount>
-inline void FoldLevels(Vec* v) {
-  if constexpr (G > 1) {
-#pragma GCC unroll 16
-    for (int i = 0; i < kCount / 2; ++i) v[i] = Fold<G>(v[2 * i], v[2 * i + 1]);
-    FoldLevels<G / 2, kCount / 2>(v);
-  }
-}
-
-// Horizontal sums of kLanes vectors at once: lane l of the result is the sum of the lanes of v[l].
-// log2(kLanes) levels of shuffles and adds instead of a scalar loop per vector.
-inline Vec ReduceLanes(const Vec* v) {
-  // The folds leave the sums in bit-reversed order, so feed the vectors in that order.
-  Vec w[kLanes];
-#pragma GCC unroll 16
-  for (int l = 0; l < kLanes; ++l) w[l] = v[BitReverse(l, Log2(kLanes))];
-  FoldLevels<kLanes, kLanes>(w);
-  return w[0];
-}
-
-// M <= kMaxSmallM rows of C as dot products along k: C(o, j) = A(o, :) . B(:, j), vectorised
-// over k, NC columns at a time. Needs contiguous columns of B. `at` holds the rows of A
-// contiguously, each zero-padded to `k_pad` floats. `c` and `mask` point at column 0 of the block.
-template <int M, int NC>
-void DotKernel(int k, int k_pad, const float* at, const float* b, int64_t bcs,
-               const Epilogue& epilogue, bool accumulate, float* c, const float* mask, int64_t crs,
-               int64_t ccs) {
-  constexpr int kCount = M * NC;
-  constexpr int kChunks = (kCount + kLanes - 1) / kLanes;
-  const int k_vec = k - k % kLanes;
-  // acc[o * NC + j] accumulates row o of A times column j of B.
-  Vec acc[kChunks * kLanes];
-#pragma GCC unroll 32
-  for (int v = 0; v < kChunks * kLanes; ++v) acc[v] = Vec{};
-  for (int p = 0; p < k_vec; p += kLanes) {
-    Vec bv[NC];
-#pragma GCC unroll 8
-    for (int j = 0; j < NC; ++j) bv[j] = Load(b + j * bcs + p);
-#pragma GCC unroll 8
-    for (int o = 0; o < M; ++o) {
-      const Vec av = Load(at + static_cast<int64_t>(o) * k_pad + p);
-#pragma GCC unroll 8
-      for (int j = 0; j < NC; ++j) acc[o * NC + j] += av * bv[j];
-    }
-  }
-  Vec sums[kChunks];
-#pragma GCC unroll 4
-  for (int chunk = 0; chunk < kChunks; ++chunk) sums[chunk] = ReduceLanes(acc + chunk * kLanes);
-    // The k % kLanes trailing products, the epilogue and the write-back. Unrolled so that the sums
-    // are read straight from registers (a scalar load from a just-stored vector stalls store
-    // forwarding).
-#pragma GCC unroll 8
-  for (int o = 0; o < M; ++o) {
-    const float* a_row = at + static_cast<int64_t>(o) * k_pad;
-#pragma GCC unroll 8
-    for (int j = 0; j < NC; ++j) {
-      float sum = sums[(o * NC + j) / kLanes][(o * NC + j) % kLanes];
-      for (int p = k_vec; p < k; ++p) sum += a_row[p] * b[j * bcs + p];
-      if (epilogue.row_bias != nullptr) sum += epilogue.row_bias[o];
-      if (epilogue.col_bias != nullptr) sum += epilogue.col_bias[j];
-      const int64_t at_c = o * crs + j * ccs;
-      if (accumulate) sum += c[at_c];
-      c[at_c] = Activate(sum, epilogue.relu, mask != nullptr ? mask + at_c : nullptr);
-    }
-  }
-}
-
-// The epilogue of the columns from j on (the mask is offset by the caller).
-inline Epilogue ShiftColumns(Epilogue e, int j) {
-  if (e.col_bias != nullptr) e.col_bias += j;
-  return e;
-}
-
-template <int M>
-void SmallMGemm(const ConstView& a, const ConstView& b, const MutView& c, bool accumulate,
-                const Epilogue& epilogue, Vector* workspace) {
-  const int n = c.cols;
-  const int k = a.cols;
-  const int k_pad = (k + kLanes - 1) / kLanes * kLanes;
-  const int64_t needed = static_cast<int64_t>(M) * k_pad;
-  if (workspace->size() < needed) workspace->resize(needed);
-  float* at = workspace->data();
-  for (int o = 0; o < M; ++o) {
-    float* row = at + static_cast<int64_t>(o) * k_pad;
-    for (int p = 0; p < k; ++p) row[p] = a.data[o * a.row_stride + p * a.col_stride];
-    std::fill(row + k, row + k_pad, 0.0f);
-  }
-  auto mask_at = [&](int j) {
-    return epilogue.mask != nullptr ? epilogue.mask + j * c.col_stride : nullptr;
-  };
-  int j = 0;
-  for (; j + kDotColumns <= n; j += kDotColumns) {
-    DotKernel<M, kDotColumns>(k, k_pad, at, b.data + j * b.col_stride, b.col_stride,
-                              ShiftColumns(epilogue, j), accumulate, c.data + j * c.col_stride,
-                              mask_at(j), c.row_stride, c.col_stride);
-  }
-  for (; j < n; ++j) {
-    DotKernel<M, 1>(k, k_pad, at, b.data + j * b.col_stride, b.col_stride,
-                    ShiftColumns(epilogue, j), accumulate, c.data + j * c.col_stride, mask_at(j),
-                    c.row_stride, c.col_stride);
-  }
-}
-
-}  // namespace
-
-void AddRowSums(const Matrix& g, float* out) {
-  // Blocks of kRowVecs vectors of rows: add the columns one after another into registers.
-  constexpr int kRowVecs = 8;
-  constexpr int kBlock = kRowVecs * kLanes;
-  const auto rows = static_cast<int>(g.rows());
-  const auto cols = static_cast<int>(g.cols());
-  const float* data = g.data();
-  int i0 = 0;
-  for (; i0 + kBlock <= rows; i0 += kBlock) {
-    Vec acc[kRowVecs];
-#pragma GCC unroll 8
-    for (int v = 0; v < kRowVecs; ++v) acc[v] = Load(out + i0 + v * kLanes);
-    for (int j = 0; j < cols; ++j) {
-      const float* col = data + static_cast<int64_t>(j) * rows + i0;
-#pragma GCC unroll 8
-      for (int v = 0; v < kRowVecs; ++v) acc[v] += Load(col + v * kLanes);
-    }
-#pragma GCC unroll 8
-    for (int v = 0; v < kRowVecs; ++v) Store(out + i0 + v * kLanes, acc[v]);
-  }
-  for (; i0 + kLanes <= rows; i0 += kLanes) {
-    Vec acc = Load(out + i0);
-    for (int j = 0; j < cols; ++j) acc += Load(data + static_cast<int64_t>(j) * rows + i0);
-    Store(out + i0, acc);
-  }
-  for (; i0 < rows; ++i0) {
-    float sum = 0.0f;
-    for (int j = 0; j < cols; ++j) sum += data[static_cast<int64_t>(j) * rows + i0];
-    out[i0] += sum;
-  }
-}
-
-bool PreferGemm(int m, int n, int k) {
-  return n >= 2 && (m >= kLanes || n >= kLanes) && static_cast<int64_t>(m) * n * k >= 8192;
-}
-
-namespace {
-
-// Gemm() on the calling thread alone.
-void GemmOneThread(const ConstView& a, const ConstView& b, const MutView& c, bool accumulate,
-                   const Epilogue& epilogue, Vector* workspace) {
-  const int m = c.rows;
-  const int n = c.cols;
-  const int k = a.cols;
-  if (m == 0 || n == 0) return;
-  // Panels of fewer rows than a vector waste most of each multiply. For a few rows, use dot
-  // products if the columns of B are contiguous...
-  if (k > 0 && m <= kMaxSmallM && b.row_stride == 1) {
-    switch (m) {
-      case 1:
-        return SmallMGemm<1>(a, b, c, accumulate, epilogue, workspace);
-      case 2:
-        return SmallMGemm<2>(a, b, c, accumulate, epilogue, workspace);
-      case 3:
-        return SmallMGemm<3>(a, b, c, accumulate, epilogue, workspace);
-      default:
-        return SmallMGemm<4>(a, b, c, accumulate, epilogue, workspace);
-    }
-  }
-  if (k > 0 && !(m < kLanes && n > m)) return PanelGemm(a, b, c, accumulate, epilogue, workspace);
-
-  // ... otherwise (and for an empty product) add the bias first, then the product as
-  // C^T += B^T A^T, which has n rows, then apply the activation steps.
-  auto elem = [&](int i, int j) { return i * c.row_stride + j * c.col_stride; };
-  for (int j = 0; j < n; ++j) {
-    for (int i = 0; i < m; ++i) {
-      float bias = epilogue.row_bias != nullptr ? epilogue.row_bias[i] : 0.0f;
-      if (epilogue.col_bias != nullptr) bias += epilogue.col_bias[j];
-      c.data[elem(i, j)] = accumulate ? c.data[elem(i, j)] + bias : bias;
-    }
-  }
-  if (k > 0) {
-    PanelGemm(b.Transposed(), a.Transposed(), c.Transposed(), /*accumulate=*/true, Epilogue{},
-              workspace);
-  }
-  if (epilogue.relu || epilogue.mask != nullptr) {
-    for (int j = 0; j < n; ++j) {
-      for (int i = 0; i < m; ++i) {
-        const float* mask = epilogue.mask != nullptr ? epilogue.mask + elem(i, j) : nullptr;
-        c.data[elem(i, j)] = Activate(c.data[elem(i, j)], epilogue.relu, mask);
-      }
-    }
-  }
-}
 
 // Rows [i0, i0 + rows) of a, columns [j0, j0 + cols) of b, and that block of c.
 ConstView Rows(const ConstView& a, int i0, int rows) {
@@ -629,17 +33,33 @@ Vector* TaskWorkspace() {
   return &workspace;
 }
 
-// Splits an m x n result (at least kMaxMr rows) of `work` multiply-adds over the threads and
-// calls piece(i0, rows, j0, cols, workspace) for each block: by whole panels of rows when there
-// are at least two full ones (every block then holds a full panel, the last one also the ragged
-// rest), otherwise by blocks of kNr columns. Every block then takes PanelGemm() with the same
-// panels and the same order of operations per element as the whole product, so the results do
-// not depend on the split. A single piece runs directly with `workspace`.
+// The kernel that computes a product in `precision`: its functions and its blocking.
+struct Product {
+  GemmFn gemm;
+  GemmPackedFn gemm_packed;
+  int panel_rows;
+  int nr;
+};
+
+Product ProductFor(const KernelSet& set, Precision precision) {
+  if (precision == Precision::kBf16 && set.gemm_bf16 != nullptr) {
+    return {set.gemm_bf16, set.gemm_packed_bf16, set.bf16_panel_rows, set.bf16_nr};
+  }
+  return {set.gemm, set.gemm_packed, set.panel_rows, set.nr};
+}
+
+// Splits an m x n result (at least one panel of rows) of `work` multiply-adds over the threads
+// and calls piece(i0, rows, j0, cols, workspace) for each block: by whole panels of rows when
+// there are at least two full ones (every block then holds a full panel, the last one also the
+// ragged rest), otherwise by blocks of nr columns. Every block then takes the kernel with the
+// same panels and the same order of operations per element as the whole product, so the results
+// do not depend on the split. A single piece runs directly with `workspace`.
 template <class F>
-void SplitResult(int m, int n, int64_t work, Vector* workspace, const F& piece) {
-  const int full_panels = m / kMaxMr;
+void SplitResult(const Product& kernel, int m, int n, int64_t work, Vector* workspace,
+                 const F& piece) {
+  const int full_panels = m / kernel.panel_rows;
   const bool by_rows = full_panels >= 2;
-  const int units = by_rows ? full_panels : n / kNr;
+  const int units = by_rows ? full_panels : n / kernel.nr;
   const int tasks = TasksFor(work, units);
   if (tasks <= 1) return piece(0, m, 0, n, workspace);
   ParallelFor(tasks, [&](int task) {
@@ -648,54 +68,144 @@ void SplitResult(int m, int n, int64_t work, Vector* workspace, const F& piece) 
     const bool last = task == tasks - 1;
     Vector* ws = task == 0 ? workspace : TaskWorkspace();
     if (by_rows) {
-      const int i0 = u0 * kMaxMr;
-      piece(i0, (last ? m : u1 * kMaxMr) - i0, 0, n, ws);
+      const int i0 = u0 * kernel.panel_rows;
+      piece(i0, (last ? m : u1 * kernel.panel_rows) - i0, 0, n, ws);
     } else {
-      const int j0 = u0 * kNr;
-      piece(0, m, j0, (last ? n : u1 * kNr) - j0, ws);
+      const int j0 = u0 * kernel.nr;
+      piece(0, m, j0, (last ? n : u1 * kernel.nr) - j0, ws);
     }
   });
 }
 
+// bf16 without the CPU's instructions: copies of the operands rounded to bfloat16, which the
+// fp32 kernels then multiply. Each copy is column-major; the buffers are the calling thread's.
+struct RoundedCopies {
+  Vector a;
+  Vector b;
+};
+RoundedCopies* EmulationBuffers() {
+  thread_local RoundedCopies buffers;
+  return &buffers;
+}
+
+ConstView RoundedCopy(const ConstView& v, Vector* buffer) {
+  const int64_t size = static_cast<int64_t>(v.rows) * v.cols;
+  if (buffer->size() < size) buffer->resize(size);
+  float* out = buffer->data();
+  for (int j = 0; j < v.cols; ++j) {
+    const float* col = v.data + j * v.col_stride;
+    for (int i = 0; i < v.rows; ++i)
+      out[i + static_cast<int64_t>(j) * v.rows] = RoundToBf16(col[i * v.row_stride]);
+  }
+  return {out, v.rows, v.cols, 1, v.rows};
+}
+
+// Whether a product in bf16 has its inputs rounded (nn/precision.h): not those without a shared
+// dimension, with at most 4 rows and contiguous columns of B (dot products), or with fewer rows
+// than 16 and more columns than rows; the kernels compute those in fp32.
+bool Bf16Applies(const ConstView& a, const ConstView& b, const MutView& c) {
+  const int m = c.rows;
+  const int n = c.cols;
+  return a.cols > 0 && !(m <= 4 && b.row_stride == 1) && !(m < 16 && n > m);
+}
+
 }  // namespace
 
+bool PreferGemm(int m, int n, int k) {
+  constexpr int kLanes = 8;
+  return n >= 2 && (m >= kLanes || n >= kLanes) && static_cast<int64_t>(m) * n * k >= 8192;
+}
+
+int PackedPanelRows(Precision precision) { return ProductFor(Kernels(), precision).panel_rows; }
+
 void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& epilogue,
-          Vector* workspace) {
+          Vector* workspace, Precision precision) {
   RL_CHECK(a.cols == b.rows && a.rows == c.rows && b.cols == c.cols)
       << "Gemm shapes: (" << a.rows << "x" << a.cols << ") * (" << b.rows << "x" << b.cols
       << ") -> (" << c.rows << "x" << c.cols << ")";
+  const KernelSet& set = Kernels();
+  if (precision == Precision::kBf16 && !Bf16Applies(a, b, c)) precision = Precision::kFp32;
+  if (precision == Precision::kBf16 && set.gemm_bf16 == nullptr) {
+    RoundedCopies* copies = EmulationBuffers();
+    return Gemm(RoundedCopy(a, &copies->a), RoundedCopy(b, &copies->b), c, accumulate, epilogue,
+                workspace, Precision::kFp32);
+  }
+  const Product kernel = ProductFor(set, precision);
   const int m = c.rows;
   const int n = c.cols;
   const int k = a.cols;
-  // Products with fewer rows take other paths than PanelGemm(); they are not split.
-  if (m < kMaxMr || n == 0 || k == 0) {
-    return GemmOneThread(a, b, c, accumulate, epilogue, workspace);
+  // Products with fewer rows than a panel take other paths than the panels; they are not split.
+  if (m < kernel.panel_rows || n == 0 || k == 0) {
+    return kernel.gemm(a, b, c, accumulate, epilogue, workspace);
   }
-  SplitResult(m, n, static_cast<int64_t>(m) * n * k, workspace,
+  SplitResult(kernel, m, n, static_cast<int64_t>(m) * n * k, workspace,
               [&](int i0, int rows, int j0, int cols, Vector* ws) {
-                GemmOneThread(Rows(a, i0, rows), Cols(b, j0, cols), Part(c, i0, rows, j0, cols),
-                              accumulate, ShiftEpilogue(epilogue, c, i0, j0), ws);
+                kernel.gemm(Rows(a, i0, rows), Cols(b, j0, cols), Part(c, i0, rows, j0, cols),
+                            accumulate, ShiftEpilogue(epilogue, c, i0, j0), ws);
               });
 }
 
 void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, bool accumulate,
-                const Epilogue& epilogue, Vector* workspace) {
+                const Epilogue& epilogue, Vector* workspace, Precision precision) {
   RL_CHECK(k == b.rows && m == c.rows && b.cols == c.cols)
       << "GemmPacked shapes: (" << m << "x" << k << ") * (" << b.rows << "x" << b.cols << ") -> ("
       << c.rows << "x" << c.cols << ")";
+  const KernelSet& set = Kernels();
   const int n = c.cols;
   if (m == 0 || n == 0) return;
-  if (k == 0) return Gemm({a_packed, m, 0, 1, m}, b, c, accumulate, epilogue, workspace);
-  if (m < kMaxMr) {
-    return PanelGemm({nullptr, m, k, 0, 0}, b, c, accumulate, epilogue, workspace, a_packed);
+  const Product kernel = ProductFor(set, precision);
+  const int rows_per_panel = kernel.panel_rows;
+  if (k == 0) {
+    return Gemm({a_packed, m, 0, 1, m}, b, c, accumulate, epilogue, workspace, precision);
   }
-  // A block of rows starting at i0 (a whole number of panels) starts at panel i0 / kMaxMr.
-  SplitResult(m, n, static_cast<int64_t>(m) * n * k, workspace,
+  if (precision == Precision::kBf16 && set.gemm_bf16 == nullptr) {
+    // The packed operand rounded whole (its padding rows too), then the fp32 kernel.
+    RoundedCopies* copies = EmulationBuffers();
+    const int64_t size =
+        static_cast<int64_t>((m + rows_per_panel - 1) / rows_per_panel) * rows_per_panel * k;
+    if (copies->a.size() < size) copies->a.resize(size);
+    std::transform(a_packed, a_packed + size, copies->a.data(), RoundToBf16);
+    return GemmPacked(copies->a.data(), m, k, RoundedCopy(b, &copies->b), c, accumulate, epilogue,
+                      workspace, Precision::kFp32);
+  }
+  if (m < rows_per_panel) {
+    return kernel.gemm_packed(a_packed, m, k, b, c, accumulate, epilogue, workspace);
+  }
+  // A block of rows starting at i0 (a whole number of panels) starts at panel i0 / R.
+  SplitResult(kernel, m, n, static_cast<int64_t>(m) * n * k, workspace,
               [&](int i0, int rows, int j0, int cols, Vector* ws) {
-                PanelGemm({nullptr, rows, k, 0, 0}, Cols(b, j0, cols), Part(c, i0, rows, j0, cols),
-                          accumulate, ShiftEpilogue(epilogue, c, i0, j0), ws,
-                          a_packed + static_cast<int64_t>(i0) * k);
+                kernel.gemm_packed(a_packed + static_cast<int64_t>(i0) * k, rows, k,
+                                   Cols(b, j0, cols), Part(c, i0, rows, j0, cols), accumulate,
+                                   ShiftEpilogue(epilogue, c, i0, j0), ws);
               });
+}
+
+int64_t PackedPairs(int m, int k) {
+  const int rows = PackedPanelRows(Precision::kBf16);
+  return static_cast<int64_t>((m + rows - 1) / rows) * rows * ((k + 1) / 2);
+}
+
+void GemmPackedPairs(const uint32_t* a_pairs, int m, int k, ConstView b, MutView c, bool accumulate,
+                     const Epilogue& epilogue, Vector* workspace) {
+  RL_CHECK(k == b.rows && m == c.rows && b.cols == c.cols && k > 0)
+      << "GemmPackedPairs shapes: (" << m << "x" << k << ") * (" << b.rows << "x" << b.cols
+      << ") -> (" << c.rows << "x" << c.cols << ")";
+  const KernelSet& set = Kernels();
+  RL_CHECK(set.gemm_pairs_bf16 != nullptr) << "GemmPackedPairs on the " << set.name << " path";
+  const int n = c.cols;
+  if (m == 0 || n == 0) return;
+  const Product kernel = ProductFor(set, Precision::kBf16);
+  const int64_t pairs_per_row = (k + 1) / 2;
+  SplitResult(kernel, m, n, static_cast<int64_t>(m) * n * k, workspace,
+              [&](int i0, int rows, int j0, int cols, Vector* ws) {
+                set.gemm_pairs_bf16(a_pairs + i0 * pairs_per_row, rows, k, Cols(b, j0, cols),
+                                    Part(c, i0, rows, j0, cols), accumulate,
+                                    ShiftEpilogue(epilogue, c, i0, j0), ws);
+              });
+}
+
+void AddRowSums(const Matrix& g, float* out) {
+  Kernels().add_row_sums(g.data(), static_cast<int>(g.rows()), static_cast<int>(g.cols()), out);
 }
 
 }  // namespace rl::nn::internal

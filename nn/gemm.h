@@ -2,16 +2,22 @@
 // API.
 //
 // Eigen's general product reaches about 70 GFLOP/s on the 84x120 by 120x128 products of the DQN
-// MLP (about 36 us each); this kernel about 95 (about 26 us). It packs panels of up to 24 rows of
-// the left operand and keeps a 24 x 8 block of the result in registers (16 x 6 without AVX-512)
+// MLP (about 36 us each); this kernel about 95 (about 26 us) with 8-float vectors. It packs panels
+// of up to 48 rows of the left operand and keeps a 48 x 8 block of the result in registers (16 x 6
+// on the avx2 path)
 // while it walks the shared dimension; products with at most 4 rows are computed as dot products
 // instead. Transposed operands are read through strides, so no transposed copy of a weight or
 // activation matrix is made, and the bias and a ReLU (or a ReLU's backward mask) are applied as
-// results are stored.
+// results are stored. In bf16 (nn/precision.h) both operands are rounded to bfloat16 as they are
+// packed, pairs of them along the shared dimension, and the AVX512_BF16 kernel keeps a 48 x 8
+// block of fp32 sums in registers; without AVX512_BF16 the rounding is done on copies of the
+// operands and the fp32 kernel multiplies them. The kernels are those of the path in use
+// (nn/kernels.h).
 #pragma once
 
 #include <cstdint>
 
+#include "nn/precision.h"
 #include "nn/tensor.h"
 
 namespace rl::nn::internal {
@@ -59,31 +65,38 @@ struct Epilogue {
   const float* mask = nullptr;
 };
 
-/// Rows per packed panel of the left operand (see GemmPacked()).
-#if defined(__AVX512F__)
-constexpr int kPanelRows = 24;
-#elif defined(__AVX__)
-constexpr int kPanelRows = 16;
-#else
-constexpr int kPanelRows = 8;
-#endif
+/// Rows per packed panel of the left operand of GemmPacked() in `precision` on the current path
+/// (see GemmPacked()).
+int PackedPanelRows(Precision precision);
 
-/// c = a * b (accumulate == false) or c += a * b (accumulate == true), followed by `epilogue`.
-/// `c` must not overlap `a`, `b` or the mask. `workspace` is scratch space; it only grows, so
-/// repeated calls with the same shapes do not allocate. O(m n k). With SetNumThreads(n > 1)
-/// (nn/parallel.h) a large product (at least 24 rows and 8M multiply-adds) is split into blocks of
-/// whole 24-row panels (or of columns) over the threads, with the same result bit for bit; the
-/// other threads use their own scratch space.
+/// c = a * b (accumulate == false) or c += a * b (accumulate == true), followed by `epilogue`,
+/// the products in `precision`. `c` must not overlap `a`, `b` or the mask. `workspace` is scratch
+/// space; it only grows, so repeated calls with the same shapes do not allocate. O(m n k). With
+/// SetNumThreads(n > 1) (nn/parallel.h) a large product (at least one panel of rows and 8M
+/// multiply-adds) is split into blocks of whole panels of rows (or of columns) over the threads,
+/// with the same result bit for bit; the other threads use their own scratch space.
 void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& epilogue,
-          Vector* workspace);
+          Vector* workspace, Precision precision = Precision::kFp32);
 
 /// As Gemm() for an m x k left operand that the caller has already packed (e.g. unfolded into
-/// place by a convolution): rows [q * kPanelRows, (q + 1) * kPanelRows) are at
-/// a_packed + q * kPanelRows * k, as k steps of kPanelRows floats (row i of the panel at step p
-/// is a_packed[q * kPanelRows * k + p * kPanelRows + i]). Rows past m in the last panel are read
-/// but do not affect c. O(m n k). Split over threads as Gemm().
+/// place by a convolution), in panels of R = PackedPanelRows(precision) rows: rows
+/// [q * R, (q + 1) * R) are at a_packed + q * R * k, as k steps of R floats (row i of the panel at
+/// step p is a_packed[q * R * k + p * R + i]). Rows past m in the last panel are read but do not
+/// affect c. O(m n k). Split over threads as Gemm().
 void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, bool accumulate,
-                const Epilogue& epilogue, Vector* workspace);
+                const Epilogue& epilogue, Vector* workspace,
+                Precision precision = Precision::kFp32);
+
+/// The layout GemmPackedPairs() reads: the rows of an m x k left operand in panels of
+/// R = PackedPanelRows(Precision::kBf16) rows, each ceil(k / 2) steps of R 32-bit words; word i of
+/// step q of panel p holds the bfloat16 of A(p R + i, 2 q) in its low half and that of
+/// A(p R + i, 2 q + 1) (0 past k) in its high half. PackedPairs(m, k) words in all.
+int64_t PackedPairs(int m, int k);
+
+/// As GemmPacked() in bf16 for a left operand already rounded and packed as bf16 pairs (e.g.
+/// unfolded so by a convolution). Only where NativeBf16() (nn/precision.h); aborts elsewhere.
+void GemmPackedPairs(const uint32_t* a_pairs, int m, int k, ConstView b, MutView c, bool accumulate,
+                     const Epilogue& epilogue, Vector* workspace);
 
 /// out[i] += sum_j g(i, j) for a column-major g (the bias gradient of a batch). O(rows cols).
 void AddRowSums(const Matrix& g, float* out);

@@ -5,7 +5,8 @@
 // up to 128 outputs in AVX-512 registers while walking the columns of the column-major weight
 // (one broadcast and one fused multiply-add per 16 outputs and column) takes about a quarter of
 // that. Narrow layers (one register of outputs) split the columns over four independent chains
-// so that the multiply-add latency does not serialise them.
+// so that the multiply-add latency does not serialise them. On the avx2 path (nn/kernels.h) the
+// same column walk is left to the compiler's vectorisation. Always fp32.
 #pragma once
 
 namespace rl::nn::internal {

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "nn/precision.h"
 #include "nn/tensor.h"
 
 namespace rl::nn {
@@ -45,11 +46,15 @@ class Layer {
   /// the two (batch normalisation) care.
   virtual void set_training(bool /*training*/) {}
 
+  /// The arithmetic of the layer's matrix products (nn/precision.h), fp32 until set. Layers
+  /// without products ignore it; copies and Clone() keep it.
+  virtual void set_precision(Precision /*precision*/) {}
+
   /// The layer in architecture-string form, e.g. "linear(4,120)" or "relu".
   virtual std::string Describe() const = 0;
 
-  /// A deep copy of the parameters and buffers, in the same mode (gradients zero, no cached
-  /// activations, no fusion).
+  /// A deep copy of the parameters and buffers, in the same mode and precision (gradients zero,
+  /// no cached activations, no fusion).
   virtual std::unique_ptr<Layer> Clone() const = 0;
 
   /// Number of input features, or 0 if the layer accepts any (element-wise layers).

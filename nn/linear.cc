@@ -54,7 +54,7 @@ const Matrix& Linear::Forward(const Matrix& x) {
     epilogue.row_bias = bias_.data();
     epilogue.relu = fused_output_relu_;
     internal::Gemm(internal::View(weight_), internal::View(x), internal::View(&output_),
-                   /*accumulate=*/false, epilogue, &workspace_);
+                   /*accumulate=*/false, epilogue, &workspace_, precision_);
   } else {
     output_.noalias() = weight_ * x;
     output_.colwise() += bias_.col(0);
@@ -73,7 +73,7 @@ void Linear::AccumulateParamGrads(const Matrix& grad_out) {
   if (internal::PreferGemm(static_cast<int>(weight_.rows()), static_cast<int>(weight_.cols()),
                            static_cast<int>(x.cols()))) {
     internal::Gemm(internal::View(grad_out), internal::View(x).Transposed(),
-                   internal::View(&weight_grad_), /*accumulate=*/true, {}, &workspace_);
+                   internal::View(&weight_grad_), /*accumulate=*/true, {}, &workspace_, precision_);
   } else {
     weight_grad_.noalias() += grad_out * x.transpose();
   }
@@ -95,7 +95,8 @@ const Matrix& Linear::Backward(const Matrix& grad_out) {
     internal::Epilogue epilogue;
     if (fused_input_relu_grad_) epilogue.mask = x.data();
     internal::Gemm(internal::View(weight_).Transposed(), internal::View(grad_out),
-                   internal::View(&grad_input_), /*accumulate=*/false, epilogue, &workspace_);
+                   internal::View(&grad_input_), /*accumulate=*/false, epilogue, &workspace_,
+                   precision_);
   } else {
     grad_input_.noalias() = weight_.transpose() * grad_out;
     if (fused_input_relu_grad_) {
@@ -113,6 +114,10 @@ std::string Linear::Describe() const {
   return "linear(" + std::to_string(weight_.cols()) + "," + std::to_string(weight_.rows()) + ")";
 }
 
-std::unique_ptr<Layer> Linear::Clone() const { return std::make_unique<Linear>(weight_, bias_); }
+std::unique_ptr<Layer> Linear::Clone() const {
+  auto copy = std::make_unique<Linear>(weight_, bias_);
+  copy->precision_ = precision_;
+  return copy;
+}
 
 }  // namespace rl::nn

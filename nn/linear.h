@@ -47,6 +47,7 @@ class Linear : public Layer {
   /// gradient with respect to the ReLU's input, zero wherever this layer's input (the ReLU's
   /// output) is 0. Set by Sequential, which then skips the ReLU's Backward().
   void set_fused_input_relu_grad(bool on) { fused_input_relu_grad_ = on; }
+  void set_precision(Precision precision) override { precision_ = precision; }
   bool FuseOutputRelu() override {
     set_fused_output_relu(true);
     return true;
@@ -70,6 +71,7 @@ class Linear : public Layer {
   Vector workspace_;               // Scratch space of the product kernel.
   bool fused_output_relu_ = false;
   bool fused_input_relu_grad_ = false;
+  Precision precision_ = Precision::kFp32;
 };
 
 }  // namespace rl::nn

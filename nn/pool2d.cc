@@ -5,6 +5,32 @@
 #include "common/check.h"
 
 namespace rl::nn {
+namespace {
+
+// One output row of a 2 x 2 max pooling: rows r0 and r1 of the input, whose first pixel has index
+// `first`. The candidates are compared in the order of the general loop (row 0 then 1, column 0
+// then 1) and the first of equal maxima is kept, without branches, so that the compiler
+// vectorises the loop (the general loop compares one pixel at a time).
+void MaxPoolRow2(const float* __restrict r0, const float* __restrict r1, int width, int out_w,
+                 int first, float* __restrict out, int* __restrict arg) {
+  for (int ox = 0; ox < out_w; ++ox) {
+    float best = r0[2 * ox];
+    int at = 2 * ox;
+    const float b = r0[2 * ox + 1];
+    at = b > best ? 2 * ox + 1 : at;
+    best = b > best ? b : best;
+    const float c = r1[2 * ox];
+    at = c > best ? width + 2 * ox : at;
+    best = c > best ? c : best;
+    const float d = r1[2 * ox + 1];
+    at = d > best ? width + 2 * ox + 1 : at;
+    best = d > best ? d : best;
+    out[ox] = best;
+    arg[ox] = first + at;
+  }
+}
+
+}  // namespace
 
 Pool2d::Pool2d(Mode mode, int channels, int kernel, int height, int width)
     : mode_(mode), kernel_(kernel) {
@@ -40,6 +66,13 @@ const Matrix& Pool2d::Forward(const Matrix& x) {
     for (int c = 0; c < in_.channels; ++c) {
       const int plane = c * in_.height * in_.width;
       for (int oy = 0; oy < out_.height; ++oy) {
+        if (mode_ == Mode::kMax && kernel_ == 2) {
+          const int o = (c * out_.height + oy) * out_.width;
+          const int first = plane + 2 * oy * in_.width;
+          MaxPoolRow2(in + first, in + first + in_.width, in_.width, out_.width, first, out + o,
+                      arg + o);
+          continue;
+        }
         for (int ox = 0; ox < out_.width; ++ox) {
           const int o = (c * out_.height + oy) * out_.width + ox;
           const int first = plane + oy * kernel_ * in_.width + ox * kernel_;

@@ -11,7 +11,8 @@
 
 namespace rl::nn {
 
-Sequential::Sequential(const Sequential& other) : training_(other.training_) {
+Sequential::Sequential(const Sequential& other)
+    : training_(other.training_), precision_(other.precision_) {
   for (const auto& layer : other.layers_) Add(layer->Clone());
 }
 
@@ -65,6 +66,7 @@ void Sequential::Add(std::unique_ptr<Layer> layer) {
     fused_backward_[layers_.size() - 1] = true;
   }
   layer->set_training(training_);
+  layer->set_precision(precision_);
 
   const std::string prefix = std::to_string(layers_.size()) + ".";
   for (Param& p : layer->Params()) {
@@ -82,6 +84,11 @@ void Sequential::Add(std::unique_ptr<Layer> layer) {
   if (!architecture_.empty()) architecture_ += ",";
   architecture_ += layer->Describe();
   layers_.push_back(std::move(layer));
+}
+
+void Sequential::set_precision(Precision precision) {
+  precision_ = precision;
+  for (auto& layer : layers_) layer->set_precision(precision);
 }
 
 void Sequential::set_training(bool training) {

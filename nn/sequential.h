@@ -54,6 +54,11 @@ class Sequential {
   void set_training(bool training);
   bool training() const { return training_; }
 
+  /// The arithmetic of every layer's matrix products (nn/precision.h), fp32 until set; layers
+  /// added later take it too. Copies keep it.
+  void set_precision(Precision precision);
+  Precision precision() const { return precision_; }
+
   /// Runs the batch `x` (InputSize() x batch) through all layers and returns the last layer's
   /// output buffer (OutputSize() x batch), valid until the next Forward/Predict/Argmax. `x` must
   /// stay alive and unchanged until Backward() (see Layer).
@@ -135,6 +140,7 @@ class Sequential {
   int output_size_ = 0;
   ImageShape image_;  // Output shape of the last layer that produces images, if any since.
   bool training_ = true;
+  Precision precision_ = Precision::kFp32;
   Matrix observation_;  // The 1-column input of Predict().
   // Per layer: a ReLU whose output the preceding layer computes (Forward() only records it), or
   // null; and whether the following layer does its Backward().

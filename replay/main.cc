@@ -83,6 +83,9 @@ int Main(int argc, char** argv) {
        "RL_FLOW messages per second (and at once on every change)")  //
       ("stats-hz", po::value(&options.stats_hz)->default_value(options.stats_hz),
        "RL_STATS_REPLAY messages per second")  //
+      ("max-actors", po::value(&options.max_actors)->default_value(options.max_actors),
+       "actor ids stored: 0 .. max-actors - 1 (at most 1024); batches of other ids are refused "
+       "and counted")  //
       ("snapshot", po::value(&snapshots.path),
        "snapshot file: loaded at the start when it exists, written every --snapshot-every "
        "seconds and at the end (none: no snapshots)")  //
@@ -121,9 +124,10 @@ int Main(int argc, char** argv) {
   rl::replay::Snapshotter snapshotter(
       snapshots, rl::replay::ReplayService::kSnapshotKind,
       [&service](rl::StateStream* out) { return service.SaveSnapshot(out); },
-      [&service] {
+      [&service, &bus] {
+        // Any message taken moves the bus's positions, which the snapshot keeps.
         return service.total_inserts() + service.total_samples() +
-               service.counters().priorities_applied;
+               service.counters().priorities_applied + bus.counters().received;
       });
   std::printf("replay: ready\n");
   std::fflush(stdout);

@@ -72,6 +72,10 @@ void ReplayServiceOptions::Validate() const {
   require(beta_anneal_samples >= 0, "beta_anneal_samples", ">= 0", beta_anneal_samples);
   require(frame_capacity >= 0, "frame_capacity", ">= 0", frame_capacity);
   require(handle_timeout_ms >= 0, "handle_timeout_ms", ">= 0", handle_timeout_ms);
+  require(max_actors >= 1 && max_actors <= kMaxActorsLimit, "max_actors", "in [1, 1024]",
+          max_actors);
+  require(stop_quiet_ms >= 0, "stop_quiet_ms", ">= 0", stop_quiet_ms);
+  require(stop_drain_ms >= 0, "stop_drain_ms", ">= 0", stop_drain_ms);
 }
 
 ReplayService::ReplayService(Bus* bus, ReplayServiceOptions options)
@@ -116,7 +120,8 @@ void ReplayService::OnTransitions(const rlmsg::transition_batch_t& m) {
   // The bus has checked sizes and values; the env's action check comes next, then the table
   // checks what only it knows (observation size, geometry, action width, frame references).
   const char* why = nullptr;
-  if (options_.check_action) {
+  if (m.actor_id >= options_.max_actors) why = "actor_id not below max_actors";
+  if (why == nullptr && options_.check_action) {
     const auto width = static_cast<size_t>(m.action_width);
     for (size_t i = 0; why == nullptr && i < static_cast<size_t>(m.count); ++i) {
       why = options_.check_action(std::span<const float>(m.action).subspan(i * width, width));
@@ -397,6 +402,11 @@ void ReplayService::Run(const std::function<bool()>& should_stop) {
     bus_.Handle(options_.handle_timeout_ms);
     Serve();
     Tick();
+  }
+  // The actors stop at the same time and send their last steps: store them too, so that the
+  // last snapshot holds every step of theirs (a restarted actor takes its count from it).
+  const double drain_end = MonoSeconds() + options_.stop_drain_ms / 1000.0;
+  while (MonoSeconds() < drain_end && bus_.Handle(options_.stop_quiet_ms) > 0) {
   }
   // Leave a last word for the monitor, and the final counts in the log.
   const double now = MonoSeconds();

@@ -32,8 +32,9 @@
 //
 // Snapshots (replay_service_snapshot.cc): SaveSnapshot() describes the whole state a restarted
 // replay needs to serve as before (the table with its sampler, the limiter's counts, the
-// sampler's random generator, the per-actor insert counts, the service's counters; not the
-// pending requests, which their requesters send again) as a StateStream of kind
+// sampler's random generator, the per-actor insert counts, the service's counters, the bus's
+// last position of each sender, so that recorded traffic older than the snapshot stays refused;
+// not the pending requests, which their requesters send again) as a StateStream of kind
 // kSnapshotKind; RestoreSnapshot()/LoadSnapshot() load one into a fresh service.
 //
 // Not thread-safe: one thread constructs the service and calls every method; the bus must be
@@ -63,6 +64,9 @@
 #include "rlmsg/transition_batch_t.hpp"
 
 namespace rl::replay {
+
+/// The largest max_actors: the pixel table holds the frame windows of 1024 actors at most.
+inline constexpr int kMaxActorsLimit = 1024;
 
 struct ReplayServiceOptions {
   // Storage: capacity and observation size.
@@ -99,6 +103,15 @@ struct ReplayServiceOptions {
   double progress_seconds = 0.0;
   // Milliseconds Run() waits for traffic in each round.
   int handle_timeout_ms = 10;
+  // Actor ids stored: 0 .. max_actors - 1. A batch of another id is refused and counted, so that
+  // forged ids cannot grow the per-actor counts (and the flow messages and snapshots that carry
+  // them) without bound. At most kMaxActorsLimit.
+  int max_actors = 1024;
+  // When Run() is asked to stop, it goes on storing what arrives until nothing has for
+  // stop_quiet_ms (at most stop_drain_ms in all): the last batches of actors that stop at the
+  // same time (they flush their last steps) reach the last snapshot.
+  int stop_quiet_ms = 100;
+  int stop_drain_ms = 1000;
 
   /// Throws std::invalid_argument naming the field when a value is out of range.
   void Validate() const;
@@ -133,7 +146,8 @@ class ReplayService {
   void Tick() { Tick(MonoSeconds()); }
 
   /// Handles traffic, serves and ticks until should_stop() returns true (checked before each
-  /// round). Publishes a flow_control_t and a stats_replay_t before returning.
+  /// round), then stores what still arrives (options: stop_quiet_ms, stop_drain_ms). Publishes
+  /// a flow_control_t and a stats_replay_t before returning.
   void Run(const std::function<bool()>& should_stop);
 
   /// The flat table (empty when the run stores pixels).

@@ -1,7 +1,6 @@
 // ReplayService's snapshots: what a restarted replay needs to serve as before (see
 // replay_service.h).
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -13,8 +12,6 @@
 namespace rl::replay {
 namespace {
 
-// Most actors whose insert counts a snapshot may hold (actor ids are 16 bits in the tables).
-constexpr int64_t kMaxActors = 65536;
 // Largest count a snapshot may hold (far from overflow; 2^62 is ages of any run).
 constexpr int64_t kMaxCount = int64_t{1} << 62;
 
@@ -59,6 +56,9 @@ std::string ReplayService::SaveSnapshot(StateStream* out) const {
   } else {
     table_.Save("flat.", out);
   }
+  // The last message heard from each sender, so that a restarted replay refuses recorded traffic
+  // that this state already holds (common/lcm_bus.h).
+  out->PutText("bus_positions", bus_.SavePositions());
   return Summary();
 }
 
@@ -93,19 +93,25 @@ void ReplayService::Restore(const StateView& in) {
   }
   counters_ =
       ServiceCounters{counters[0], counters[1], counters[2], counters[3], counters[4], counters[5]};
-  const std::vector<int64_t> actors = in.Ints("actor_inserts", 2 * kMaxActors);
+  // The ids a running service stores (below max_actors), as it saved them.
+  const std::vector<int64_t> actors = in.Ints("actor_inserts", 2 * int64_t{kMaxActorsLimit});
   if (actors.size() % 2 != 0) throw std::runtime_error("section 'actor_inserts' is not pairs");
   actor_inserts_.clear();
   for (size_t k = 0; k < actors.size(); k += 2) {
-    if (actors[k] < std::numeric_limits<int32_t>::min() ||
-        actors[k] > std::numeric_limits<int32_t>::max() || actors[k + 1] < 0 ||
-        actors[k + 1] > kMaxCount) {
-      throw std::runtime_error("section 'actor_inserts' holds a bad actor id or count");
+    if (actors[k] < 0 || actors[k] >= options_.max_actors) {
+      throw std::runtime_error("section 'actor_inserts' holds actor id " +
+                               std::to_string(actors[k]) + ", this replay stores ids below " +
+                               std::to_string(options_.max_actors) + " (max-actors)");
+    }
+    if (actors[k + 1] < 0 || actors[k + 1] > kMaxCount) {
+      throw std::runtime_error("section 'actor_inserts' holds a bad count");
     }
     actor_inserts_[static_cast<int32_t>(actors[k])] = actors[k + 1];
   }
   insert_allowed_ = limiter_.CanInsert(options_.insert_unit);
   low_credit_ = limiter_.InsertCredit();
+  // Snapshots written before the bus kept positions have none.
+  if (in.Has("bus_positions")) bus_.LoadPositions(in.Text("bus_positions"));
 }
 
 void ReplayService::CheckFresh() const {

@@ -14,7 +14,14 @@
 #              the kuka_grasp launch that measures the whole pipeline's episodes per hour; 0 or
 #              --skip-goal: skip it), CAR_PIPELINE_SECONDS (300: the same for car_racing_td3, whose
 #              env steps are agent steps of 5 frames), TD3_SEEDS ("1": seeds of the Pendulum and
-#              LunarLanderContinuous runs to their goals), PEER_TD3 (1: run the peer's td3 mode).
+#              LunarLanderContinuous runs to their goals), PEER_TD3 (1: run the peer's td3 mode),
+#              BENCHES ("env actor learner replay cnn kuka": which of our benchmarks run),
+#              PEER_BF16 (1: also run the peer's update modes with --precision bf16, torch's CPU
+#              autocast, for the bf16 rows of ours), RL_BENCH_CLOCK (cpu: our one-thread rates
+#              per CPU second, for a shared machine; the peer's stay per wall second).
+# Our learner and network rows come in fp32 and bf16 ("precision"); each gains "peer" and
+# "ratio" against the peer in the same precision, and "peer_fp32", "ratio_vs_peer_fp32",
+# "peer_bf16", "ratio_vs_peer_bf16" against both.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
@@ -48,16 +55,21 @@ isolated() {
 
 ours="$work/ours.jsonl"
 echo "bench: ours" >&2
-"$bin/bench_env" "$repeats" "$seconds" >> "$ours"
-"$bin/bench_actor" "$repeats" "$seconds" >> "$ours"
-"$bin/bench_learner" "$repeats" "$seconds" >> "$ours"
-isolated "$bin/bench_replay" "$repeats" "$seconds" >> "$ours"
-# Pixel networks (Nature and grasp CNN): updates/s, latency, convolution GFLOP/s, the FMA peak.
+benches=" ${BENCHES:-env actor learner replay cnn kuka} "
+wanted() { [[ "$benches" == *" $1 "* ]]; }
+if wanted env; then "$bin/bench_env" "$repeats" "$seconds" >> "$ours"; fi
+if wanted actor; then "$bin/bench_actor" "$repeats" "$seconds" >> "$ours"; fi
+if wanted learner; then "$bin/bench_learner" "$repeats" "$seconds" >> "$ours"; fi
+if wanted replay; then isolated "$bin/bench_replay" "$repeats" "$seconds" >> "$ours"; fi
+# Pixel networks (Nature and grasp CNN): updates/s, latency, convolution GFLOP/s, the FMA and
+# bf16 peaks; the CarRacing actors' latency.
 cnn_threads=${CNN_THREADS:-1,2}
-"$bin/bench_cnn" "${CNN_REPEATS:-$repeats}" "${CNN_SECONDS:-$seconds}" "$cnn_threads" >> "$ours"
+if wanted cnn; then
+  "$bin/bench_cnn" "${CNN_REPEATS:-$repeats}" "${CNN_SECONDS:-$seconds}" "$cnn_threads" >> "$ours"
+fi
 # KUKA grasping (Bullet, OSMesa at 48x48, one llvmpipe thread): rendered frames/s, physics and
 # env steps/s and episodes per hour of one actor (per CPU second), oracle and random success.
-"$bin/kuka_probe" --json --episodes "${KUKA_EPISODES:-20}" >> "$ours"
+if wanted kuka; then "$bin/kuka_probe" --json --episodes "${KUKA_EPISODES:-20}" >> "$ours"; fi
 
 # Time from launch to goal for CartPole, start-up and evaluation included.
 if [ "$skip_goal" -eq 0 ]; then
@@ -177,6 +189,18 @@ if [ "$skip_peer" -eq 0 ] && [ -f "$peer_dir/micro.py" ] && "$py" -c 'import tor
         >> "$peer"
     done
   fi
+  if [ "${PEER_BF16:-1}" = 1 ]; then
+    for r in $(seq "${PEER_REPEATS:-3}"); do
+      echo "bench: peer micro bf16 (mlp, td3; one thread), repeat $r" >&2
+      (cd "$peer_dir" && "$py" micro.py --only mlp,td3 --threads 1 --min-time 2 --precision bf16 \
+        --tag "bf16-r$r") >> "$peer"
+      if [ "${PEER_CNN:-1}" = 1 ]; then
+        echo "bench: peer micro bf16 CNN (nature, small; threads $cnn_threads), repeat $r" >&2
+        (cd "$peer_dir" && "$py" micro.py --only nature,small --threads "$cnn_threads" \
+          --min-time 2 --precision bf16 --tag "bf16-cnn-r$r") >> "$peer"
+      fi
+    done
+  fi
   if [ "${PEER_DQN:-1}" = 1 ] && [ "$skip_goal" -eq 0 ]; then
     echo "bench: peer DQN on CartPole (500,000 steps)" >&2
     start=$(date +%s.%N)
@@ -217,20 +241,37 @@ match = {
                                      and p.get("net") == "nature_cnn"
                                      and p.get("threads") == o.get("threads"), "lower", 1e-3),
 }
-peaks = [o["value"] for o in ours if o["bench"] == "peak_fp32_gflops" and o.get("threads", 1) == 1]
+def peak(name):
+    values = [o["value"] for o in ours if o["bench"] == name and o.get("threads", 1) == 1]
+    return values[0] if values else None
+peaks = {"fp32": peak("peak_fp32_gflops"), "bf16": peak("peak_bf16_gflops")}
+def peer_median(m, o, precision):
+    """The peer's median for our line o in `precision` (the peer's fp32 lines have none)."""
+    lines = [l for l in peer_lines(m[0](o)) if l.get("precision", "fp32") == precision]
+    if not lines:
+        return None, lines
+    return statistics.median([l["rate"] for l in lines]) * (m[2] if len(m) > 2 else 1), lines
 for o in ours:
-    if "gflops" in o and peaks:
-        o["fraction_of_peak"] = round(float(o["gflops"]) / peaks[0], 3)
+    precision = o.get("precision", "fp32")
+    if "gflops" in o and peaks.get(precision):
+        o["fraction_of_peak"] = round(float(o["gflops"]) / peaks[precision], 3)
+        o["peak_used"] = "peak_%s_gflops" % precision
     m = match.get(o["bench"])
     if m:
-        lines = peer_lines(m[0](o))
-        if lines:
-            p = statistics.median([l["rate"] for l in lines]) * (m[2] if len(m) > 2 else 1)
-            o["peer"] = round(p, 6 if p < 1 else 3)
-            o["peer_repeats"] = len(lines)
-            if lines[0].get("blas"):
-                o["peer_blas"] = lines[0]["blas"]
-            o["ratio"] = round(o["value"] / p if m[1] == "higher" else p / o["value"], 2)
+        for peer_precision in ("fp32", "bf16"):
+            p, lines = peer_median(m, o, peer_precision)
+            if p is None:
+                continue
+            ratio = round(o["value"] / p if m[1] == "higher" else p / o["value"], 2)
+            o["peer_" + peer_precision] = round(p, 6 if p < 1 else 3)
+            o["ratio_vs_peer_" + peer_precision] = ratio
+            if peer_precision == precision:
+                o["peer"] = o["peer_" + peer_precision]
+                o["peer_repeats"] = len(lines)
+                if lines[0].get("blas"):
+                    o["peer_blas"] = lines[0]["blas"]
+                o["ratio"] = ratio
+        if "peer" in o:
             if o["bench"] == "cartpole_time_to_goal":
                 o["peer_note"] = "wall time of the peer's full 500,000-step CleanRL DQN run"
             if o["bench"].startswith("inference_latency_"):

@@ -15,8 +15,9 @@
 #   --no-build        use the binaries in DIR as they are
 #   -- ARGS...        passed to libFuzzer (e.g. -- -fork=2 -max_len=4096)
 #
-# Builds the fuzz targets (only them) with CC=clang-14 CXX=clang++-14 -DRL_FUZZ=ON unless
-# --no-build. Each target starts from its committed corpus fuzz/corpus/TARGET/ (only read) and
+# Builds the fuzz targets (only them) unless --no-build, configuring DIR from the preset "fuzz"
+# (CMakePresets.json: clang-14, -DRL_FUZZ=ON) when it has no build yet. The preset "asan" builds
+# them too, beside the tests (what scripts/test.sh runs: --build-dir build-asan). Each target starts from its committed corpus fuzz/corpus/TARGET/ (only read) and
 # its dictionary fuzz/dict/TARGET.dict; new inputs, crash files and the log go to
 # DIR/fuzz-runs/TARGET/{corpus,artifacts,log} (the next run starts from both corpora). A
 # target's line says how long it ran, its executions and coverage, or what it found and how to
@@ -51,9 +52,7 @@ if [ "$build" -eq 1 ]; then
   if [ ! -f "$build_dir/CMakeCache.txt" ]; then
     werror=OFF
     [ "${CI:-}" = "true" ] && werror=ON
-    CC=clang-14 CXX=clang++-14 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-      -DRL_FUZZ=ON -DRL_BUILD_TESTS=OFF -DRL_BUILD_BENCH=OFF -DRL_SKIP="actor;evaluator;tools" \
-      -DRL_WARNINGS_AS_ERRORS="$werror" >/dev/null
+    cmake --preset fuzz -B "$build_dir" -DRL_WARNINGS_AS_ERRORS="$werror" >/dev/null
   fi
   cmake --build "$build_dir" --target fuzz -j"$(nproc)"
 fi

@@ -24,10 +24,13 @@ done
 packages=(
   build-essential cmake pkg-config git
   liblcm-dev liblcm-bin liblcm-java libglib2.0-dev libjchart2d-java openjdk-17-jdk-headless
-  libeigen3-dev libboost-program-options-dev libgtest-dev libssl-dev
+  libeigen3-dev libboost-program-options-dev libgtest-dev libssl-dev nlohmann-json3-dev
   libbox2d-dev libbullet-dev libopencv-dev libosmesa6-dev
   clang-14 libclang-rt-14-dev llvm-14  # fuzz/: clang, libFuzzer and sanitizers, symbolizer
+  clang-tidy-14  # scripts/tidy.sh
   iproute2 util-linux procps
+  qemu-user  # tests/nn/haswell_test.sh: the binaries on a CPU without AVX-512
+  slurm-wlm munge  # tests/cluster: a Slurm cluster in namespaces for the cluster tests
   chromium  # headless: the integration test that renders the report and compare pages
 )
 missing=()

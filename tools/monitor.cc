@@ -7,7 +7,9 @@
 // (tools/metrics_log.h).
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -34,6 +36,10 @@ using rl::Thousands;
 struct View {
   std::map<std::string, rlmsg::stats_actor_t> actors;  // by sender
   std::map<std::string, double> actor_seen;
+  // The largest step count each actor showed: a restarted actor takes its count up from the
+  // replay (actor/actor.h), which may lack the batch it had on the way when it died, so the
+  // total never goes back.
+  std::map<std::string, int64_t> actor_steps;
   rlmsg::stats_replay_t replay{};
   rlmsg::stats_learner_t learner{};
   rlmsg::stats_evaluator_t evaluator{};
@@ -68,7 +74,7 @@ std::string ProgressLine(const View& v, double elapsed, double now, int64_t rest
   double ret = 0;
   int live = 0, paused = 0;
   for (const auto& [name, a] : v.actors) {
-    steps += a.env_steps;
+    steps += v.actor_steps.at(name);
     episodes += a.episodes;
     lost += a.lost;
     dropped += rl::Dropped(a);
@@ -112,7 +118,9 @@ int Main(int argc, char** argv) {
       ("time-budget", rl::po::value(&time_budget)->default_value(time_budget),
        "seconds after which the run ends unsolved")  //
       ("stale-seconds", rl::po::value(&stale_seconds)->default_value(stale_seconds),
-       "a replay, learner or evaluator silent this long ends the run")  //
+       "a replay, learner or evaluator silent this long ends the run (the launcher passes its "
+       "longest restart backoff plus the time a restarted process has to get ready, plus 5 s, "
+       "so that a process being restarted is not taken for one that hangs)")  //
       ("print-seconds", rl::po::value(&print_seconds)->default_value(print_seconds),
        "seconds between progress lines")  //
       ("metrics", rl::po::value(&metrics_path),
@@ -138,6 +146,8 @@ int Main(int argc, char** argv) {
                                       [&v](const rlmsg::stats_actor_t& s) {
                                         v.actors[s.header.sender] = s;
                                         v.actor_seen[s.header.sender] = rl::MonoSeconds();
+                                        int64_t& steps = v.actor_steps[s.header.sender];
+                                        steps = std::max(steps, s.env_steps);
                                       });
   bus.Subscribe<rlmsg::stats_replay_t>(rl::channels::kStatsReplay,
                                        [&v](const rlmsg::stats_replay_t& s) {

@@ -196,6 +196,104 @@ TEST_F(ActorTest, RefusesWeightsOfANetworkThatDoesNotFitTheEnv) {
   EXPECT_EQ(actor.weights_version(), 2);
 }
 
+// Chunks that claim a buffer other than the network the actor built (here 256 MB for a network
+// of 58 floats) are refused before anything is allocated for them.
+TEST_F(ActorTest, RefusesWeightsChunksOfAnotherSizeThanItsNetwork) {
+  Actor actor(config_, &bus_);
+  std::mt19937 rng(1);
+  nn::Sequential net = nn::MakeMlp(4, {8}, 2, &rng);
+  std::vector<float> flat;
+  net.GetFlat(&flat);
+  for (auto& c : learner::MakeWeightChunks(1, net.Architecture(), flat)) {
+    bus_.Publish(channels::kWeights, &c, Port::kBulk);
+  }
+  bus_.Handle(0);
+  ASSERT_EQ(actor.weights_version(), 1);
+  rlmsg::weights_chunk_t huge = learner::MakeWeightChunks(2, net.Architecture(), flat)[0];
+  huge.total_size = 1 << 26;
+  huge.num_chunks = 1 << 14;
+  bus_.Publish(channels::kWeights, &huge, Port::kBulk);
+  // As many chunks as floats, each with one float: absurd, refused as well.
+  rlmsg::weights_chunk_t many = learner::MakeWeightChunks(3, net.Architecture(), flat)[0];
+  many.num_chunks = many.total_size + 1;
+  bus_.Publish(channels::kWeights, &many, Port::kBulk);
+  bus_.Handle(0);
+  EXPECT_EQ(bus_.counters().invalid, 0) << "the bus let them through: the actor refused them";
+  EXPECT_EQ(actor.weights_refused(), 2);
+  EXPECT_EQ(actor.weights_version(), 1);
+}
+
+// A restarted actor, or an actor of a resumed run, takes up its step count from the replay's
+// first flow message before it acts: the transitions stored from its id, one per step of its
+// earlier lives. Its exploration schedule continues from there (here: past the random start,
+// sigma annealed), and its count never goes back.
+TEST_F(ActorTest, TakesUpItsStepCountFromTheReplayBeforeItActs) {
+  std::vector<rlmsg::stats_actor_t> stats;
+  bus_.Subscribe<rlmsg::stats_actor_t>(
+      channels::kStatsActor, [&stats](const rlmsg::stats_actor_t& s) { stats.push_back(s); });
+  config_.env_id = "Pendulum-v1";
+  config_.actor_id = 1;
+  config_.num_actors = 2;
+  config_.n_step = 1;
+  ExplorationConfig& e = config_.exploration;
+  e.mode = "gaussian";
+  e.start_steps = 500;
+  e.sigma = 0.5;
+  e.sigma_end = 0.1;
+  e.sigma_anneal_steps = 1000;
+  Actor actor(config_, &bus_);
+  EXPECT_FALSE(actor.count_taken_up());
+  EXPECT_DOUBLE_EQ(actor.exploration(), 1.0);  // as a fresh actor: the random start
+  rlmsg::flow_control_t f{};
+  f.insert_allowed = 1;
+  f.insert_credit = 64;  // a share of 32
+  f.num_actors = 2;
+  f.actor_id = {0, 1};
+  f.actor_inserts = {900, 700};
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  ASSERT_TRUE(actor.count_taken_up());
+  EXPECT_EQ(actor.env_steps(), 700);
+  EXPECT_EQ(actor.published(), 700);
+  EXPECT_NEAR(actor.exploration(), 0.5 + (0.1 - 0.5) * 0.7, 1e-12);
+  // Nothing of its own is on the way: its whole share is free.
+  EXPECT_EQ(actor.insert_limit(), 700 + 32);
+  while (!actor.paused()) actor.StepEnvs();
+  EXPECT_EQ(actor.env_steps(), 732);
+  // A replay restarted from an older snapshot holds fewer: the count does not go back.
+  f.actor_inserts = {900, 650};
+  bus_.Publish(channels::kFlow, &f);
+  bus_.Handle(0);
+  EXPECT_EQ(actor.env_steps(), 732);
+  actor.PublishStats();
+  bus_.Handle(0);
+  ASSERT_FALSE(stats.empty());
+  EXPECT_EQ(stats.back().env_steps, 732);
+  EXPECT_NEAR(stats.back().epsilon, 0.5 + (0.1 - 0.5) * 0.732, 1e-12);
+}
+
+// A stopping actor sends every step it took, the pending n-step returns as truncations, so that
+// the replay's count of its transitions is its step count.
+TEST_F(ActorTest, SendsEveryStepItTookWhenItStops) {
+  config_.n_step = 3;
+  config_.max_steps = 50;
+  Actor actor(config_, &bus_);
+  rlmsg::flow_control_t f{};
+  f.insert_allowed = 1;
+  f.insert_credit = -1;  // the ratio is not enforced
+  bus_.Publish(channels::kFlow, &f);
+  actor.Run();
+  bus_.Handle(0);
+  EXPECT_GE(actor.env_steps(), 50);
+  EXPECT_EQ(actor.published(), actor.env_steps());
+  int64_t received = 0;
+  for (const auto& b : batches_) received += b.count;
+  EXPECT_EQ(received, actor.env_steps());
+  // The last transition bootstraps from the last observation (a truncation, not a terminal).
+  ASSERT_FALSE(batches_.empty());
+  EXPECT_GT(batches_.back().discount.back(), 0.0f);
+}
+
 TEST_F(ActorTest, PublishesStatsWithItsCounters) {
   std::vector<rlmsg::stats_actor_t> stats;
   bus_.Subscribe<rlmsg::stats_actor_t>(

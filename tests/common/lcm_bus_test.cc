@@ -35,9 +35,12 @@ rlmsg::transition_batch_t MakeBatch(int count, int obs_size) {
   return m;
 }
 
+// Encoded as actor-1 of run 42 would send it now (a fresh time, an incarnation just before it).
 std::vector<uint8_t> Encode(rlmsg::transition_batch_t m) {
   m.header.run_id = 42;
   m.header.sender = "actor-1";
+  m.header.utime = WallMicros();
+  m.header.incarnation = m.header.utime - 1000;
   std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   return bytes;
@@ -74,6 +77,7 @@ TEST_F(BusTest, DropsAnotherRunsMessagesAsForeign) {
   rlmsg::transition_batch_t other = MakeBatch(2, 4);
   other.header.run_id = 43;
   other.header.sender = "actor-9";
+  other.header.utime = WallMicros();
   std::vector<uint8_t> foreign(static_cast<size_t>(other.getEncodedSize()));
   other.encode(foreign.data(), 0, static_cast<int>(foreign.size()));
   bus_.PublishRaw(channels::kTransitions, foreign.data(), foreign.size());
@@ -91,6 +95,7 @@ TEST_F(BusTest, DropsTruncatedAndForeignTypeBytesAsMalformed) {
   rlmsg::checkpoint_t ckpt{};  // a real message of another type
   ckpt.header.run_id = 42;
   ckpt.header.sender = "learner";
+  ckpt.header.utime = WallMicros();
   ckpt.path = "x";
   std::vector<uint8_t> other(static_cast<size_t>(ckpt.getEncodedSize()));
   ckpt.encode(other.data(), 0, static_cast<int>(other.size()));
@@ -142,6 +147,7 @@ TEST_F(BusTest, CountsSequenceGapsAsLost) {
     m.header.run_id = 42;
     m.header.sender = "actor-1";
     m.header.seq = seq;
+    m.header.utime = WallMicros();
     std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
     m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
     bus_.PublishRaw(channels::kTransitions, bytes.data(), bytes.size());
@@ -155,15 +161,16 @@ TEST_F(BusTest, CountsSequenceGapsAsLost) {
 // attacker, or a recording) would send them.
 const std::string kKey(kKeyBytes, 'k');
 
-// Encodes a one-transition batch of run 42 with the given header, signed with `key` (unless
-// empty).
+// Encodes a one-transition batch of run 42 from actor-2 with the given header (utime: now unless
+// given), signed with `key` (unless empty).
 std::vector<uint8_t> Stamped(int64_t incarnation, int64_t seq, const std::string& key,
-                             int64_t run_id = 42) {
+                             int64_t run_id = 42, int64_t utime = -1) {
   auto m = MakeBatch(1, 4);
   m.header.run_id = run_id;
   m.header.sender = "actor-2";
   m.header.incarnation = incarnation;
   m.header.seq = seq;
+  m.header.utime = utime < 0 ? WallMicros() : utime;
   std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   if (!key.empty()) {
@@ -252,6 +259,7 @@ TEST_F(KeyedBusTest, DropsAMessageSignedForAnotherChannel) {
   m.header.sender = "actor-2";
   m.header.incarnation = 1;
   m.header.seq = 0;
+  m.header.utime = WallMicros();
   std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   MessageAuthenticator auth(kKey);
@@ -345,6 +353,201 @@ TEST(BusOpenTest, ABadUrlThrowsWithTheUrlInTheMessage) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("nosuchprovider://"), std::string::npos);
   }
+}
+
+// The freshness window, the replay check and the saved positions, with receive times chosen by
+// the test (Bus::Deliver): messages of actor-2, signed, at times around t_ (now).
+constexpr int64_t kSecond = 1'000'000;
+
+class WindowTest : public ::testing::Test {
+ protected:
+  WindowTest() : bus_(Config()) { Watch(&bus_, &got_); }
+  static BusConfig Config() {
+    BusConfig c = MemqConfig(42, "replay");
+    c.key = kKey;
+    c.max_message_age = 60 * kSecond;
+    c.max_clock_skew = 10 * kSecond;
+    return c;
+  }
+  static void Watch(Bus* bus, std::vector<int64_t>* got) {
+    bus->Subscribe<rlmsg::transition_batch_t>(
+        channels::kTransitions,
+        [got](const rlmsg::transition_batch_t& m) { got->push_back(m.header.seq); });
+  }
+  // Delivers actor-2's message (incarnation, seq, utime) as received at `at`.
+  static void Send(Bus* bus, int64_t incarnation, int64_t seq, int64_t utime, int64_t at) {
+    const auto bytes = Stamped(incarnation, seq, kKey, 42, utime);
+    bus->Deliver(channels::kTransitions, bytes.data(), bytes.size(), at);
+  }
+  void Send(int64_t incarnation, int64_t seq, int64_t utime, int64_t at) {
+    Send(&bus_, incarnation, seq, utime, at);
+  }
+  const int64_t t_ = WallMicros();
+  Bus bus_;
+  std::vector<int64_t> got_;
+};
+
+TEST_F(WindowTest, DropsWhatIsOlderThanTheWindowOrAheadOfTheSkewAsStale) {
+  const int64_t inc = t_ - 3600 * kSecond;
+  Send(inc, 0, t_ - 61 * kSecond, t_);           // a minute and a second old
+  Send(inc, 1, t_ + 11 * kSecond, t_);           // 11 s ahead
+  Send(t_ + 10 * kSecond, 2, t_ - kSecond, t_);  // started 11 s after it was sent
+  EXPECT_EQ(bus_.counters().stale, 3);
+  Send(inc, 3, t_ - 59 * kSecond, t_);
+  Send(inc, 4, t_ + 9 * kSecond, t_);
+  Send(t_ + 5 * kSecond, 0, t_ - 4 * kSecond, t_);  // within the skew
+  EXPECT_EQ(got_, (std::vector<int64_t>{3, 4, 0}));
+  EXPECT_EQ(bus_.counters().stale, 3);
+  EXPECT_EQ(bus_.counters().dropped(), 3);
+  rlmsg::stats_learner_t stats{};
+  bus_.FillCounters(&stats);
+  EXPECT_EQ(stats.dropped_stale, 3);
+  EXPECT_EQ(Dropped(stats), 3);
+}
+
+// A holder of the key forges a message of actor-2 with a later incarnation, or a huge sequence
+// number: the real actor-2 is dropped as replayed only until the forged position ages out.
+TEST_F(WindowTest, AForgedLaterIncarnationOrSequenceSilencesItsSenderOnlyForTheWindow) {
+  const int64_t inc = t_ - 3600 * kSecond;
+  Send(inc, 0, t_, t_);
+  Send(t_ + 9 * kSecond, 0, t_ + 9 * kSecond, t_);  // forged: a later incarnation
+  Send(inc, 1, t_ + kSecond, t_ + kSecond);
+  Send(inc, 2, t_ + 69 * kSecond, t_ + 69 * kSecond);  // the forged one is 60 s old: not yet
+  EXPECT_EQ(bus_.counters().replayed, 2);
+  Send(inc, 3, t_ + 69 * kSecond + 1, t_ + 69 * kSecond + 1);
+  Send(inc, std::numeric_limits<int64_t>::max(), t_ + 70 * kSecond, t_ + 70 * kSecond);  // forged
+  Send(inc, 4, t_ + 71 * kSecond, t_ + 71 * kSecond);
+  Send(inc, 5, t_ + 130 * kSecond + 1, t_ + 130 * kSecond + 1);
+  EXPECT_EQ(got_, (std::vector<int64_t>{0, 0, 3, std::numeric_limits<int64_t>::max(), 5}));
+  EXPECT_EQ(bus_.counters().replayed, 3);
+}
+
+// What a restarted process loads from its state: recorded messages not newer than the saved
+// positions are replayed even inside the window, newer ones flow, and nothing counts as lost.
+TEST_F(WindowTest, SavedPositionsMakeARestartedBusRefuseRecordedTraffic) {
+  const int64_t old_inc = t_ - 7200 * kSecond, inc = t_ - 3600 * kSecond;
+  Send(old_inc, 0, t_ - 30 * kSecond, t_ - 30 * kSecond);
+  Send(inc, 0, t_ - 20 * kSecond, t_ - 20 * kSecond);
+  Send(inc, 1, t_ - 10 * kSecond, t_ - 10 * kSecond);
+  ASSERT_EQ(got_.size(), 3U);
+  const std::vector<StreamPosition> saved = bus_.Positions();
+  ASSERT_EQ(saved.size(), 1U);  // (the positions older than the window are left out)
+  EXPECT_EQ(saved[0].channel, channels::kTransitions);
+  EXPECT_EQ(saved[0].sender, "actor-2");
+  EXPECT_EQ(saved[0].incarnation, inc);
+  EXPECT_EQ(saved[0].seq, 1);
+  const std::string text = bus_.SavePositions();
+
+  // Restored before and after subscribing.
+  for (const bool before : {true, false}) {
+    SCOPED_TRACE(before ? "restored before subscribing" : "restored after subscribing");
+    Bus restarted(Config());
+    std::vector<int64_t> got;
+    if (before) restarted.LoadPositions(text);
+    Watch(&restarted, &got);
+    if (!before) restarted.LoadPositions(text);
+    Send(&restarted, old_inc, 0, t_ - 30 * kSecond, t_);  // the recording, played back
+    Send(&restarted, inc, 0, t_ - 20 * kSecond, t_);
+    Send(&restarted, inc, 1, t_ - 10 * kSecond, t_);
+    EXPECT_TRUE(got.empty());
+    EXPECT_EQ(restarted.counters().replayed, 3);
+    Send(&restarted, inc, 5, t_, t_);  // live: a gap since the save, not counted as lost
+    Send(&restarted, inc, 7, t_, t_);  // one lost
+    EXPECT_EQ(got, (std::vector<int64_t>{5, 7}));
+    EXPECT_EQ(restarted.counters().lost, 1);
+  }
+  // Without them (today's restart), the recording is taken.
+  Bus forgetful(Config());
+  std::vector<int64_t> got;
+  Watch(&forgetful, &got);
+  Send(&forgetful, inc, 0, t_ - 20 * kSecond, t_);
+  EXPECT_EQ(got.size(), 1U);
+}
+
+TEST_F(WindowTest, RestoringKeepsTheNewerOfTwoPositionsAndPositionsRoundTripAsText) {
+  Send(t_ - 100, 9, t_, t_);
+  bus_.RestorePositions({{channels::kTransitions, "actor-2", t_ - 100, 3, t_},
+                         {channels::kTransitions, "actor-7", t_ - 50, 2, t_},
+                         {"RL_ELSEWHERE", "learner", 5, 6, t_}});
+  const auto positions = bus_.Positions();
+  ASSERT_EQ(positions.size(), 3U);
+  EXPECT_EQ(positions[0].channel, "RL_ELSEWHERE");  // no subscription: kept as restored
+  EXPECT_EQ(positions[1].sender, "actor-2");
+  EXPECT_EQ(positions[1].seq, 9);  // heard later than the restored 3
+  EXPECT_EQ(positions[2].sender, "actor-7");
+  const auto parsed = ParsePositions(FormatPositions(positions));
+  ASSERT_EQ(parsed.size(), positions.size());
+  for (size_t i = 0; i < parsed.size(); ++i) {
+    EXPECT_EQ(parsed[i].channel, positions[i].channel);
+    EXPECT_EQ(parsed[i].sender, positions[i].sender);
+    EXPECT_EQ(parsed[i].incarnation, positions[i].incarnation);
+    EXPECT_EQ(parsed[i].seq, positions[i].seq);
+    EXPECT_EQ(parsed[i].utime, positions[i].utime);
+  }
+  EXPECT_TRUE(ParsePositions("").empty());
+}
+
+TEST(PositionsTextTest, RefusesWhatIsNotPositions) {
+  for (const std::string& bad : std::vector<std::string>{
+           "CH actor-1 1 2 3", "CH actor-1 1 2\n", "CH actor-1 1 2 3 4\n", "CH actor-1 1 2 x\n",
+           "CH actor-1 -1 2 3\n", "CH actor-1 1 -2 3\n", "CH  1 2 3\n", "CH a\tb 1 2 3\n",
+           " actor-1 1 2 3\n", "CH " + std::string(kMaxSenderBytes + 1, 'a') + " 1 2 3\n",
+           std::string(64, 'C') + " a 1 2 3\n", "CH a 1 2 99999999999999999999\n"}) {
+    EXPECT_THROW(ParsePositions(bad), std::runtime_error) << bad;
+  }
+  std::string many;
+  for (size_t i = 0; i <= kMaxStoredPositions; ++i) many += "CH a 1 2 3\n";
+  EXPECT_THROW(ParsePositions(many), std::runtime_error);
+}
+
+// The MAC and the freshness checks come before any decoding: a forged message whose body would
+// not decode is unauthenticated, a signed one that is stale or replayed is counted so, not as
+// malformed.
+TEST_F(WindowTest, ChecksTheMacAndFreshnessBeforeDecoding) {
+  std::vector<uint8_t> junk = Stamped(5, 0, "", 42, t_);
+  junk.resize(junk.size() - 3);  // torn: would not decode
+  auto send = [&](const std::vector<uint8_t>& m, int64_t at) {
+    bus_.Deliver(channels::kTransitions, m.data(), m.size(), at);
+  };
+  std::vector<uint8_t> forged = junk;
+  forged[MacOffset(7)] = 1;  // a MAC, wrong
+  send(forged, t_);
+  EXPECT_EQ(bus_.counters().unauthenticated, 1);
+  MessageAuthenticator key_holder(kKey);
+  ASSERT_TRUE(key_holder.Sign(channels::kTransitions, junk.data(), junk.size(), MacOffset(7)));
+  send(junk, t_ + 61 * kSecond);
+  EXPECT_EQ(bus_.counters().stale, 1);
+  send(junk, t_);
+  EXPECT_EQ(bus_.counters().malformed, 1);  // fresh: decoded, refused, position not taken
+  Send(5, 0, t_, t_);
+  send(junk, t_);
+  EXPECT_EQ(bus_.counters().replayed, 1);
+  EXPECT_EQ(bus_.counters().malformed, 1);
+  EXPECT_EQ(got_, (std::vector<int64_t>{0}));
+}
+
+TEST(BusSenderTest, RefusesASenderNameUnfitForTheNonceAndDropsSuchMessagesAsMalformed) {
+  EXPECT_THROW(Bus(InProcessBusConfig(1, "actor 1")), std::invalid_argument);
+  EXPECT_THROW(Bus(InProcessBusConfig(1, std::string(kMaxSenderBytes + 1, 'a'))),
+               std::invalid_argument);
+  BusConfig bad_window = InProcessBusConfig(1, "replay");
+  bad_window.max_message_age = 0;
+  EXPECT_THROW(Bus{bad_window}, std::invalid_argument);
+  Bus bus(InProcessBusConfig(42, "replay"));
+  int got = 0;
+  bus.Subscribe<rlmsg::transition_batch_t>(channels::kTransitions,
+                                           [&got](const rlmsg::transition_batch_t&) { ++got; });
+  auto m = MakeBatch(1, 4);
+  m.header.run_id = 42;
+  m.header.utime = WallMicros();
+  for (const std::string& sender : {std::string(kMaxSenderBytes + 1, 'a'), std::string("a b")}) {
+    m.header.sender = sender;
+    std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+    m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    bus.Deliver(channels::kTransitions, bytes.data(), bytes.size(), m.header.utime);
+  }
+  EXPECT_EQ(got, 0);
+  EXPECT_EQ(bus.counters().malformed, 2);
 }
 
 }  // namespace

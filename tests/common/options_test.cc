@@ -2,8 +2,11 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -61,6 +64,63 @@ TEST(OptionsTest, AnUnknownKeyInOurSectionIsRefusedWithItsName) {
     EXPECT_NE(std::string(e.what()).find("unknown key 'epsiodes' in section [evaluator]"),
               std::string::npos)
         << e.what();
+  }
+}
+
+TEST(OptionsTest, ASectionOfNoProcessIsRefusedWithItsName) {
+  try {
+    Parse("env = CartPole-v1\n[lerner]\nlearning-rate = 0.001\n");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown section [lerner] (key 'learning-rate')"),
+              std::string::npos)
+        << e.what();
+  }
+  // The other processes' sections are not ours, but no error.
+  EXPECT_EQ(Parse("[replay]\ncapacity = 5\n[learner]\nx = 1\n").episodes, 100);
+}
+
+TEST(OptionsTest, ListOptionsPrintsTheNamesAPresetMaySet) {
+  CommonOptions common;
+  po::options_description desc("Options");
+  AddCommonOptions(&desc, &common);
+  desc.add_options()("episodes", po::value<int>(), "episodes");
+  std::string program = "evaluator", flag = "--list-options";
+  char* argv[] = {program.data(), flag.data()};
+  po::variables_map vm;
+  std::ostringstream out;
+  std::streambuf* saved = std::cout.rdbuf(out.rdbuf());
+  const bool go_on = ParseOptions(2, argv, "evaluator", "usage", desc, &vm);
+  std::cout.rdbuf(saved);
+  EXPECT_FALSE(go_on);
+  EXPECT_EQ(out.str(),
+            "run-id\nkey-file\nlcm-url\nlcm-bulk-url\nmax-message-age\nmax-clock-skew\nepisodes\n");
+}
+
+// The freshness window: seconds on the command line, microseconds in the bus's configuration;
+// a window that is not positive (or beyond a day) is refused with the option's name.
+TEST(OptionsTest, TheFreshnessWindowReachesTheBusAndABadOneIsRefused) {
+  CommonOptions defaults;
+  EXPECT_EQ(defaults.MakeBusConfig("actor-0").max_message_age, kDefaultMaxMessageAgeMicros);
+  EXPECT_EQ(defaults.MakeBusConfig("actor-0").max_clock_skew, kDefaultMaxClockSkewMicros);
+  po::options_description desc;
+  CommonOptions common;
+  AddCommonOptions(&desc, &common);
+  const char* argv[] = {"x", "--max-message-age", "2.5", "--max-clock-skew", "0.5"};
+  po::variables_map vm;
+  ASSERT_TRUE(ParseOptions(5, const_cast<char**>(argv), "actor", "usage", desc, &vm));
+  const BusConfig c = common.MakeBusConfig("actor-0");
+  EXPECT_EQ(c.max_message_age, 2'500'000);
+  EXPECT_EQ(c.max_clock_skew, 500'000);
+  for (const double bad : {0.0, -1.0, 90000.0, std::nan("")}) {
+    CommonOptions o;
+    o.max_message_age = bad;
+    try {
+      o.MakeBusConfig("actor-0");
+      ADD_FAILURE() << bad << " was taken";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("--max-message-age"), std::string::npos);
+    }
   }
 }
 

@@ -1,5 +1,7 @@
 #include "evaluator/evaluator_service.h"
 
+#include <sys/stat.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +22,7 @@ namespace rl::evaluator {
 namespace {
 
 using testing::CountOccurrences;
+using testing::FifoUnblocker;
 using testing::ReadFile;
 using testing::TempDir;
 
@@ -43,6 +46,7 @@ nn::Checkpoint AlwaysLeftCheckpoint(int64_t update) {
 class EvaluatorServiceTest : public ::testing::Test {
  protected:
   EvaluatorServiceTest() : bus_(MemqConfig()) {
+    std::filesystem::create_directories(checkpoints_);
     bus_.Subscribe<rlmsg::eval_result_t>(
         channels::kEval, [this](const rlmsg::eval_result_t& m) { results_.push_back(m); });
     bus_.Subscribe<rlmsg::stats_evaluator_t>(
@@ -59,7 +63,7 @@ class EvaluatorServiceTest : public ::testing::Test {
   }
 
   std::string WriteCheckpoint(int64_t update) {
-    const std::string path = dir_ / ("ckpt_" + std::to_string(update) + ".bin");
+    const std::string path = checkpoints_ + "/ckpt_" + std::to_string(update) + ".bin";
     nn::SaveCheckpoint(path, AlwaysLeftCheckpoint(update));
     return path;
   }
@@ -87,6 +91,9 @@ class EvaluatorServiceTest : public ::testing::Test {
   }
 
   TempDir dir_;
+  // The run's checkpoint folder (Config().out_dir + "/checkpoints"): announced files are read
+  // from it only.
+  const std::string checkpoints_ = dir_ / "run-a/checkpoints";
   Bus bus_;
   std::vector<rlmsg::eval_result_t> results_;
   std::vector<rlmsg::stats_evaluator_t> stats_;
@@ -197,7 +204,7 @@ TEST_F(EvaluatorServiceTest, ShowsAGridOfCameraFramesForAPixelEnv) {
   net.GetFlat(&ckpt.params);
   ckpt.meta.update = 50;
   ckpt.meta.run_id = 77;
-  const std::string path = dir_ / "ckpt_50.bin";
+  const std::string path = checkpoints_ + "/ckpt_50.bin";
   nn::SaveCheckpoint(path, ckpt);
   EvaluatorService service(c, &bus_, nullptr);
   Announce(path, 50);
@@ -211,7 +218,7 @@ TEST_F(EvaluatorServiceTest, ShowsAGridOfCameraFramesForAPixelEnv) {
 }
 
 // A Catch checkpoint of a random MLP (a hidden layer of 8).
-std::string WriteCatchCheckpoint(const TempDir& dir, int64_t update) {
+std::string WriteCatchCheckpoint(const std::string& folder, int64_t update) {
   std::mt19937 rng(5);
   nn::Sequential net = nn::MakeMlp(2 * 10 * 5, {8}, 3, &rng);
   nn::Checkpoint ckpt;
@@ -219,7 +226,7 @@ std::string WriteCatchCheckpoint(const TempDir& dir, int64_t update) {
   net.GetFlat(&ckpt.params);
   ckpt.meta.update = update;
   ckpt.meta.run_id = 77;
-  const std::string path = dir / ("ckpt_" + std::to_string(update) + ".bin");
+  const std::string path = folder + "/ckpt_" + std::to_string(update) + ".bin";
   nn::SaveCheckpoint(path, ckpt);
   return path;
 }
@@ -232,7 +239,7 @@ TEST_F(EvaluatorServiceTest, DrawsATsneMapOfACheckpointAtTheGoalBeforeItsResult)
   std::FILE* log = std::tmpfile();
   ASSERT_NE(log, nullptr);
   EvaluatorService service(c, &bus_, log);
-  Announce(WriteCatchCheckpoint(dir_, 50), 50);
+  Announce(WriteCatchCheckpoint(checkpoints_, 50), 50);
   ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
   EXPECT_FALSE(service.tsne_map_due());
   EXPECT_GT(service.tsne_seconds(), 0.0);
@@ -262,7 +269,7 @@ TEST_F(EvaluatorServiceTest, KeepsTheTsneMapOfANewBestDueWhileTheTimeShareIsSpen
   c.tsne = 100;
   c.goal = 10;  // never reached
   EvaluatorService service(c, &bus_, nullptr);
-  Announce(WriteCatchCheckpoint(dir_, 50), 50);
+  Announce(WriteCatchCheckpoint(checkpoints_, 50), 50);
   ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
   // Its first map is expected to take kTsneFirstGuessSeconds, more than a fifth of the time the
   // service has run: due, not made.
@@ -282,7 +289,7 @@ TEST_F(EvaluatorServiceTest, RefusesACorruptedCheckpointAndStillScoresTheNextGoo
   EvaluatorService service(Config(), &bus_, nullptr);
   // Flip one byte in the middle of a real checkpoint.
   const std::string good = WriteCheckpoint(100);
-  const std::string bad = dir_ / "ckpt_corrupted.bin";
+  const std::string bad = checkpoints_ + "/ckpt_corrupted.bin";
   std::filesystem::copy_file(good, bad);
   {
     std::fstream f(bad, std::ios::in | std::ios::out | std::ios::binary);
@@ -301,7 +308,7 @@ TEST_F(EvaluatorServiceTest, RefusesACorruptedCheckpointAndStillScoresTheNextGoo
   EXPECT_EQ(service.checkpoints_scored(), 0);
 
   // A missing file is refused the same way.
-  Announce(dir_ / "ckpt_missing.bin", 60);
+  Announce(checkpoints_ + "/ckpt_missing.bin", 60);
   ASSERT_TRUE(PollUntil(&service, [&] { return service.checkpoints_refused() == 2; }));
 
   Announce(good, 100);
@@ -311,6 +318,38 @@ TEST_F(EvaluatorServiceTest, RefusesACorruptedCheckpointAndStillScoresTheNextGoo
   EXPECT_EQ(service.checkpoints_refused(), 2);
 }
 
+// Whoever holds the run's key can announce any path: only regular files in the run's checkpoint
+// folder are read. A checkpoint elsewhere, a symbolic link to it, a device that never ends and a
+// FIFO that would block are refused and counted, and the service goes on to score the next good
+// one. (A helper thread opens the FIFO for writing should the service block on it, so that the
+// test fails instead of hanging.)
+TEST_F(EvaluatorServiceTest, ReadsAnnouncedCheckpointsFromTheRunsCheckpointFolderOnly) {
+  EvaluatorService service(Config(), &bus_, nullptr);
+  const std::string outside = dir_ / "ckpt_7.bin";
+  nn::SaveCheckpoint(outside, AlwaysLeftCheckpoint(7));
+  std::filesystem::create_symlink(outside, checkpoints_ + "/ckpt_8.bin");
+  const std::string fifo = checkpoints_ + "/ckpt_9.bin";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  {
+    const FifoUnblocker unblock(fifo);
+    int64_t update = 7;
+    for (const std::string& path : {outside, checkpoints_ + "/ckpt_8.bin", fifo,
+                                    checkpoints_ + "/../../ckpt_7.bin", std::string("/dev/zero")}) {
+      const int64_t refused = service.checkpoints_refused();
+      Announce(path, update++);
+      EXPECT_TRUE(PollUntil(&service, [&] { return service.checkpoints_refused() == refused + 1; }))
+          << path;
+    }
+  }
+  EXPECT_TRUE(results_.empty());
+  EXPECT_EQ(service.checkpoints_scored(), 0);
+  Announce(WriteCheckpoint(100), 100);
+  ASSERT_TRUE(PollUntil(&service, [&] { return !results_.empty(); }));
+  EXPECT_EQ(results_.front().update, 100);
+  ASSERT_TRUE(PollUntil(&service,
+                        [&] { return !stats_.empty() && stats_.back().checkpoints_refused == 5; }));
+}
+
 TEST_F(EvaluatorServiceTest, RefusesANetworkThatDoesNotFitTheEnv) {
   EvaluatorService service(Config(), &bus_, nullptr);
   std::mt19937 rng(1);
@@ -318,7 +357,7 @@ TEST_F(EvaluatorServiceTest, RefusesANetworkThatDoesNotFitTheEnv) {
   nn::Checkpoint ckpt;
   ckpt.architecture = wide.Architecture();
   wide.GetFlat(&ckpt.params);
-  const std::string path = dir_ / "wide.bin";
+  const std::string path = checkpoints_ + "/wide.bin";
   nn::SaveCheckpoint(path, ckpt);
   Announce(path, 10);
   ASSERT_TRUE(PollUntil(&service, [&] { return service.checkpoints_refused() == 1; }));

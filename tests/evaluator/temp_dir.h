@@ -1,12 +1,16 @@
 // A fresh temporary directory per test, removed with its contents at the end.
 #pragma once
 
+#include <fcntl.h>
 #include <stdlib.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -48,5 +52,32 @@ inline int CountOccurrences(const std::string& text, const std::string& needle) 
   }
   return n;
 }
+
+// While it lives, opens the FIFO at `path` for writing as soon as someone opens it for reading,
+// and closes it: code that (wrongly) blocks opening the FIFO returns instead of hanging the test.
+class FifoUnblocker {
+ public:
+  explicit FifoUnblocker(const std::string& path)
+      : thread_([this, path] {
+          while (!done_) {
+            const int fd = ::open(path.c_str(), O_WRONLY | O_NONBLOCK);
+            if (fd >= 0) {
+              ::close(fd);
+              return;
+            }
+            std::this_thread::yield();
+          }
+        }) {}
+  FifoUnblocker(const FifoUnblocker&) = delete;
+  FifoUnblocker& operator=(const FifoUnblocker&) = delete;
+  ~FifoUnblocker() {
+    done_ = true;
+    thread_.join();
+  }
+
+ private:
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+};
 
 }  // namespace rl::evaluator::testing

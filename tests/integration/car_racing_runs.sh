@@ -4,15 +4,17 @@
 # dimensions over LCM) for a bounded time: frames stored, nothing lost or dropped, and the
 # evaluator scoring checkpoints on the unmodified environment (no no-op start, no off-track rule,
 # every frame's reward) and new best ones on the article's rules as well. Learning CarRacing takes
-# hours; this test checks the plumbing.
+# hours; this test checks the plumbing, and that it kept working to the end of the budget: a run
+# that stalled and sat out its time fails, since the replay's inserts and the learner's updates
+# must grow over the second half of the run, and the evaluator must score a checkpoint made then.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
 set +e
-# Checkpoints every 150 updates and 3 evaluation episodes, so that the evaluator scores a few;
+# Checkpoints every 50 updates and 3 evaluation episodes, so that the evaluator scores a few;
 # the learner on one thread, so that the run does not oversubscribe the two cores of CI.
 launch car_racing_td3 --out "$dir/run" --seed 1 --goal 100000 --time-budget 150 \
-  --learner-args "--checkpoint-every 150 --threads 1" --evaluator-args "--episodes 3 --second-episodes 2 --videos 1" \
+  --learner-args "--checkpoint-every 50 --threads 1" --evaluator-args "--episodes 3 --second-episodes 2 --videos 1" \
   > "$dir/launch.log" 2>&1
 status=$?
 set -e
@@ -30,4 +32,24 @@ if grep -q 'off-track=1' "$dir/run/logs/evaluator.log"; then fail "the evaluator
 grep -q '"second_episodes": 2' "$dir/run/eval.jsonl" || fail "no second metric in eval.jsonl"
 grep -q "the TD3 article&#39;s rules\|the TD3 article's rules" "$dir/run/report/index.html" ||
   fail "the report does not name the second metric"
-echo "PASS: CarRacing TD3 pipeline ran; $(wc -l < "$dir/run/eval.jsonl") evaluations on the unmodified env"
+# Progress over the second half of the run, from the metrics rows (t: seconds since the monitor
+# started): the replay's inserts and the learner's updates grew between the last row of the first
+# half and the last row, and the evaluator scored a checkpoint made in the second half (of an
+# update after the learner's count at half time).
+progress() {  # progress ROLE FIELD: prints "VALUE_AT_HALF VALUE_AT_END END_SECONDS"
+  grep -F "\"role\": \"$1\"," "$dir/run/metrics.jsonl" |
+    sed -n "s/^{\"t\": \([0-9.]*\),.*\"$2\": \([0-9.e+]*\)[,}].*/\1 \2/p" |
+    awk -v end="$(tail -1 "$dir/run/metrics.jsonl" | sed -n 's/^{"t": \([0-9.]*\),.*/\1/p')" '
+      $1 <= end / 2 { half = $2 } { last = $2; t = $1 } END { printf "%d %d %d", half, last, t }'
+}
+read -r inserts_half inserts_end end <<<"$(progress replay inserts)"
+read -r updates_half updates_end _ <<<"$(progress learner updates)"
+scored=$(last_scored_update "$dir/run")
+echo "progress over the second half (${end} s of metrics): replay inserts $inserts_half -> $inserts_end," \
+  "learner updates $updates_half -> $updates_end, last scored checkpoint at update $scored"
+[ "$inserts_end" -gt "$inserts_half" ] || fail "the run stalled: no replay insert in its second half"
+[ "$updates_end" -gt "$updates_half" ] || fail "the run stalled: no learner update in its second half"
+[ "$scored" -gt "$updates_half" ] ||
+  fail "the run stalled: the evaluator scored no checkpoint made in the second half"
+expect_no_restarts "$dir/run"
+echo "PASS: CarRacing TD3 pipeline ran to the end of its budget; $(wc -l < "$dir/run/eval.jsonl") evaluations on the unmodified env"

@@ -16,4 +16,5 @@ ls "$dir/run/checkpoints"/ckpt-*.bin >/dev/null || fail "no checkpoints"
 for role in replay learner evaluator actor-0; do
   [ -s "$dir/run/logs/$role.log" ] || fail "no log of $role"
 done
+expect_no_restarts "$dir/run"
 echo "PASS: solved with best evaluation mean $best"

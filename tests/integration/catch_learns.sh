@@ -18,4 +18,5 @@ awk -v b="$best" 'BEGIN{exit !(b >= 0.8)}' || fail "best evaluation mean $best <
 expect_clean_pixel_replay "$dir/run"
 [ "$(replay_field priorities)" -gt 0 ] || fail "the replay applied no priorities"
 [ -s "$dir/run/report/best.webm" ] || fail "no video of the greedy policy"
+expect_no_restarts "$dir/run"
 echo "PASS: Catch learned from pixels to a mean of $best"

@@ -53,4 +53,5 @@ tail -2 "$dir/remote-actor.log"
 grep -q "actors 2" "$run/logs/monitor.log" || fail "host A never saw host B's actor"
 grep -Eq "actor-1: stopped after [1-9][0-9]* steps.*weights [0-9]+" "$dir/remote-actor.log" ||
   fail "the remote actor did not act with the learner's weights"
+expect_no_restarts "$run"
 echo "PASS: an actor on another host joined the run"

@@ -32,7 +32,7 @@ cleanup() {
   [ -z "$pids" ] || kill $pids 2>/dev/null || true
   wait 2>/dev/null || true
   # Whatever a launch left behind (it stops its processes itself; this is the safety net).
-  cat "$dir"/*/pids 2>/dev/null | awk '{print $2}' | xargs -r kill -KILL 2>/dev/null || true
+  cat "$dir"/*/pids "$dir"/*/runs/*/pids 2>/dev/null | awk '{print $2}' | xargs -r kill -KILL 2>/dev/null || true
   [ -n "${RL_KEEP:-}" ] || rm -rf "$dir" 2>/dev/null || true
 }
 
@@ -79,7 +79,105 @@ wait_line() {  # wait_line FILE PATTERN TIMEOUT_SECONDS
     fail "no line matching '$pattern' in $file within $limit s"
 }
 
+# Fails when a process of the run was restarted: a restart hides a crash (a learner that
+# segfaults mid-run still reaches the goal), so a test that kills nothing calls this at its end.
+# Names each restarted process and how it died (from RUN/restarts: "TIME ROLE status CODE
+# restart N", CODE 128 + the signal for a killed process) and shows the last lines of its log.
+expect_no_restarts() {  # expect_no_restarts RUN_DIR
+  local run=$1 time role word code word2 count how restarted=""
+  local -A seen=()
+  [ -f "$run/restarts" ] || fail "$run has no restarts file (not a launcher's run folder)"
+  [ -s "$run/restarts" ] || return 0
+  while read -r time role word code word2 count; do
+    if [ "$code" -gt 128 ]; then
+      how="was killed by signal $((code - 128)) (SIG$(kill -l $((code - 128)) 2>/dev/null || echo '?'))"
+    else
+      how="exited with status $code"
+    fi
+    seen[$role]=$((${seen[$role]:-0} + 1))
+    echo "$role $how at $time (restart $count); the last lines of its log before it:" >&2
+    # The lines before the launcher's message about this death (the role's k-th restart).
+    awk -v k="${seen[$role]}" '/^launch: .*restarting it in/ && ++n == k {
+        for (i = NR - 12; i < NR; i++) if (i > 0) print "  " line[i]; exit }
+        { line[NR] = $0 }' "$run/logs/$role.log" >&2 || true
+    restarted="$restarted${restarted:+, }$role ($how)"
+  done < "$run/restarts"
+  fail "processes of $run died and were restarted: $restarted"
+}
+
+# Waits (bounded) until every process of the run's pids file has ended (a zombie has ended).
+expect_all_ended() {  # expect_all_ended RUN_DIR SECONDS
+  local run=$1 limit=$2 role pid alive
+  for _ in $(seq $((limit * 10))); do
+    alive=""
+    while read -r role pid; do
+      if awk '$3 != "Z" { found = 1 } END { exit !found }' "/proc/$pid/stat" 2>/dev/null; then
+        alive="$alive $role ($pid)"
+      fi
+    done < "$run/pids"
+    [ -n "$alive" ] || return 0
+    sleep 0.1
+  done
+  fail "processes of the run still alive $limit s later:$alive"
+}
+
+# After the launcher of RUN_DIR died mid-run (killed, hung up): every process stopped cleanly (the
+# replay wrote its last snapshot, the learner its state), `launch.sh --stop` says the run is not
+# going, and `launch.sh --resume` continues the run to the CartPole goal with no restart. Its
+# output goes to RUN_DIR/../resumed.log.
+expect_resumable_after_launcher_death() {  # expect_resumable_after_launcher_death RUN_DIR
+  local run=$1 status
+  grep -q "^replay: last snapshot written to " "$run/logs/replay.log" ||
+    fail "the replay did not stop cleanly (no last snapshot): $(tail -3 "$run/logs/replay.log")"
+  grep -q "^learner: stopped after " "$run/logs/learner.log" ||
+    fail "the learner did not stop cleanly: $(tail -3 "$run/logs/learner.log")"
+  set +e
+  "$root/scripts/launch.sh" --stop "$run" > "$run/../stop.log" 2>&1
+  status=$?
+  set -e
+  [ "$status" -eq 1 ] && grep -q "is not going" "$run/../stop.log" ||
+    fail "--stop after the launcher's end (status $status): $(cat "$run/../stop.log")"
+  set +e
+  "$root/scripts/launch.sh" --resume "$run" --no-setup --build-dir "$build_dir" --time-budget 240 \
+    > "$run/../resumed.log" 2>&1
+  status=$?
+  set -e
+  tail -4 "$run/../resumed.log"
+  [ "$status" -eq 0 ] || fail "the resumed run exited with $status"
+  grep -q "resumed at update [1-9]" "$run/logs/learner.log" || fail "the learner did not resume"
+  expect_no_restarts "$run"
+}
+
+# A copy of the checkout's layout in DIR for a launch that must not touch the checkout: its
+# scripts (linked), its presets (copied, so that a test may edit them) and its own runs/, where
+# default run folders go.
+fake_root() {  # fake_root DIR
+  mkdir -p "$1"
+  ln -s "$root/scripts" "$1/scripts"
+  cp -r "$root/configs" "$1/configs"
+}
+
 # The value of a '# key = value' line of a run's config.ini.
 run_setting() { sed -n "s/^# $2 = //p" "$1/config.ini"; }
 
 launch() { "$root/scripts/launch.sh" "$@" --no-setup --build-dir "$build_dir"; }
+
+# The last value of FIELD in ROLE's rows of a run's metrics.jsonl (empty when it has none).
+last_metric() {  # last_metric RUN_DIR ROLE FIELD
+  grep -F "\"role\": \"$2\"," "$1/metrics.jsonl" 2>/dev/null | tail -1 |
+    sed -n "s/.*\"$3\": \([-0-9.e+]*\)[,}].*/\1/p"
+}
+
+# The highest "update" of a run's eval.jsonl (-1 when it has none).
+last_scored_update() {  # last_scored_update RUN_DIR
+  { sed -n 's/.*"update": \([0-9]*\).*/\1/p' "$1/eval.jsonl" 2>/dev/null; echo -1; } | sort -n | tail -1
+}
+
+# Fails when a process of the run reported a sanitizer finding in its log (ASan, LSan, UBSan or
+# TSan, on a sanitizer build): the process aborted, and its restart would hide it.
+expect_no_sanitizer_reports() {  # expect_no_sanitizer_reports RUN_DIR
+  local pattern='^==[0-9]+==ERROR: (Address|Leak)Sanitizer|runtime error: |WARNING: ThreadSanitizer'
+  local found
+  found=$(grep -l -E "$pattern" "$1"/logs/*.log 2>/dev/null || true)
+  [ -z "$found" ] || { grep -h -A30 -E "$pattern" $found | head -80 >&2; fail "sanitizer reports in" $found; }
+}

@@ -17,4 +17,5 @@ best=$(best_mean "$dir/run/eval.jsonl")
 awk -v b="$best" 'BEGIN{exit !(b >= 0)}' || fail "best evaluation mean $best < 0"
 [ -s "$dir/run/report/best.webm" ] || fail "no video of the greedy policy"
 grep -q '<video src="best.webm"' "$dir/run/report/index.html" || fail "the report shows no video"
+expect_no_restarts "$dir/run"
 echo "PASS: LunarLander learned to a mean of $best"

@@ -37,4 +37,5 @@ awk -F'"t": |, "role": "learner", ' '/"role": "learner"/ {
     last_t = t; last_steps = steps; n++ }
   END { if (n < 4) { print "only " n " learner rows"; exit 1 } }' "$metrics" ||
   fail "time or env steps went back"
+expect_no_restarts "$dir/run"
 echo "PASS: $rows_before metrics lines, every role, whole lines after SIGKILL of the monitor"

@@ -139,5 +139,7 @@ render "$dir/seed1/report/index.html" "$dir/seed1/report.png" 1280 2400
 render "$dir/compare.html" "$dir/compare.png" 1280 1800
 [ "$probe_svgs" -eq 2 ] || fail "the compare page has $probe_svgs plots, not 2"
 [ -z "${RL_KEEP:-}" ] || echo "screenshots: $dir/seed1/report.png $dir/compare.png"
+expect_no_restarts "$dir/seed1"
+expect_no_restarts "$dir/seed2"
 echo "PASS: report and compare page render (screenshots, images, no console message);" \
   "the recording plays back ($evaluations evaluations)"

@@ -14,4 +14,5 @@ tail -20 "$dir/launch.log"
 best=$(expect_best_mean "$dir/run" -250)
 grep -q "TD3" "$dir/run/logs/learner.log" || fail "the learner did not run TD3"
 grep -q "without noise" "$dir/run/report/index.html" || fail "the report does not say how it scored"
+expect_no_restarts "$dir/run"
 echo "PASS: TD3 learned Pendulum-v1 with best evaluation mean $best"

@@ -49,4 +49,5 @@ awk -F'"update": ' '{split($2, a, ","); u = a[1] + 0; if (u < prev) { print "upd
   "$dir/run/eval.jsonl" || fail "evaluation updates went back"
 awk -F'"env_steps": ' '{split($2, a, ","); s = a[1] + 0; if (s < prev) { print "env steps " s " after " prev; exit 1 } prev = s}' \
   "$dir/run/eval.jsonl" || fail "evaluation env steps went back"
+expect_no_restarts "$dir/run"
 echo "PASS: stopped at update $last_update_before, resumed at $resumed, goal reached"

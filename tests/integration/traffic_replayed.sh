@@ -1,44 +1,130 @@
 #!/usr/bin/env bash
-# Recorded traffic played back into the live run it came from changes nothing: a CartPole run
-# records its main port (launch.sh --record); with its actors stopped, lcm-logplayer plays a copy
-# of the recording back onto the run's port; the replay and the evaluator drop every recorded
-# message of their channels as replayed (exactly as many as the file holds), the replay inserts
-# nothing, and no lost count moves. Then the run goes on, and launch.sh --stop stops it cleanly.
+# Recorded traffic played back into the live run it came from changes nothing, also after the
+# receiver was killed and restarted: a CartPole run records its main port (launch.sh --record)
+# and, here, its bulk port too; lcm-logplayer plays the recordings back onto the run's ports.
+#   1. Into the live run, with its actors stopped: the replay and the evaluator drop every
+#      recorded message of their channels as replayed (exactly as many as the file holds), the
+#      replay inserts nothing, and no lost count moves (tools/inject.cc --replayed-log).
+#   2. The same after SIGKILL of the replay, restarted by the supervisor from a snapshot written
+#      after the recording's end: the restarted replay loads the last position of every sender
+#      with it, so it still refuses the recording (replayed, or stale once older than its window)
+#      and stores none of it.
+#   3. The recorded sample replies after SIGKILL of the learner, restarted from its state file,
+#      with the replay stopped so that the learner hears no live reply: it drops them as replayed
+#      and trains on none (its update count stands still); without the positions it took the
+#      recorded replies to its first requests, whose ids a restarted learner uses again.
+# Then the run goes on, and launch.sh --stop stops it cleanly.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
 command -v lcm-logplayer >/dev/null || fail "lcm-logplayer is missing (liblcm-bin)"
+# The bulk port is recorded from before the run starts, so that the recording holds the replies
+# to the learner's first requests (ids 0, 1, ...).
+port=$((20000 + 2 * (RANDOM % 20000)))
+bulk_url="udpm://239.255.76.67:$((port + 1))?ttl=0&recv_buf_size=4194304"
+lcm-logger --quiet --lcm-url="$bulk_url" "$dir/bulk.lcmlog" > "$dir/bulk-logger.log" 2>&1 &
+bulk_logger=$!
 set -m
-launch cartpole --out "$dir/run" --actors 2 --seed 4 --goal 1000000 --time-budget 120 --record \
-  > "$dir/launch.log" 2>&1 &
+launch cartpole --out "$dir/run" --actors 2 --seed 4 --goal 1000000 --time-budget 300 --record \
+  --port "$port" --replay-args "--snapshot-every 1" > "$dir/launch.log" 2>&1 &
 launch_pid=$!
 set +m
 wait_line "$dir/launch.log" "running; logs in" 60
 run="$dir/run"
-# Traffic of every kind, a checkpoint and its evaluation included, then a copy of what the logger
-# has written so far (the live file grows while it plays, with the played messages too).
-wait_line "$run/eval.jsonl" '"checkpoint"' 60
-cp "$run/lcm-log/main.lcmlog.0" "$dir/recording.lcmlog"
+url=$(run_setting "$run" lcm-url)
+[ "$(run_setting "$run" lcm-bulk-url)" = "$bulk_url" ] || fail "the run's bulk port is not $bulk_url"
+# Traffic of every kind, a checkpoint and its evaluation included.
+wait_line "$run/eval.jsonl" '"checkpoint"' 90
+
+pid_of() { awk -v r="$1" '$1 == r {p = $2} END {print p}' "$run/pids"; }
+# The learner's newest metrics: field NAME of its last line in metrics.jsonl.
+learner_rows='"role": "learner"'
+learner_metric() {
+  grep "$learner_rows" "$run/metrics.jsonl" | tail -1 | grep -Eo "\"$1\": [0-9.e+]+" |
+    grep -Eo '[0-9.e+]+$'
+}
+lines() { grep -c -- "$2" "$1" || true; }          # lines FILE PATTERN
+at_least() { [ "$(lines "$1" "$2")" -ge "$3" ]; }  # at_least FILE PATTERN N
+learner_updates_at_least() { [ "$(learner_metric updates)" -ge "$1" ]; }
+# Waits (bounded) until COMMAND succeeds.
+wait_for() {  # wait_for TIMEOUT_SECONDS WHAT COMMAND...
+  local limit=$1 what=$2 end=$((SECONDS + $1))
+  shift 2
+  until "$@"; do
+    [ "$SECONDS" -lt "$end" ] || fail "$what within $limit s"
+    sleep 0.05
+  done
+}
+# Plays the main-port recording back while inject checks that the replay and the evaluator
+# refuse all of it and that nothing changes (the actors are stopped).
+play_back() {  # play_back WHAT
+  "$bin/inject" --replayed-log "$dir/main.lcmlog" --run-id "$(run_setting "$run" run-id)" \
+    --key-file "$run/key" --lcm-url "$url" --lcm-bulk-url "$bulk_url" --timeout 60 \
+    > "$dir/inject.log" 2>&1 &
+  local inject_pid=$! inject_status=0
+  wait_line "$dir/inject.log" "ready for playback" 60
+  lcm-logplayer --speed=2 --lcm-url="$url" "$dir/main.lcmlog" > "$dir/player.log" 2>&1 ||
+    fail "lcm-logplayer failed: $(tail -3 "$dir/player.log")"
+  wait "$inject_pid" || inject_status=$?
+  grep -v "^\[inject\]" "$dir/inject.log"
+  [ "$inject_status" -eq 0 ] || fail "$1 took recorded traffic, or it changed the run"
+}
+
+# --- 1. The live run ----------------------------------------------------------------------
 actors=$(awk '$1 ~ /^actor-/ {p[$1] = $2} END {for (a in p) print p[a]}' "$run/pids")
 [ -n "$actors" ] || fail "no actor in $run/pids"
 # shellcheck disable=SC2086
 kill -STOP $actors
-"$bin/inject" --replayed-log "$dir/recording.lcmlog" --run-id "$(run_setting "$run" run-id)" \
-  --key-file "$run/key" --lcm-url "$(run_setting "$run" lcm-url)" \
-  --lcm-bulk-url "$(run_setting "$run" lcm-bulk-url)" --timeout 60 > "$dir/inject.log" 2>&1 &
-inject_pid=$!
-wait_line "$dir/inject.log" "ready for playback" 60
-lcm-logplayer --speed=2 --lcm-url="$(run_setting "$run" lcm-url)" "$dir/recording.lcmlog" \
-  > "$dir/player.log" 2>&1 || fail "lcm-logplayer failed: $(tail -3 "$dir/player.log")"
-set +e
-wait "$inject_pid"
-inject_status=$?
-set -e
-cat "$dir/inject.log"
+# What the logger has written so far (the live file grows while it plays, with the played
+# messages too).
+cp "$run/lcm-log/main.lcmlog.0" "$dir/main.lcmlog"
+play_back "the live run"
+grep -q "dropped a replayed message" "$run/logs/replay.log" || fail "the replay logged no replayed drop"
+
+# --- 2. The replay, restarted -------------------------------------------------------------
+written="^replay: snapshot [0-9]* written"
+snapshots=$(lines "$run/logs/replay.log" "$written")
+# Two more snapshots: the second began after the recording's end, so it holds every position.
+wait_for 30 "two snapshots with the actors stopped" \
+  at_least "$run/logs/replay.log" "$written" $((snapshots + 2))
+kill -KILL "$(pid_of replay)"
+wait_line "$run/logs/replay.log" "^replay: snapshot .* loaded (" 30
+grep "^replay: snapshot .* loaded (" "$run/logs/replay.log" | tail -1
+play_back "the restarted replay"
 # shellcheck disable=SC2086
 kill -CONT $actors
-[ "$inject_status" -eq 0 ] || fail "replayed traffic was not all dropped, or it changed the run"
-grep -q "dropped a replayed message" "$run/logs/replay.log" || fail "the replay logged no replayed drop"
+grep -q " replay status 137 restart 1$" "$run/restarts" || fail "the replay was not restarted"
+
+# --- 3. The learner, restarted ------------------------------------------------------------
+# Training again, with a newer learner state (a checkpoint every 500 updates).
+updates=$(learner_metric updates)
+wait_for 60 "1000 more updates" learner_updates_at_least $((updates + 1000))
+replay_pid=$(pid_of replay)
+kill -STOP "$replay_pid"
+kill -INT "$bulk_logger"
+wait "$bulk_logger" || true
+kill -KILL "$(pid_of learner)"
+wait_for 30 "a restarted learner" at_least "$run/logs/learner.log" "^learner: ready" 2
+# Its first stats, then what it has trained and refused so far.
+rows=$(lines "$run/metrics.jsonl" "$learner_rows")
+wait_for 10 "stats of the restarted learner" \
+  at_least "$run/metrics.jsonl" "$learner_rows" $((rows + 2))
+before=$(learner_metric updates)
+refused_before=$(learner_metric replayed)
+lcm-logplayer --speed=20 --regexp=RL_SAMPLES --lcm-url="$bulk_url" "$dir/bulk.lcmlog" \
+  > "$dir/bulk-player.log" 2>&1 || fail "lcm-logplayer failed: $(tail -3 "$dir/bulk-player.log")"
+rows=$(lines "$run/metrics.jsonl" "$learner_rows")
+wait_for 10 "stats of the learner" at_least "$run/metrics.jsonl" "$learner_rows" $((rows + 2))
+after=$(learner_metric updates)
+refused_after=$(learner_metric replayed)
+kill -CONT "$replay_pid"
+echo "learner: updates $before -> $after while the recorded replies played; replayed" \
+  "$refused_before -> $refused_after"
+[ "$after" = "$before" ] || fail "the restarted learner trained on recorded replies"
+awk -v a="$refused_after" -v b="$refused_before" 'BEGIN {exit !(a > b)}' ||
+  fail "the restarted learner counted no recorded reply as replayed"
+grep -q " learner status 137 restart 1$" "$run/restarts" || fail "the learner was not restarted"
+
 while read -r role pid; do
   kill -0 "$pid" 2>/dev/null || fail "$role (pid $pid) died"
 done < <(awk '{p[$1] = $2} END {for (r in p) print r, p[r]}' "$run/pids")
@@ -59,4 +145,5 @@ status=$?
 set -e
 [ "$status" -eq 1 ] && grep -q "is not going" "$dir/stop2.log" ||
   fail "a second --stop did not say the run is not going (status $status): $(cat "$dir/stop2.log")"
-echo "PASS: a recording played back into its run was dropped as replayed and changed nothing"
+echo "PASS: recordings played back into their run, live and after restarts of the replay and the" \
+  "learner, were refused and changed nothing"

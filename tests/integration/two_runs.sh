@@ -39,4 +39,5 @@ for r in a b; do
   echo "$final" | grep -Eq ' dropped [1-9]' && foreign=1
 done
 [ "$foreign" -eq 1 ] || fail "the control runs on one port did not see each other's messages"
+for run in apart-a apart-b shared-a shared-b; do expect_no_restarts "$dir/$run"; done
 echo "PASS: concurrent runs are isolated by their ports"

@@ -2,14 +2,17 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <random>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "common/channels.h"
 #include "nn/checkpoint.h"
+#include "nn/parallel.h"
 #include "rlmsg/checkpoint_t.hpp"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
@@ -215,6 +218,26 @@ TEST_F(LearnerTest, TrainsOnPixelBatchesAndSendsTheirTdErrorsAsPriorities) {
   EXPECT_EQ(ckpt.meta.env_steps, 4321);
 }
 
+// With two compute threads (--threads 2) the learner trains as with one, its convolution split
+// over nn's pool (ThreadSanitizer runs this test: scripts/test.sh, preset tsan).
+TEST_F(LearnerTest, TrainsOnTwoComputeThreads) {
+  pixels_ = true;
+  LearnerConfig c = ShortRun(256, 5, 100);
+  c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)";
+  // 256 x 64 x 2 x 9 x 50 = 14.7M multiply-adds per convolution: enough to be split.
+  c.dqn.network = "conv2d(2,64,3,1,1,10,5),relu,flatten,linear(3200,3)";
+  c.threads = 2;
+  const int64_t sections = nn::internal::ParallelSections();
+  {
+    Learner learner(c, bus_.get());
+    learner.Run();
+    bus_->Handle(0);
+    EXPECT_EQ(learner.updates(), 5);
+  }
+  EXPECT_GT(nn::internal::ParallelSections(), sections) << "nothing ran on two threads";
+  nn::SetNumThreads(1);
+}
+
 TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFiles) {
   LearnerConfig c = ShortRun(8, 50, 10);
   c.keep_checkpoints = 2;
@@ -228,6 +251,33 @@ TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFiles) {
   // The learner's state (for a restart) is kept beside them.
   EXPECT_EQ(left, (std::vector<std::string>{"ckpt-000000040.bin", "ckpt-000000050.bin",
                                             "learner-state.bin"}));
+}
+
+// A restarted or resumed learner counts the checkpoint files of its earlier lives towards
+// keep_checkpoints (they go first), so they do not pile up; other files stay.
+TEST_F(LearnerTest, KeepsOnlyTheNewestCheckpointFilesOfEveryLife) {
+  LearnerConfig c = ShortRun(8, 60, 10);
+  c.keep_checkpoints = 0;        // all: 10, 20, ..., 60
+  Learner first(c, bus_.get());  // alive to the end: the bus keeps its handler
+  first.Run();
+  bus_->Handle(0);
+  for (const char* name : {"ckpt-000000070.bin.tmp.77", "notes.txt", "ckpt-abc.bin"}) {
+    std::ofstream(dir_ / "checkpoints" / name) << "x";
+  }
+  c.keep_checkpoints = 3;
+  c.resume = true;
+  c.max_updates = 80;
+  Learner second(c, bus_.get());
+  ASSERT_TRUE(second.resumed());
+  second.Run();  // 70, 80
+  std::vector<std::string> left;
+  for (const auto& e : fs::directory_iterator(dir_ / "checkpoints")) {
+    left.push_back(e.path().filename().string());
+  }
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"ckpt-000000060.bin", "ckpt-000000070.bin",
+                                            "ckpt-000000070.bin.tmp.77", "ckpt-000000080.bin",
+                                            "ckpt-abc.bin", "learner-state.bin", "notes.txt"}));
 }
 
 TEST(LearnerConfigTest, RefusesBadSettings) {
@@ -339,6 +389,30 @@ TEST_F(LearnerTest, Td3ResumesFromItsSavedStateAndNeverGoesBack) {
   ExpectResumes(c, bus_.get(), &versions_, &announced_);
 }
 
+// precision = bf16 reaches the networks, the checkpoint's note and the state: a resume keeps it
+// and one in another precision is refused, naming both.
+TEST_F(LearnerTest, Bf16ResumesInBf16AndRefusesAnotherPrecision) {
+  LearnerConfig c = ShortRun(16, 30, 10);
+  c.precision = "bf16";
+  Learner probe(c, bus_.get());  // alive to the end: the bus keeps its handler
+  EXPECT_EQ(probe.algorithm().policy().precision(), nn::Precision::kBf16);
+  ExpectResumes(c, bus_.get(), &versions_, &announced_);
+  EXPECT_NE(nn::LoadCheckpoint(announced_.back()).meta.note.find("precision = bf16"),
+            std::string::npos);
+  LearnerConfig fp32 = c;
+  fp32.precision = "fp32";
+  fp32.resume = true;
+  try {
+    Learner other(fp32, bus_.get());
+    ADD_FAILURE() << "a bf16 state was resumed in fp32";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("precision bf16, this run's is fp32"), std::string::npos)
+        << e.what();
+  }
+  c.precision = "fp16";
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
 TEST_F(LearnerTest, RefusesAStateOfAnotherRunOrATornOne) {
   Learner first(ShortRun(8, 10, 10), bus_.get());  // alive to the end: the bus keeps its handler
   first.Run();
@@ -369,6 +443,36 @@ TEST_F(LearnerTest, RefusesAStateOfAnotherRunOrATornOne) {
   Learner fresh(same, bus_.get());
   EXPECT_FALSE(fresh.resumed());
   EXPECT_EQ(fresh.updates(), 0);
+}
+
+// A restarted learner loads, with its state, the last reply it had taken from each replay:
+// replies recorded before its last checkpoint and played back to it are dropped as replayed,
+// inside the freshness window too; later ones pass the bus (and match no request of its).
+TEST_F(LearnerTest, AResumedLearnerRefusesRecordedRepliesOlderThanItsState) {
+  std::vector<std::vector<uint8_t>> recorded;  // every reply, as it went over the bus
+  bus_->Subscribe<rlmsg::sample_batch_t>(
+      channels::kSamples,
+      [&recorded](const rlmsg::sample_batch_t& m) {
+        std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
+        m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+        recorded.push_back(std::move(bytes));
+      },
+      Port::kBulk);
+  LearnerConfig c = ShortRun(16, 30, 10);
+  Learner first(c, bus_.get());  // alive to the end: the bus keeps its handler
+  first.Run();                   // its last checkpoint (and state) when it stops
+  const size_t before_state = recorded.size();
+  bus_->Handle(0);  // replies to requests still in flight
+  ASSERT_GT(before_state, 0U);
+  Bus restarted(InProcessBusConfig(9, "learner"));  // the new process's bus
+  c.resume = true;
+  Learner second(c, &restarted);
+  ASSERT_TRUE(second.resumed());
+  for (const auto& bytes : recorded) {
+    restarted.Deliver(channels::kSamples, bytes.data(), bytes.size(), WallMicros());
+  }
+  EXPECT_EQ(restarted.counters().replayed, static_cast<int64_t>(before_state));
+  EXPECT_EQ(restarted.counters().received, static_cast<int64_t>(recorded.size() - before_state));
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // shapes are stable.
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include "nn/optimizers.h"
 #include "nn/parallel.h"
 #include "nn/pixels.h"
+#include "nn/precision.h"
 #include "nn/presets.h"
 #include "nn/sequential.h"
 #include "tests/nn/allocation_counter.h"
@@ -172,6 +174,41 @@ TEST(AllocationTest, PixelNetworksDoNotAllocateWithTwoThreads) {
   SetNumThreads(1);
   EXPECT_EQ(allocations, 0) << sum;
   EXPECT_GT(internal::ParallelSections(), sections) << "nothing ran on two threads";
+}
+
+// bf16 networks on every path this CPU runs (the AVX512_BF16 kernels, the emulation): an update
+// of the Nature network and of an MLP, and a single observation, at 1 and 2 threads.
+TEST(AllocationTest, Bf16NetworksDoNotAllocateOnEveryPath) {
+  ASSERT_TRUE(AllocationCountingAvailable()) << "this test needs glibc without a sanitizer";
+  for (const std::string& path : RunnableKernelPaths()) {
+    SetKernelPath(path);
+    for (int threads : {1, 2}) {
+      SetNumThreads(threads);
+      std::mt19937 rng(0);
+      Sequential nature = MakeNatureCnn(7, &rng);
+      Sequential mlp = MakeMlp(10, {256, 256}, 1, &rng);
+      nature.set_precision(Precision::kBf16);
+      mlp.set_precision(Precision::kBf16);
+      Sequential actor = nature;
+      const Matrix nature_x = RandomMatrix(nature.InputSize(), 4, &rng).cwiseAbs();
+      const Matrix nature_dq = RandomMatrix(7, 4, &rng);
+      const Matrix mlp_x = RandomMatrix(10, 256, &rng);
+      const Matrix mlp_dq = RandomMatrix(1, 256, &rng);
+      auto work = [&] {
+        nature.Forward(nature_x);
+        nature.BackwardParams(nature_dq);
+        mlp.Forward(mlp_x);
+        mlp.Backward(mlp_dq);
+        return actor.Argmax(nature_x.data(), nature.InputSize());
+      };
+      int sum = work() + work();
+      const int64_t before = AllocationCount();
+      for (int i = 0; i < 3; ++i) sum += work();
+      EXPECT_EQ(AllocationCount() - before, 0) << path << ", " << threads << " threads " << sum;
+    }
+  }
+  SetNumThreads(1);
+  SetKernelPath("auto");
 }
 
 }  // namespace

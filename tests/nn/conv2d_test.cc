@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/nn/gradient_check.h"
+#include "tests/nn/kernel_paths.h"
 
 namespace rl::nn {
 namespace {
@@ -64,6 +65,10 @@ Matrix NaiveConv2d(const ConvCase& g, const Matrix& weight, const Matrix& bias, 
   return y;
 }
 
+// The tests of the computation run on every kernel path this CPU can run.
+class Conv2dKernelTest : public KernelPathTest {};
+RL_INSTANTIATE_KERNEL_PATHS(Conv2dKernelTest);
+
 TEST(Conv2dTest, ComputesOutputShapesLikePyTorch) {
   std::mt19937 rng(0);
   const Conv2d nature1(4, 32, 8, 4, 0, 84, 84, &rng);
@@ -89,7 +94,7 @@ TEST(Conv2dTest, InitialisesWeightsAndBiasWithinOneOverSqrtFanIn) {
   EXPECT_NEAR(conv.weight().mean(), 0.0f, 0.02f);
 }
 
-TEST(Conv2dTest, ForwardMatchesANaiveConvolution) {
+TEST_P(Conv2dKernelTest, ForwardMatchesANaiveConvolution) {
   const ConvCase cases[] = {
       {3, 5, 3, 1, 0, 7, 9},     {2, 4, 4, 2, 1, 9, 7},    {1, 3, 5, 3, 2, 11, 6},
       {3, 2, 1, 1, 0, 4, 5},     {2, 3, 3, 2, 0, 5, 5},    {4, 32, 8, 4, 0, 84, 84},
@@ -111,7 +116,7 @@ TEST(Conv2dTest, ForwardMatchesANaiveConvolution) {
   }
 }
 
-TEST(Conv2dTest, FusedReluClampsTheOutput) {
+TEST_P(Conv2dKernelTest, FusedReluClampsTheOutput) {
   std::mt19937 rng(3);
   const ConvCase g{2, 4, 3, 2, 1, 9, 8};
   Conv2d conv = g.Make(&rng);
@@ -146,7 +151,7 @@ void CheckGradients(const ConvCase& g, int batch) {
   EXPECT_LE((conv.bias_grad() - 2.0f * db).cwiseAbs().maxCoeff(), 1e-4f);
 }
 
-TEST(Conv2dTest, GradientsMatchFiniteDifferences) {
+TEST_P(Conv2dKernelTest, GradientsMatchFiniteDifferences) {
   CheckGradients({2, 3, 3, 1, 0, 5, 6}, 2);
   CheckGradients({2, 3, 3, 2, 1, 7, 6}, 3);
   CheckGradients({1, 2, 4, 2, 0, 8, 10}, 2);
@@ -162,7 +167,7 @@ TEST(Conv2dTest, GradientsMatchFiniteDifferences) {
 }
 
 // Batches large enough to be unfolded in several groups, the last one partial.
-TEST(Conv2dTest, GradientsAreTheSameForEveryGroupingOfTheBatch) {
+TEST_P(Conv2dKernelTest, GradientsAreTheSameForEveryGroupingOfTheBatch) {
   std::mt19937 rng(4);
   const ConvCase g{8, 16, 3, 1, 1, 16, 16};
   Conv2d conv = g.Make(&rng);
@@ -191,7 +196,7 @@ TEST(Conv2dTest, GradientsAreTheSameForEveryGroupingOfTheBatch) {
   EXPECT_LE((db_sum - db).cwiseAbs().maxCoeff(), 1e-3f);
 }
 
-TEST(Conv2dTest, FusedInputReluGradMasksWhereTheInputIsNotPositive) {
+TEST_P(Conv2dKernelTest, FusedInputReluGradMasksWhereTheInputIsNotPositive) {
   std::mt19937 rng(5);
   for (const ConvCase& g : {ConvCase{2, 3, 3, 2, 1, 7, 7}, ConvCase{2, 3, 3, 1, 0, 5, 5},
                             ConvCase{4, 3, 3, 1, 0, 3, 3}}) {

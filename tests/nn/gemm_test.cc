@@ -7,51 +7,32 @@
 #include <gtest/gtest.h>
 
 #include "tests/nn/gradient_check.h"
+#include "tests/nn/kernel_paths.h"
 
 namespace rl::nn::internal {
 namespace {
+
+// Every test runs on every kernel path this CPU can run.
+class GemmTest : public KernelPathTest {};
+RL_INSTANTIATE_KERNEL_PATHS(GemmTest);
 
 // Compares Gemm with Eigen for c (m x n) = op(a) * op(b) (+ biases) over every combination of
 // transposed operands, transposed output, accumulation, row bias and column bias.
 void CheckAgainstEigen(int m, int n, int k) {
   std::mt19937 rng(static_cast<unsigned>(m * 10007 + n * 101 + k));
   Vector workspace;
-  const Matrix a = RandomMatrix(m, k, &rng);
-  const Matrix a_t = a.transpose();
-  const Matrix b = RandomMatrix(k, n, &rng);
-  const Matrix b_t = b.transpose();
-  const Matrix bias = RandomMatrix(m, 1, &rng);
-  const Matrix col_bias = RandomMatrix(n, 1, &rng);
-  const Matrix start = RandomMatrix(m, n, &rng);
-  const Matrix product = a * b;
+  const GemmOperands o(m, n, k, &rng);
+  const Matrix product = o.a * o.b;
   for (int mode = 0; mode < 64; ++mode) {
-    const bool trans_a = (mode & 1) != 0;
-    const bool trans_b = (mode & 2) != 0;
-    const bool trans_c = (mode & 4) != 0;
-    const bool accumulate = (mode & 8) != 0;
-    const bool with_bias = (mode & 16) != 0;
-    const bool with_col_bias = (mode & 32) != 0;
-    Matrix c = start;
-    Matrix c_t = start.transpose();
-    const ConstView va = trans_a ? View(a_t).Transposed() : View(a);
-    const ConstView vb = trans_b ? View(b_t).Transposed() : View(b);
-    const MutView vc = trans_c ? View(&c_t).Transposed() : View(&c);
-    Epilogue epilogue;
-    epilogue.row_bias = with_bias ? bias.data() : nullptr;
-    epilogue.col_bias = with_col_bias ? col_bias.data() : nullptr;
-    Gemm(va, vb, vc, accumulate, epilogue, &workspace);
-    Matrix expected = product;
-    if (with_bias) expected.colwise() += bias.col(0);
-    if (with_col_bias) expected.rowwise() += col_bias.col(0).transpose();
-    if (accumulate) expected += start;
-    const Matrix got = trans_c ? Matrix(c_t.transpose()) : c;
+    Matrix offset, offset_scale;
+    const Matrix got = GemmInMode(o, mode, Precision::kFp32, &workspace, &offset, &offset_scale);
     const float tol = 1e-5f * static_cast<float>(k + 1);
-    EXPECT_LE((got - expected).cwiseAbs().maxCoeff(), tol)
+    EXPECT_LE((got - (product + offset)).cwiseAbs().maxCoeff(), tol)
         << m << "x" << k << " * " << k << "x" << n << " mode " << mode;
   }
 }
 
-TEST(GemmTest, MatchesEigenOnRaggedShapes) {
+TEST_P(GemmTest, MatchesEigenOnRaggedShapes) {
   for (int m : {1, 2, 3, 4, 5, 8, 17, 24, 25, 84}) {
     for (int n : {1, 2, 5, 8, 13, 32}) {
       for (int k : {1, 4, 9, 33}) CheckAgainstEigen(m, n, k);
@@ -59,20 +40,20 @@ TEST(GemmTest, MatchesEigenOnRaggedShapes) {
   }
 }
 
-TEST(GemmTest, MatchesEigenOnTheCartPoleShapes) {
+TEST_P(GemmTest, MatchesEigenOnTheCartPoleShapes) {
   CheckAgainstEigen(120, 128, 4);
   CheckAgainstEigen(84, 128, 120);
   CheckAgainstEigen(84, 120, 128);
   CheckAgainstEigen(120, 128, 84);
 }
 
-TEST(GemmTest, MatchesEigenWhenTheSharedDimensionSpansSeveralSlices) {
+TEST_P(GemmTest, MatchesEigenWhenTheSharedDimensionSpansSeveralSlices) {
   CheckAgainstEigen(30, 9, 600);
 }
 
 // The fused activation steps: relu(a * b + bias), and a * b zeroed where a mask is not positive,
 // on every code path (dot products, panels, transposed output, several slices of k).
-TEST(GemmTest, EpilogueAppliesReluAndMask) {
+TEST_P(GemmTest, EpilogueAppliesReluAndMask) {
   for (const auto& [m, n, k] : {std::array<int, 3>{2, 16, 9}, std::array<int, 3>{30, 17, 40},
                                 std::array<int, 3>{5, 40, 7}, std::array<int, 3>{12, 9, 300}}) {
     std::mt19937 rng(static_cast<unsigned>(m + n + k));
@@ -101,7 +82,7 @@ TEST(GemmTest, EpilogueAppliesReluAndMask) {
   }
 }
 
-TEST(GemmTest, EmptySharedDimensionGivesBiasOrKeepsTheAccumulator) {
+TEST_P(GemmTest, EmptySharedDimensionGivesBiasOrKeepsTheAccumulator) {
   Vector workspace;
   const Matrix a(3, 0);
   const Matrix b(0, 2);
@@ -117,7 +98,7 @@ TEST(GemmTest, EmptySharedDimensionGivesBiasOrKeepsTheAccumulator) {
 }
 
 // A left operand packed by the caller in the documented layout gives the same product.
-TEST(GemmTest, PrepackedLeftOperandMatchesEigen) {
+TEST_P(GemmTest, PrepackedLeftOperandMatchesEigen) {
   for (const auto& [m, n, k] :
        {std::array<int, 3>{1, 5, 3}, std::array<int, 3>{24, 8, 9}, std::array<int, 3>{49, 64, 576},
         std::array<int, 3>{400, 32, 256}, std::array<int, 3>{30, 13, 300}}) {
@@ -126,6 +107,7 @@ TEST(GemmTest, PrepackedLeftOperandMatchesEigen) {
     const Matrix a = RandomMatrix(m, k, &rng);
     const Matrix b = RandomMatrix(k, n, &rng);
     const Matrix col_bias = RandomMatrix(n, 1, &rng);
+    const int kPanelRows = PackedPanelRows(Precision::kFp32);
     const int panels = (m + kPanelRows - 1) / kPanelRows;
     // Rows past m hold garbage, which must not reach c.
     std::vector<float> packed(static_cast<size_t>(panels) * kPanelRows * k, 1e30f);
@@ -148,7 +130,7 @@ TEST(GemmTest, PrepackedLeftOperandMatchesEigen) {
   }
 }
 
-TEST(AddRowSumsTest, AddsTheSumOfEachRowAcrossTheBatch) {
+TEST_P(GemmTest, AddRowSumsAddsTheSumOfEachRowAcrossTheBatch) {
   std::mt19937 rng(5);
   for (int rows : {1, 7, 8, 63, 64, 65, 120, 130}) {
     const Matrix g = RandomMatrix(rows, 37, &rng);

@@ -5,11 +5,15 @@
 #include <gtest/gtest.h>
 
 #include "nn/tensor.h"
+#include "tests/nn/kernel_paths.h"
 
 namespace rl::nn::internal {
 namespace {
 
-TEST(GemvTest, MatchesEigenForEveryBlockingCase) {
+class GemvTest : public KernelPathTest {};
+RL_INSTANTIATE_KERNEL_PATHS(GemvTest);
+
+TEST_P(GemvTest, MatchesEigenForEveryBlockingCase) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   for (int out : {1, 2, 15, 16, 17, 33, 84, 128, 129, 300}) {

@@ -19,6 +19,7 @@
 #include "nn/presets.h"
 #include "nn/sequential.h"
 #include "tests/nn/gradient_check.h"
+#include "tests/nn/kernel_paths.h"
 
 namespace rl::nn {
 namespace {
@@ -119,24 +120,30 @@ TEST(ParallelTest, CallersOnSeveralThreadsShareThePool) {
   EXPECT_EQ(bad.load(), 0);
 }
 
-// Gemm at 1 thread, then at 2 and 3: same bits.
+// Gemm at 1 thread, then at 2 and 3: same bits, in both precisions.
 void CheckGemm(const internal::ConstView& a, const internal::ConstView& b, int m, int n,
                bool accumulate, const internal::Epilogue& epilogue, const Matrix& start) {
   ASSERT_GE(static_cast<int64_t>(m) * n * a.cols, 2 * internal::kMinTaskWork)
       << "too small to split";
   Vector workspace;
-  Matrix want = start;
-  internal::Gemm(a, b, internal::View(&want), accumulate, epilogue, &workspace);
-  for (int n_threads : {2, 3}) {
-    Threads threads(n_threads);
-    Matrix got = start;
-    internal::Gemm(a, b, internal::View(&got), accumulate, epilogue, &workspace);
-    EXPECT_EQ(MaxDiff(got, want), 0.0f)
-        << m << "x" << n << "x" << a.cols << ", " << n_threads << " threads";
+  for (Precision precision : {Precision::kFp32, Precision::kBf16}) {
+    Matrix want = start;
+    internal::Gemm(a, b, internal::View(&want), accumulate, epilogue, &workspace, precision);
+    for (int n_threads : {2, 3}) {
+      Threads threads(n_threads);
+      Matrix got = start;
+      internal::Gemm(a, b, internal::View(&got), accumulate, epilogue, &workspace, precision);
+      EXPECT_EQ(MaxDiff(got, want), 0.0f) << m << "x" << n << "x" << a.cols << ", " << n_threads
+                                          << " threads, " << PrecisionName(precision);
+    }
   }
 }
 
-TEST(ParallelTest, GemmGivesTheSameBitsWithThreads) {
+// The computations run on every kernel path this CPU can run.
+class ParallelKernelTest : public KernelPathTest {};
+RL_INSTANTIATE_KERNEL_PATHS(ParallelKernelTest);
+
+TEST_P(ParallelKernelTest, GemmGivesTheSameBitsWithThreads) {
   std::mt19937 rng(1);
   {
     // A large column-major weight times a batch (packed a block at a time), bias and ReLU;
@@ -177,44 +184,47 @@ TEST(ParallelTest, GemmGivesTheSameBitsWithThreads) {
   }
 }
 
-TEST(ParallelTest, GemmPackedGivesTheSameBitsWithThreads) {
-  using internal::kPanelRows;
+TEST_P(ParallelKernelTest, GemmPackedGivesTheSameBitsWithThreads) {
   std::mt19937 rng(2);
-  for (int m : {400, 30}) {  // Split by rows, then by columns.
-    const int k = 256;
-    const int n = m == 400 ? 96 : 1200;
-    ASSERT_GE(static_cast<int64_t>(m) * n * k, 2 * internal::kMinTaskWork) << "too small to split";
-    const Matrix a = RandomMatrix(m, k, &rng);
-    const Matrix b = RandomMatrix(k, n, &rng);
-    const Matrix col_bias = RandomMatrix(n, 1, &rng);
-    const int panels = (m + kPanelRows - 1) / kPanelRows;
-    std::vector<float> packed(static_cast<size_t>(panels) * kPanelRows * k, 0.0f);
-    for (int i = 0; i < m; ++i) {
-      for (int p = 0; p < k; ++p) {
-        packed[static_cast<size_t>((i / kPanelRows) * kPanelRows * k + p * kPanelRows +
-                                   i % kPanelRows)] = a(i, p);
+  for (Precision precision : {Precision::kFp32, Precision::kBf16}) {
+    const int rows = internal::PackedPanelRows(precision);
+    for (int m : {400, 30}) {  // Split by rows, then by columns.
+      const int k = 256;
+      const int n = m == 400 ? 96 : 1200;
+      ASSERT_GE(static_cast<int64_t>(m) * n * k, 2 * internal::kMinTaskWork)
+          << "too small to split";
+      const Matrix a = RandomMatrix(m, k, &rng);
+      const Matrix b = RandomMatrix(k, n, &rng);
+      const Matrix col_bias = RandomMatrix(n, 1, &rng);
+      const int panels = (m + rows - 1) / rows;
+      std::vector<float> packed(static_cast<size_t>(panels) * rows * k, 0.0f);
+      for (int i = 0; i < m; ++i) {
+        for (int p = 0; p < k; ++p) {
+          packed[static_cast<size_t>((i / rows) * rows * k + p * rows + i % rows)] = a(i, p);
+        }
       }
-    }
-    internal::Epilogue e;
-    e.col_bias = col_bias.data();
-    e.relu = true;
-    Vector workspace;
-    Matrix want(m, n);
-    internal::GemmPacked(packed.data(), m, k, internal::View(b), internal::View(&want), false, e,
-                         &workspace);
-    EXPECT_LE(MaxDiff(want, ((a * b).rowwise() + col_bias.col(0).transpose()).cwiseMax(0.0f)),
-              1e-4f);
-    for (int n_threads : {2, 3}) {
-      Threads threads(n_threads);
-      Matrix got(m, n);
-      internal::GemmPacked(packed.data(), m, k, internal::View(b), internal::View(&got), false, e,
-                           &workspace);
-      EXPECT_EQ(MaxDiff(got, want), 0.0f) << m << " rows, " << n_threads << " threads";
+      internal::Epilogue e;
+      e.col_bias = col_bias.data();
+      e.relu = true;
+      Vector workspace;
+      Matrix want(m, n);
+      internal::GemmPacked(packed.data(), m, k, internal::View(b), internal::View(&want), false, e,
+                           &workspace, precision);
+      const Matrix exact = ((a * b).rowwise() + col_bias.col(0).transpose()).cwiseMax(0.0f);
+      EXPECT_LE(MaxDiff(want, exact), precision == Precision::kFp32 ? 1e-4f : 0.1f);
+      for (int n_threads : {2, 3}) {
+        Threads threads(n_threads);
+        Matrix got(m, n);
+        internal::GemmPacked(packed.data(), m, k, internal::View(b), internal::View(&got), false, e,
+                             &workspace, precision);
+        EXPECT_EQ(MaxDiff(got, want), 0.0f)
+            << m << " rows, " << n_threads << " threads, " << PrecisionName(precision);
+      }
     }
   }
 }
 
-TEST(ParallelTest, GemvGivesTheSameBitsWithThreads) {
+TEST_P(ParallelKernelTest, GemvGivesTheSameBitsWithThreads) {
   std::mt19937 rng(3);
   // Gemv counts a multiply-add as 4 of a matrix product's (it is bound by reading the weight).
   for (const auto& [out, in] : {std::pair{512, 4200}, std::pair{300, 7200}}) {
@@ -259,7 +269,7 @@ ConvResult RunConv(const ConvCase& c, const Matrix& x, const Matrix& dy) {
   return r;
 }
 
-TEST(ParallelTest, Conv2dGivesTheSameResultsWithThreads) {
+TEST_P(ParallelKernelTest, Conv2dGivesTheSameResultsWithThreads) {
   const ConvCase cases[] = {
       {4, 32, 8, 4, 0, 84, 84, 7, true, false},  // Nature layer 1, odd batch.
       {3, 16, 3, 2, 1, 33, 29, 80, true, true},  // Padding, non-square, many groups.
@@ -311,10 +321,12 @@ NetResult RunNet(Sequential* net, const Matrix& x, const Matrix& dq) {
   return r;
 }
 
-TEST(ParallelTest, NetworksGiveTheSameResultsWithThreads) {
-  for (const bool nature : {true, false}) {
+TEST_P(ParallelKernelTest, NetworksGiveTheSameResultsWithThreads) {
+  for (const int variant : {0, 1, 2}) {
+    const bool nature = variant != 1;
     std::mt19937 rng(11);
     Sequential net = nature ? MakeNatureCnn(7, &rng) : MakeGraspCnn(7, &rng);
+    if (variant == 2) net.set_precision(Precision::kBf16);
     const int batch = nature ? 4 : 32;  // Enough for the convolutions to be split.
     Matrix x = RandomMatrix(net.InputSize(), batch, &rng).cwiseAbs();
     const Matrix dq = RandomMatrix(7, batch, &rng);

@@ -84,6 +84,42 @@ TEST(Pool2dTest, PoolsWindowsOfKByKWithFloorMode) {
   EXPECT_THROW(Pool2d(Pool2d::Mode::kMax, 1, 3, 2, 2), std::invalid_argument);
 }
 
+// Max pooling against a direct loop, with many equal values: the first maximum of each window
+// (row by row) is the one kept and the one the gradient goes to, for the 2 x 2 windows (computed
+// a row at a time) and for others.
+TEST(Pool2dTest, MaxPoolingKeepsTheFirstOfEqualMaxima) {
+  std::mt19937 rng(4);
+  std::uniform_int_distribution<int> level(0, 3);
+  for (const int kernel : {2, 3}) {
+    Pool2d pool(Pool2d::Mode::kMax, 3, kernel, 41, 23);
+    const ImageShape out = pool.output_shape();
+    Matrix x(pool.input_size(), 2);
+    for (Eigen::Index i = 0; i < x.size(); ++i) x.data()[i] = static_cast<float>(level(rng));
+    const Matrix y = pool.Forward(x);
+    const Matrix g = Matrix::Ones(pool.output_size(), 2);
+    const Matrix dx = pool.Backward(g);
+    Matrix want_dx = Matrix::Zero(x.rows(), 2);
+    for (int n = 0; n < 2; ++n) {
+      for (int c = 0; c < 3; ++c) {
+        for (int oy = 0; oy < out.height; ++oy) {
+          for (int ox = 0; ox < out.width; ++ox) {
+            int best = -1;
+            for (int ky = 0; ky < kernel; ++ky) {
+              for (int kx = 0; kx < kernel; ++kx) {
+                const int i = (c * 41 + oy * kernel + ky) * 23 + ox * kernel + kx;
+                if (best < 0 || x(i, n) > x(best, n)) best = i;
+              }
+            }
+            ASSERT_EQ(y((c * out.height + oy) * out.width + ox, n), x(best, n));
+            want_dx(best, n) += 1.0f;
+          }
+        }
+      }
+    }
+    EXPECT_EQ((dx - want_dx).cwiseAbs().maxCoeff(), 0.0f) << "kernel " << kernel;
+  }
+}
+
 TEST(Pool2dTest, GradientsMatchFiniteDifferences) {
   std::mt19937 rng(2);
   for (Pool2d::Mode mode : {Pool2d::Mode::kMax, Pool2d::Mode::kAverage}) {

@@ -80,7 +80,7 @@ class ReplayServiceTest : public ::testing::Test {
     m.header.run_id = run_id;
     m.header.sender = sender;
     m.header.seq = next_seq_[{channel, sender}]++;
-    m.header.utime = 1;
+    m.header.utime = WallMicros();
     std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
     ASSERT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())),
               static_cast<int>(bytes.size()));
@@ -541,6 +541,39 @@ TEST_F(ReplayServiceTest, RunServesUntilAskedToStop) {
   ASSERT_FALSE(flows_.empty());
   ASSERT_FALSE(stats_.empty());
   EXPECT_EQ(stats_.back().total_samples, 8);
+}
+
+// Actors that stop with the replay send their last steps as they go: a replay asked to stop
+// still stores what arrives (until it has been quiet a while), so its last snapshot has them.
+TEST_F(ReplayServiceTest, RunStoresWhatArrivesAsItStops) {
+  Start(Options(8, 10, 200));
+  SendTransitions(0, 10);
+  service_->Run([] { return true; });
+  EXPECT_EQ(service_->total_inserts(), 10);
+}
+
+// Actor ids at or above max_actors are refused and counted: a forged id cannot grow the
+// per-actor counts that every flow message and snapshot carries.
+TEST_F(ReplayServiceTest, RefusesActorIdsFromMaxActorsOn) {
+  ReplayServiceOptions o = Options(8, 100, 200);
+  o.max_actors = 4;
+  Start(o);
+  for (const int32_t id : {3, 4, std::numeric_limits<int32_t>::max()}) {
+    rlmsg::transition_batch_t m = MakeBatch(0, 5, 4);
+    m.actor_id = id;
+    PublishAs(channels::kTransitions, m, "actor-" + std::to_string(id));
+  }
+  Pump();
+  EXPECT_EQ(service_->total_inserts(), 5);
+  EXPECT_EQ(service_->counters().batches_refused, 2);
+  service_->Tick();
+  bus_.Handle(0);
+  ASSERT_FALSE(flows_.empty());
+  EXPECT_EQ(flows_.back().actor_id, std::vector<int32_t>{3});
+  o.max_actors = 0;
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
+  o.max_actors = kMaxActorsLimit + 1;
+  EXPECT_THROW(o.Validate(), std::invalid_argument);
 }
 
 }  // namespace

@@ -115,7 +115,8 @@ class Replica {
     m.header.run_id = run_id_;
     m.header.sender = sender;
     m.header.seq = seq_[sender]++;
-    m.header.utime = 1;
+    m.header.utime = WallMicros();
+    m.header.incarnation = incarnation_;
     std::vector<uint8_t> bytes(static_cast<size_t>(m.getEncodedSize()));
     ASSERT_EQ(m.encode(bytes.data(), 0, static_cast<int>(bytes.size())),
               static_cast<int>(bytes.size()));
@@ -153,8 +154,16 @@ class Replica {
   ReplayService& service() { return *service_; }
 
  private:
+  // The test peer's senders start anew with each replica, as restarted processes do: a later
+  // incarnation (a restored replica refuses what the saved one's peer had sent).
+  static int64_t NewIncarnation() {
+    static int64_t last = 0;
+    return last = std::max(WallMicros(), last + 1);
+  }
+
   Bus bus_;
   int64_t run_id_;
+  int64_t incarnation_ = NewIncarnation();
   std::unique_ptr<ReplayService> service_;
   std::map<std::string, int64_t> seq_;
   std::vector<rlmsg::sample_batch_t> replies_;
@@ -439,6 +448,38 @@ TEST_F(ReplaySnapshotTest, SurvivesMutatedSnapshotsWhoseChecksumIsRight) {
   EXPECT_GT(loaded, 0);  // some changes (in frames, observations) are harmless
 }
 
+// A replay restored from a snapshot refuses the messages its saved self had taken (a recording
+// played back after a restart), inside the freshness window too, and stores none of them.
+TEST_F(ReplaySnapshotTest, ARestoredReplayRefusesTrafficItsSavedSelfHadTaken) {
+  std::vector<std::vector<uint8_t>> recorded;
+  Bus saved_bus(InProcessBusConfig(kRunId, "replay"));
+  ReplayService saved(&saved_bus, Options(false));
+  const int64_t now = WallMicros();
+  for (int k = 0; k < 4; ++k) {
+    rlmsg::transition_batch_t m = FlatBatch(25 * k, 25);
+    m.header.run_id = kRunId;
+    m.header.sender = "actor-0";
+    m.header.seq = k;
+    m.header.utime = now;
+    m.header.incarnation = now - 1000;
+    recorded.emplace_back(static_cast<size_t>(m.getEncodedSize()));
+    ASSERT_EQ(m.encode(recorded.back().data(), 0, static_cast<int>(recorded.back().size())),
+              static_cast<int>(recorded.back().size()));
+    saved_bus.Deliver(channels::kTransitions, recorded.back().data(), recorded.back().size(), now);
+  }
+  ASSERT_EQ(saved.total_inserts(), 100);
+  StateStream out(ReplayService::kSnapshotKind);
+  saved.SaveSnapshot(&out);
+  Bus restarted_bus(InProcessBusConfig(kRunId, "replay"));
+  ReplayService restarted(&restarted_bus, Options(false));
+  restarted.RestoreSnapshot(out.Serialize());
+  for (const auto& bytes : recorded) {
+    restarted_bus.Deliver(channels::kTransitions, bytes.data(), bytes.size(), now);
+  }
+  EXPECT_EQ(restarted.total_inserts(), 100);
+  EXPECT_EQ(restarted_bus.counters().replayed, 4);
+}
+
 TEST_F(ReplaySnapshotTest, TheSnapshotterWritesFromAForkedChildAndTheFileLoads) {
   Replica saved(Options(true));
   FillFlat(&saved);
@@ -503,6 +544,31 @@ TEST_F(ReplaySnapshotTest, AFailedSnapshotIsCountedAndKeepsTheService) {
   SnapshotterOptions bad;
   bad.every_seconds = 0;
   EXPECT_THROW(bad.Validate(), std::invalid_argument);
+}
+
+// Actor ids come from the network: a key holder may send any (2^31 - 1, or more distinct ones
+// than a snapshot holds). Ids from max_actors on are refused and counted, so the per-actor
+// counts stay bounded and the next snapshot loads; a replay told to take fewer ids refuses a
+// snapshot that holds more, saying so.
+TEST_F(ReplaySnapshotTest, ForgedActorIdsAreRefusedAndTheNextSnapshotLoads) {
+  ReplayServiceOptions options = Options(false, 100);
+  Replica saved(options);
+  saved.Publish(channels::kTransitions, FlatBatch(0, 2, std::numeric_limits<int32_t>::max()),
+                "actor-x");
+  constexpr int kIds = 66000;  // more than the 65536 a snapshot held before ids were bounded
+  for (int id = 0; id < kIds; ++id) {
+    saved.Publish(channels::kTransitions, FlatBatch(id, 1, id), "actor-x");
+  }
+  EXPECT_EQ(saved.service().total_inserts(), options.max_actors);
+  EXPECT_EQ(saved.service().counters().batches_refused, kIds - options.max_actors + 1);
+  const std::string bytes = saved.Snapshot();
+  Replica restored(options);
+  EXPECT_EQ(ErrorOf([&] { restored.service().RestoreSnapshot(bytes); }), "");
+  EXPECT_EQ(restored.service().total_inserts(), options.max_actors);
+  ReplayServiceOptions fewer = options;
+  fewer.max_actors = 8;
+  EXPECT_NE(LoadError(bytes, fewer).find("holds actor id 8, this replay stores ids below 8"),
+            std::string::npos);
 }
 
 TEST_F(ReplaySnapshotTest, AReplayThatHasServedRefusesToLoad) {

@@ -1,0 +1,37 @@
+// Where a planned process runs: the small step between a run's plan (run_plan.h) and the
+// supervisor (supervisor.h), which executes Command(process) for each process and watches what it
+// starts. On this host the command is the process's own argv; a placement on a cluster returns a
+// command that runs the same argv on a node of its choosing (for Slurm: srun --nodes=1
+// --ntasks=1 --nodelist=NODE --overlap ... ARGV, whose client process the supervisor then starts,
+// restarts and stops like any other).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "launch/run_plan.h"
+
+namespace rl::launch {
+
+class Placement {
+ public:
+  virtual ~Placement() = default;
+
+  /// Where the run's processes go, for the launcher's first line ("this host").
+  virtual std::string Describe() const = 0;
+
+  /// The command the supervisor executes for `process` (argv[0] looked up on PATH when it has no
+  /// '/'). Called for every start, restarts included; must not fail.
+  virtual std::vector<std::string> Command(const PlannedProcess& process) const = 0;
+};
+
+/// Every process on this host, as planned.
+class LocalPlacement final : public Placement {
+ public:
+  std::string Describe() const override { return "this host"; }
+  std::vector<std::string> Command(const PlannedProcess& process) const override {
+    return process.argv;
+  }
+};
+
+}  // namespace rl::launch

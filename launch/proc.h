@@ -1,0 +1,41 @@
+// Small facts about processes, from /proc and wait statuses, that the launcher, its watchdog and
+// `launch.sh --stop` share.
+#pragma once
+
+#include <sys/types.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rl::launch {
+
+/// The start time of process `pid` (field 22 of /proc/PID/stat, in clock ticks since boot): with
+/// the pid, it names one process, so that a pid since reused by another is not taken for it.
+/// 0 when there is no such process or it has ended (a zombie).
+uint64_t ProcessStartTime(pid_t pid);
+
+/// Whether `pid` is the same living process that had `start_time` (ProcessStartTime).
+bool SameProcessAlive(pid_t pid, uint64_t start_time);
+
+/// "SIGSEGV" for 11; "SIG<n>" for a number without a name.
+std::string SignalName(int signal);
+
+/// How a process ended, from its wait status: "status 2", "signal 11 (SIGSEGV)".
+std::string DescribeWaitStatus(int wait_status);
+
+/// The exit code a shell would report for the wait status: the status, or 128 + the signal.
+int ShellExitCode(int wait_status);
+
+/// Whether the process `pid` has the file `path` open (its /proc/PID/fd links).
+bool HoldsFileOpen(pid_t pid, const std::string& path);
+
+/// The directory of the running executable (/proc/self/exe).
+std::string ExecutableDir();
+
+/// Runs `argv` (argv[0] a path), waits for it and returns its standard output; throws
+/// std::runtime_error naming the program when it cannot run or exits other than with status 0
+/// (with the last line of its standard error). For short queries (`PROGRAM --list-options`).
+std::string RunAndCapture(const std::vector<std::string>& argv);
+
+}  // namespace rl::launch

@@ -1,0 +1,123 @@
+#include "launch/launch_options.h"
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace rl::launch {
+namespace {
+
+// The error ParseLaunchArgs gives for `args`, or "" when it accepts them.
+std::string ErrorOf(const std::vector<std::string>& args) {
+  try {
+    ParseLaunchArgs(args);
+  } catch (const LaunchError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(LaunchOptionsTest, ReadsEveryOptionOfARun) {
+  const LaunchOptions o = ParseLaunchArgs({"cartpole",
+                                           "--out",
+                                           "runs/x",
+                                           "--actors",
+                                           "2",
+                                           "--num-actors",
+                                           "6",
+                                           "--time-budget",
+                                           "90.5",
+                                           "--goal",
+                                           "-250",
+                                           "--seed",
+                                           "7",
+                                           "--ttl",
+                                           "1",
+                                           "--port",
+                                           "7667",
+                                           "--run-id",
+                                           "42",
+                                           "--actor-args",
+                                           " --stats-hz 2  --max-steps 9",
+                                           "--record",
+                                           "--record-mb",
+                                           "16",
+                                           "--max-restarts",
+                                           "3",
+                                           "--max-backoff",
+                                           "4",
+                                           "--reset-restarts-after",
+                                           "60"});
+  EXPECT_EQ(o.mode, Mode::kRun);
+  EXPECT_EQ(o.preset, "cartpole");
+  EXPECT_EQ(o.out, "runs/x");
+  EXPECT_EQ(o.actors, 2);
+  EXPECT_EQ(o.num_actors, 6);
+  EXPECT_DOUBLE_EQ(o.time_budget, 90.5);
+  EXPECT_EQ(o.goal, "-250");
+  EXPECT_EQ(o.seed, 7u);
+  EXPECT_EQ(o.ttl, 1);
+  EXPECT_EQ(o.port, 7667);
+  EXPECT_EQ(o.run_id, 42);
+  EXPECT_EQ(o.extra_args.at("actor"),
+            (std::vector<std::string>{"--stats-hz", "2", "--max-steps", "9"}));
+  EXPECT_TRUE(o.record);
+  EXPECT_EQ(o.record_mb, 16);
+  EXPECT_EQ(o.limits.max_restarts, 3);
+  EXPECT_DOUBLE_EQ(o.limits.max_backoff, 4);
+  EXPECT_DOUBLE_EQ(o.limits.reset_after, 60);
+}
+
+TEST(LaunchOptionsTest, ResumeAndStopTakeARunFolder) {
+  LaunchOptions o = ParseLaunchArgs({"--resume", "runs/a", "--time-budget", "30"});
+  EXPECT_EQ(o.mode, Mode::kResume);
+  EXPECT_EQ(o.run_dir, "runs/a");
+  o = ParseLaunchArgs({"--stop", "runs/a"});
+  EXPECT_EQ(o.mode, Mode::kStop);
+  EXPECT_EQ(ErrorOf({"--stop", "runs/a", "--seed", "1"}),
+            "--stop takes a run folder and nothing else");
+  EXPECT_EQ(ErrorOf({"--resume", "runs/a", "--seed", "2"}),
+            "--seed cannot change a resumed run's seed");
+  EXPECT_EQ(ErrorOf({"--resume", "runs/a", "--out", "b"}),
+            "--out cannot change a resumed run's folder");
+  EXPECT_EQ(ErrorOf({"--resume"}), "--resume needs a run folder");
+}
+
+TEST(LaunchOptionsTest, RefusesNumbersThatAreNoneOrOutOfRange) {
+  EXPECT_EQ(ErrorOf({"cartpole", "--time-budget", "-5"}),
+            "--time-budget must be a positive number of seconds, not '-5'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--time-budget", "0"}),
+            "--time-budget must be a positive number of seconds, not '0'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--time-budget", "ten"}),
+            "--time-budget must be a positive number of seconds, not 'ten'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--time-budget", "nan"}),
+            "--time-budget must be a positive number of seconds, not 'nan'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--actors", "-1"}),
+            "--actors must be a whole number from 0 to 4096, not '-1'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--actors", "2x"}),
+            "--actors must be a whole number from 0 to 4096, not '2x'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--seed", "1.5"}), "--seed must be a whole number, not '1.5'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--goal", "high"}),
+            "--goal must be a number (an evaluation mean), not 'high'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--ttl", "2"}), "--ttl must be 0 or 1, not '2'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--port", "65535"}),
+            "--port must be a UDP port from 1024 to 65534 (P and P+1), not '65535'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--record-mb", "4"}),
+            "--record-mb must be a whole number of at least 8, not '4'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--max-backoff", "-1"}),
+            "--max-backoff must be a positive number of seconds, not '-1'");
+  EXPECT_EQ(ErrorOf({"cartpole", "--actors", "4", "--num-actors", "2"}),
+            "--num-actors (2) must be at least --actors (4)");
+}
+
+TEST(LaunchOptionsTest, RefusesUnknownOptionsAndMissingValues) {
+  EXPECT_EQ(ErrorOf({"cartpole", "--acters", "2"}), "unknown option '--acters' (see --help)");
+  EXPECT_EQ(ErrorOf({"cartpole", "--seed"}), "--seed needs a value (see --help)");
+  EXPECT_EQ(ErrorOf({"cartpole", "extra"}), "unexpected argument 'extra' (see --help)");
+  EXPECT_EQ(ErrorOf({}), "no preset given (see --help)");
+  EXPECT_EQ(ParseLaunchArgs({"cartpole", "--help"}).mode, Mode::kHelp);
+}
+
+}  // namespace
+}  // namespace rl::launch
