@@ -9,12 +9,6 @@
 namespace rl::plot {
 namespace {
 
-std::string Format(const char* fmt, double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), fmt, v);
-  return buf;
-}
-
 // Text sizes of the frames: title, tick labels and legends, axis titles.
 constexpr double kTitleSize = 14;
 constexpr double kSmallSize = 11;
@@ -29,6 +23,12 @@ Font SmallFont(Colour colour, Anchor anchor = Anchor::kStart) {
 }
 
 }  // namespace
+
+std::string FormatNumber(const char* fmt, double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), fmt, v);
+  return buf;
+}
 
 std::string Colour::ToHex() const {
   char buf[8];
@@ -79,7 +79,7 @@ std::string FormatTick(double v, TickFormat format) {
     if (a >= 1e6) return FormatTick(v / 1e6, TickFormat::kPlain) + "M";
     if (a >= 1e3) return FormatTick(v / 1e3, TickFormat::kPlain) + "k";
   }
-  return Format(std::abs(v) < 1e15 && v == std::round(v) ? "%.0f" : "%.3g", v);
+  return FormatNumber(std::abs(v) < 1e15 && v == std::round(v) ? "%.0f" : "%.3g", v);
 }
 
 TimeUnit PickTimeUnit(double max_seconds) {
@@ -254,7 +254,7 @@ void DrawColourBar(Canvas* canvas, const ColourScale& scale, Point corner, doubl
     const double y = corner.y + std::round((hi - t) / (hi - lo) * (rows - 1));
     canvas->Line({corner.x + width, y}, {corner.x + width + 4, y}, ink);
     canvas->Text({corner.x + width + 7, y + 5},
-                 Format("%.3g", std::abs(t) < 1e-12 * (hi - lo) ? 0.0 : t), font);
+                 FormatNumber("%.3g", std::abs(t) < 1e-12 * (hi - lo) ? 0.0 : t), font);
   }
   canvas->Text({corner.x - 8, corner.y - 8}, title, font);
 }

@@ -39,6 +39,10 @@ enum class TickFormat {
 };
 std::string FormatTick(double v, TickFormat format);
 
+/// `v` printed with the printf format `fmt` (one double conversion, e.g. "%.1f"), up to 31
+/// characters.
+std::string FormatNumber(const char* fmt, double v);
+
 /// The unit of a duration axis: seconds, minutes from 2 minutes, hours from 2 hours.
 struct TimeUnit {
   double seconds = 1;  // the unit in seconds

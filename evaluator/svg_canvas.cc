@@ -1,23 +1,15 @@
 #include "evaluator/svg_canvas.h"
 
-#include <cstdio>
+#include "evaluator/plot.h"
 
 namespace rl::plot {
 namespace {
 
 // A coordinate, with one decimal.
-std::string Px(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.1f", v);
-  return buf;
-}
+std::string Px(double v) { return FormatNumber("%.1f", v); }
 
 // A width, opacity or size: the shortest of up to 6 significant digits.
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
+std::string Num(double v) { return FormatNumber("%g", v); }
 
 std::string Attr(const char* name, const std::string& value) {
   return std::string(" ") + name + "=\"" + value + "\"";

@@ -14,13 +14,10 @@
 namespace rl::evaluator {
 namespace {
 
-using testing::CountOccurrences;
-using testing::ReadFile;
 using testing::TempDir;
 
-EvalRecord Record(const std::string& name, int64_t update, double mean) {
-  return testing::SampleRecord(name, update, mean);
-}
+// A record with plausible numbers.
+constexpr auto& Record = testing::SampleRecord;
 
 TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   TempDir dir;
@@ -43,10 +40,10 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   d.second_std = -0.5;
   for (const EvalRecord& r : {a, b, c, d}) AppendJsonLine(path, r);
 
-  const std::string text = ReadFile(path);
-  EXPECT_EQ(CountOccurrences(text, "\n"), 4);
-  EXPECT_EQ(CountOccurrences(text, "\"second_mean\": 642.125"), 1);
-  EXPECT_EQ(CountOccurrences(text, "\"value_correlation\": null"), 1);
+  const std::string text = testing::ReadFile(path);
+  EXPECT_EQ(testing::CountOccurrences(text, "\n"), 4);
+  EXPECT_EQ(testing::CountOccurrences(text, "\"second_mean\": 642.125"), 1);
+  EXPECT_EQ(testing::CountOccurrences(text, "\"value_correlation\": null"), 1);
   int skipped = -1;
   const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
   EXPECT_EQ(skipped, 0);

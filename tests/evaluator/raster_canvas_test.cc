@@ -88,7 +88,7 @@ TEST(RasterCanvasTest, DrawsAColourBarOfThePlotModuleRowByRow) {
   EXPECT_EQ(At(canvas, 28, 22), high);         // high values at the top
   EXPECT_EQ(At(canvas, 28, 117), low);         // low ones at the bottom
   EXPECT_EQ(At(canvas, 20, 60), font.colour);  // the outline
-  EXPECT_EQ(At(canvas, 95, 60), kWhite);  // right of the tick labels
+  EXPECT_EQ(At(canvas, 95, 60), kWhite);       // right of the tick labels
 }
 
 }  // namespace
