@@ -1,16 +1,9 @@
 #include "evaluator/evaluator_service.h"
 
-#include "envs/specs.h"
-#include "evaluator/announced_checkpoint.h"
-#include "evaluator/frame_grid.h"
-#include "evaluator/tsne_map.h"
-#include "evaluator/video.h"
-
 #include <algorithm>
 #include <cmath>
-#include <cstdarg>
+#include <exception>
 #include <filesystem>
-#include <random>
 #include <stdexcept>
 #include <system_error>
 
@@ -19,37 +12,77 @@
 #include "common/clock.h"
 #include "common/shutdown.h"
 #include "common/text_format.h"
-#include "envs/registry.h"
 #include "envs/specs.h"
-#include "nn/checkpoint.h"
-#include "nn/sequential.h"
+#include "evaluator/announced_checkpoint.h"
+#include "evaluator/tsne_map.h"
+#include "evaluator/video.h"
 #include "rlmsg/eval_result_t.hpp"
 #include "rlmsg/stats_evaluator_t.hpp"
 
 namespace rl::evaluator {
 namespace {
 
-// The summary of a score, which EvalScore, EvalRecord and eval_result_t all carry.
-template <class From, class To>
-void CopySummary(const From& from, To* to) {
-  to->mean = from.mean;
-  to->std = from.std;
-  to->min = from.min;
-  to->max = from.max;
-  to->episodes = from.episodes;
-}
-
-std::string FileName(const std::string& path) {
-  return std::filesystem::path(path).filename().string();
-}
+namespace fs = std::filesystem;
 
 // The name of the run folder `dir` ("runs/cartpole-1/" -> "cartpole-1").
 std::string FolderName(const std::string& dir) {
   std::error_code ec;
-  std::filesystem::path p = std::filesystem::absolute(dir, ec).lexically_normal();
-  if (ec) p = std::filesystem::path(dir).lexically_normal();
+  fs::path p = fs::absolute(dir, ec).lexically_normal();
+  if (ec) p = fs::path(dir).lexically_normal();
   if (p.filename().empty()) p = p.parent_path();
   return p.filename().string();
+}
+
+// `config` when it is valid for a service; throws std::invalid_argument otherwise.
+EvaluatorConfig Validated(EvaluatorConfig config) {
+  config.Validate();
+  // LookupSpec throws for an unknown id.
+  if (config.tsne > 0 && envs::LookupSpec(config.env_id).frame_height <= 0) {
+    throw std::invalid_argument("tsne needs a pixel env (its maps show camera frames); " +
+                                config.env_id + " has none");
+  }
+  return config;
+}
+
+// What every report of the run shows: env, run, goal (by default the env's reward threshold),
+// config, how checkpoints are scored, the second metric, and the run folder's other files.
+ReportInfo RunReportInfo(const EvaluatorConfig& c, int64_t run_id) {
+  const envs::EnvSpec spec = envs::LookupSpec(c.env_id);
+  ReportInfo info;
+  info.env_id = c.env_id;
+  info.run_name = c.run_name.empty() && !c.out_dir.empty() ? FolderName(c.out_dir) : c.run_name;
+  info.run_id = run_id;
+  info.goal = std::isnan(c.goal) ? spec.reward_threshold : c.goal;
+  info.run_config = c.run_config_text;
+  const uint64_t last_seed = c.seed_base + static_cast<uint64_t>(c.episodes) - 1;
+  info.eval_settings = "Each checkpoint is scored on " + std::to_string(c.episodes) +
+                       " episodes (seeds " + std::to_string(c.seed_base) + " to " +
+                       std::to_string(last_seed) + ")" +
+                       (spec.continuous() ? std::string(" with the actor's action, without noise")
+                                          : " with epsilon " + FormatDouble("%g", c.epsilon)) +
+                       "; returns G are discounted with gamma " + FormatDouble("%g", c.gamma) + ".";
+  if (!c.second_env.empty()) {
+    info.second_name = (c.second_name.empty() ? c.second_env : c.second_name) + ", " +
+                       std::to_string(c.second_episodes) + " episodes";
+  }
+  if (!c.out_dir.empty()) {
+    info.metrics_file = (fs::path(c.out_dir) / "metrics.jsonl").string();
+    info.restarts_file = (fs::path(c.out_dir) / "restarts").string();
+  }
+  return info;
+}
+
+// The run folder's history (creating the folder), or one in memory without a folder.
+EvalHistory OpenHistory(const std::string& out_dir) {
+  if (out_dir.empty()) return EvalHistory();
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) throw std::runtime_error("cannot create '" + out_dir + "': " + ec.message());
+  return EvalHistory((fs::path(out_dir) / "eval.jsonl").string());
+}
+
+std::string ReportDir(const std::string& out_dir) {
+  return out_dir.empty() ? "" : (fs::path(out_dir) / "report").string();
 }
 
 }  // namespace
@@ -89,123 +122,33 @@ void EvaluatorConfig::Validate() const {
   }
 }
 
-nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env_id,
-                                 nn::CheckpointMeta* meta) {
-  const nn::Checkpoint ckpt = nn::LoadCheckpoint(path);
-  if (meta != nullptr) *meta = ckpt.meta;
-  return PolicyNetwork(ckpt, path, env_id);
-}
-
-nn::Sequential PolicyNetwork(const nn::Checkpoint& ckpt, const std::string& path,
-                             const std::string& env_id) {
-  // Build; every failure is a refusal with a reason.
-  std::mt19937 init_rng(0);  // the initial weights are overwritten by the checkpoint's
-  nn::Sequential net;
-  try {
-    net = nn::BuildFromArchitecture(ckpt.architecture, &init_rng);
-  } catch (const std::exception& e) {
-    throw std::runtime_error("checkpoint " + path + ": cannot build architecture '" +
-                             ckpt.architecture + "': " + e.what());
-  }
-  if (static_cast<int64_t>(ckpt.params.size()) != net.FlatSize()) {
-    throw std::runtime_error("checkpoint " + path + ": " + std::to_string(ckpt.params.size()) +
-                             " parameters, but architecture '" + ckpt.architecture + "' has " +
-                             std::to_string(net.FlatSize()));
-  }
-  net.SetFlat(ckpt.params.data(), ckpt.params.size());
-  const std::string misfit = CheckNetworkFitsEnv(net, envs::LookupSpec(env_id));
-  if (!misfit.empty()) throw std::runtime_error("checkpoint " + path + ": " + misfit);
-  return net;
-}
-
-EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
-                               double epsilon, uint64_t first_seed, double gamma,
-                               const std::function<void()>& after_episode) {
-  return ScoreCheckpoint(nn::LoadCheckpoint(path), path, env_id, episodes, epsilon, first_seed,
-                         gamma, after_episode);
-}
-
-EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
-                           const std::string& env_id, int episodes, double epsilon,
-                           uint64_t first_seed, double gamma,
-                           const std::function<void()>& after_episode) {
-  const nn::CheckpointMeta& meta = ckpt.meta;
-  nn::Sequential net = PolicyNetwork(ckpt, path, env_id);
-
-  // Score.
-  const double start = MonoSeconds();
-  const EvalScore score =
-      ScorePolicy(&net, env_id, episodes, epsilon, first_seed, gamma, after_episode);
-  EvalRecord r;
-  r.checkpoint = FileName(path);
-  r.update = meta.update;
-  r.env_steps = meta.env_steps;
-  r.wall_seconds = meta.wall_seconds;
-  CopySummary(score, &r);
-  r.eval_seconds = MonoSeconds() - start;
-  if (score.values) {
-    r.value_steps = score.values->steps;
-    r.value_estimate = score.values->estimate;
-    r.value_return = score.values->actual;
-    if (std::isfinite(score.values->correlation)) r.value_correlation = score.values->correlation;
-  }
-  return r;
-}
-
 EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* progress)
-    : config_(std::move(config)), bus_(bus), progress_(progress) {
-  config_.Validate();
-  // The goal defaults to the env's reward threshold (LookupSpec throws for an unknown id).
-  const envs::EnvSpec spec = envs::LookupSpec(config_.env_id);
-  goal_ = std::isnan(config_.goal) ? spec.reward_threshold : config_.goal;
-  has_frames_ = spec.frame_height > 0;
-  if (config_.tsne > 0 && !has_frames_) {
-    throw std::invalid_argument("tsne needs a pixel env (its maps show camera frames); " +
-                                config_.env_id + " has none");
-  }
-  start_time_ = MonoSeconds();
-  char epsilon[32], gamma[32];
-  std::snprintf(epsilon, sizeof(epsilon), "%g", config_.epsilon);
-  std::snprintf(gamma, sizeof(gamma), "%g", config_.gamma);
-  const uint64_t last_seed = config_.seed_base + static_cast<uint64_t>(config_.episodes) - 1;
-  eval_settings_ = "Each checkpoint is scored on " + std::to_string(config_.episodes) +
-                   " episodes (seeds " + std::to_string(config_.seed_base) + " to " +
-                   std::to_string(last_seed) + ")" +
-                   (spec.continuous() ? std::string(" with the actor's action, without noise")
-                                      : std::string(" with epsilon ") + epsilon) +
-                   "; returns G are discounted with gamma " + gamma + ".";
-
-  // Resume the history of the run folder.
-  if (!config_.out_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(config_.out_dir, ec);
-    if (ec) {
-      throw std::runtime_error("cannot create '" + config_.out_dir + "': " + ec.message());
-    }
-    jsonl_path_ = (std::filesystem::path(config_.out_dir) / "eval.jsonl").string();
-    report_dir_ = (std::filesystem::path(config_.out_dir) / "report").string();
+    : config_(Validated(std::move(config))),
+      bus_(bus),
+      log_(progress),
+      report_dir_(ReportDir(config_.out_dir)),
+      report_(RunReportInfo(config_, bus->config().run_id)),
+      history_(OpenHistory(config_.out_dir)),
+      second_({config_.second_env, config_.second_episodes, config_.epsilon, config_.seed_base,
+               config_.gamma},
+              log_),
+      media_({config_.env_id, config_.seed_base, config_.video_width, config_.video_height,
+              config_.video_fps, report_dir_}),
+      tsne_({config_.env_id, config_.tsne, config_.seed_base, config_.gamma, report_dir_}, log_) {
+  if (!report_dir_.empty()) {
     // An earlier life killed while it wrote a report file or a video left its temporary file.
     RemoveStaleTemporaries(report_dir_);
-    std::filesystem::remove(VideoTemporaryPath(report_dir_ + "/" + kBestVideo), ec);
-    run_name_ = config_.run_name.empty() ? FolderName(config_.out_dir) : config_.run_name;
-    int skipped_lines = 0;
-    records_ = LoadJsonLines(jsonl_path_, &skipped_lines);
-    if (!records_.empty() || skipped_lines > 0) {
-      Log("evaluator: resumed %zu records from %s (%d unreadable lines skipped)\n", records_.size(),
-          jsonl_path_.c_str(), skipped_lines);
-    }
-    for (const EvalRecord& r : records_) {
-      scored_keys_.insert({r.checkpoint, r.update});
-      if (r.mean >= goal_) goal_reached_ = true;
-    }
-  } else {
-    run_name_ = config_.run_name;
+    std::error_code ec;
+    fs::remove(VideoTemporaryPath((fs::path(report_dir_) / kBestVideo).string()), ec);
   }
-
+  if (!history_.records().empty() || history_.skipped_lines() > 0) {
+    log_("evaluator: resumed %zu records from %s (%d unreadable lines skipped)\n",
+         history_.records().size(), history_.path().c_str(), history_.skipped_lines());
+  }
   // The bus cannot unsubscribe: after the service is gone, its handler does nothing.
   bus_->Subscribe<rlmsg::checkpoint_t>(channels::kCheckpoint,
                                        [alive = alive_](const rlmsg::checkpoint_t& m) {
-                                         if (*alive != nullptr) (*alive)->OnCheckpoint(m);
+                                         if (*alive != nullptr) (*alive)->queue_.Offer(m);
                                        });
   WriteReportNow();
   next_stats_time_ = MonoSeconds();
@@ -213,42 +156,14 @@ EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* 
 
 EvaluatorService::~EvaluatorService() { *alive_ = nullptr; }
 
-void EvaluatorService::Log(const char* fmt, ...) const {
-  if (progress_ == nullptr) return;
-  va_list args;
-  va_start(args, fmt);
-  std::vfprintf(progress_, fmt, args);
-  va_end(args);
-  std::fflush(progress_);
+bool EvaluatorService::goal_reached() const {
+  const EvalRecord* b = history_.best();
+  return b != nullptr && b->mean >= report_.goal;
 }
 
 std::string EvaluatorService::CheckpointFolder() const {
   if (config_.out_dir.empty()) return {};
-  return (std::filesystem::path(config_.out_dir) / "checkpoints").string();
-}
-
-void EvaluatorService::OnCheckpoint(const rlmsg::checkpoint_t& msg) {
-  // A re-announcement of a scored checkpoint changes nothing.
-  if (scored_keys_.count({FileName(msg.path), msg.update}) > 0 ||
-      (pending_ && pending_->path == msg.path && pending_->update == msg.update)) {
-    ++duplicates_;
-    return;
-  }
-  // Keep the newest; the other one is skipped.
-  if (pending_ && msg.update < pending_->update) {
-    ++skipped_;
-    return;
-  }
-  if (pending_) ++skipped_;
-  pending_ = msg;
-}
-
-const EvalRecord* EvaluatorService::best() const {
-  const EvalRecord* b = nullptr;
-  for (const EvalRecord& r : records_) {
-    if (b == nullptr || r.mean > b->mean) b = &r;
-  }
-  return b;
+  return (fs::path(config_.out_dir) / "checkpoints").string();
 }
 
 bool EvaluatorService::Poll(int timeout_ms) {
@@ -258,7 +173,7 @@ bool EvaluatorService::Poll(int timeout_ms) {
   bus_->Handle(std::clamp(stats_ms, 0, std::max(timeout_ms, 0)));
   const bool reached = ScorePending();
   // A map left due by the time share is made when the time allows, between checkpoints.
-  if (!reached && !pending_) MakeDueTsneMap();
+  if (!reached && !queue_.has_pending()) MakeDueTsneMap();
   if (MonoSeconds() >= next_stats_time_) PublishStats();
   return reached && config_.stop_at_goal;
 }
@@ -271,319 +186,125 @@ void EvaluatorService::Run() {
   PublishStats();
 }
 
-bool EvaluatorService::ScorePending() {
-  if (!pending_) return false;
-  const rlmsg::checkpoint_t announced = std::move(*pending_);
-  pending_.reset();
+void EvaluatorService::Tick() {
+  if (StopRequested()) throw Interrupted{};
+  if (MonoSeconds() >= next_stats_time_) PublishStats();
+}
+
+std::optional<EvalRecord> EvaluatorService::Score(const rlmsg::checkpoint_t& announced,
+                                                  nn::Checkpoint* ckpt) {
   busy_ = true;
   PublishStats();
-
-  // Load and score; a refused path or file is logged and counted. The file is read once, from
-  // the run's checkpoint folder only (announced_checkpoint.h), and serves every use below.
+  // A refused path or file is logged and counted. The file is read once, from the run's
+  // checkpoint folder only (announced_checkpoint.h), and serves every use of the checkpoint.
   EvalRecord record;
-  nn::Checkpoint ckpt;
-  // Thrown between episodes when a stop was requested: an unfinished evaluation is dropped.
-  struct Stopped {};
   try {
-    ckpt = ReadAnnouncedCheckpoint(announced.path, CheckpointFolder());
+    *ckpt = ReadAnnouncedCheckpoint(announced.path, CheckpointFolder());
     // Stats keep flowing during a long evaluation (KUKA: about a second per episode), so the
     // monitor never mistakes a busy evaluator for a dead one, and a stop request is honoured
     // after the current episode.
-    record = ScoreCheckpoint(ckpt, announced.path, config_.env_id, config_.episodes,
-                             config_.epsilon, config_.seed_base, config_.gamma, [this] {
-                               if (StopRequested()) throw Stopped{};
-                               if (MonoSeconds() >= next_stats_time_) PublishStats();
-                             });
-  } catch (const Stopped&) {
+    record = ScoreCheckpoint(*ckpt, announced.path, config_.env_id, config_.episodes,
+                             config_.epsilon, config_.seed_base, config_.gamma, [this] { Tick(); });
+  } catch (const Interrupted&) {
     busy_ = false;
     std::printf("evaluator: stopped during an evaluation; %s is left unscored\n",
                 announced.path.c_str());
     std::fflush(stdout);
-    return false;
+    return std::nullopt;
   } catch (const std::exception& e) {
     ++refused_;
     busy_ = false;
-    std::fprintf(stderr, "evaluator: checkpoint refused: %s\n", e.what());
-    std::fflush(stderr);
-    return false;
+    LogError(std::string("checkpoint refused: ") + e.what());
+    return std::nullopt;
   }
-  busy_ = false;
   // The announcement says when the checkpoint was taken.
   record.update = announced.update;
   record.env_steps = announced.env_steps;
   record.wall_seconds = announced.wall_seconds;
-  // A new best is also scored on the second metric.
-  if (!config_.second_env.empty() && record.mean > best_second_mean_) {
-    best_second_mean_ = record.mean;
-    busy_ = true;
-    try {
-      const EvalRecord second =
-          ScoreCheckpoint(ckpt, announced.path, config_.second_env, config_.second_episodes,
-                          config_.epsilon, config_.seed_base, config_.gamma, [this] {
-                            if (StopRequested()) throw Stopped{};
-                            if (MonoSeconds() >= next_stats_time_) PublishStats();
-                          });
-      record.second_mean = second.mean;
-      record.second_std = second.std;
-      record.second_episodes = second.episodes;
-      Log("evaluator: update %lld on the second metric: mean %.2f \xC2\xB1 %.1f (%d episodes, "
-          "%.2f s)\n",
-          static_cast<long long>(record.update), second.mean, second.std, second.episodes,
-          second.eval_seconds);
-    } catch (const Stopped&) {
-      // Stopping: the record keeps its standard score.
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "evaluator: no second metric: %s\n", e.what());
-      std::fflush(stderr);
-    }
-    busy_ = false;
-  }
-  const bool reached = record.mean >= goal_;
-  goal_reached_ = goal_reached_ || reached;
+  second_.ScoreIfBest(*ckpt, announced.path, &record, [this] { Tick(); });
+  busy_ = false;
+  return record;
+}
+
+bool EvaluatorService::ScorePending() {
+  const std::optional<rlmsg::checkpoint_t> announced = queue_.Take();
+  if (!announced) return false;
+  nn::Checkpoint ckpt;
+  const std::optional<EvalRecord> record = Score(*announced, &ckpt);
+  if (!record) return false;
+  const bool reached = record->mean >= report_.goal;
   ++scored_;
-  last_mean_ = record.mean;
-  records_.push_back(record);
-  scored_keys_.insert({record.checkpoint, record.update});
-  if (config_.videos && !report_dir_.empty() && record.mean > best_video_mean_) {
-    RecordVideo(ckpt, announced.path, record);
+  // Persist the history line first, then the media of a new best and the report.
+  try {
+    history_.Add(*record);
+  } catch (const std::exception& e) {
+    LogError(e.what());
   }
-  // A new best checkpoint's t-SNE map becomes due (replacing an older best's that was not made).
-  if (config_.tsne > 0 && !report_dir_.empty() && record.mean > best_tsne_mean_) {
-    try {
-      tsne_net_ = PolicyNetwork(ckpt, announced.path, config_.env_id);
-      tsne_record_ = record;
-      best_tsne_mean_ = record.mean;
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "evaluator: no t-SNE map: %s\n", e.what());
-      std::fflush(stderr);
-    }
-  }
+  if (config_.videos && !report_dir_.empty()) media_.RecordIfBest(ckpt, announced->path, *record);
+  tsne_.OfferBest(ckpt, announced->path, *record);
   // At the goal the run may end as soon as the result is out: a quick map goes first.
-  if (reached && tsne_net_ && ExpectedTsneSeconds() <= kTsneGoalSeconds) MakeTsneMap();
-
-  // Persist: the line first (the history), then the report.
-  if (!jsonl_path_.empty()) {
-    try {
-      AppendJsonLine(jsonl_path_, record);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "evaluator: %s\n", e.what());
-      std::fflush(stderr);
-    }
-  }
+  if (reached && tsne_.due() && tsne_.quick()) MakeTsneMap();
   WriteReportNow();
+  Announce(*announced, *record, reached);
+  MakeDueTsneMap();
+  return reached;
+}
 
-  // Announce the result.
+void EvaluatorService::Announce(const rlmsg::checkpoint_t& announced, const EvalRecord& record,
+                                bool reached) {
   rlmsg::eval_result_t result{};
   result.checkpoint = announced.path;
   result.update = record.update;
   result.env_steps = record.env_steps;
   result.wall_seconds = record.wall_seconds;
-  CopySummary(record, &result);
+  result.mean = record.mean;
+  result.std = record.std;
+  result.min = record.min;
+  result.max = record.max;
+  result.episodes = record.episodes;
   result.goal_reached = reached ? 1 : 0;
   bus_->Publish(channels::kEval, &result);
-
-  Log("evaluator: update %lld, env steps %lld, wall %.1f s: mean %.2f \xC2\xB1 %.1f "
+  log_(
+      "evaluator: update %lld, env steps %lld, wall %.1f s: mean %.2f \xC2\xB1 %.1f "
       "(min %g, max %g, %d episodes, %.2f s)%s\n",
       static_cast<long long>(record.update), static_cast<long long>(record.env_steps),
       record.wall_seconds, record.mean, record.std, record.min, record.max, record.episodes,
       record.eval_seconds, reached ? ", goal reached" : "");
-  MakeDueTsneMap();
-  return reached;
-}
-
-void EvaluatorService::MakeDueTsneMap() {
-  if (!tsne_net_ || report_dir_.empty() || StopRequested()) return;
-  if (tsne_seconds_ + ExpectedTsneSeconds() > kTsneTimeShare * (MonoSeconds() - start_time_)) {
-    return;
-  }
-  if (MakeTsneMap()) WriteReportNow();
-}
-
-double EvaluatorService::ExpectedTsneSeconds() const {
-  return last_tsne_seconds_ > 0 ? last_tsne_seconds_ : kTsneFirstGuessSeconds;
 }
 
 bool EvaluatorService::MakeTsneMap() {
-  if (!tsne_net_) return false;
-  const EvalRecord record = tsne_record_;
-  const double start = MonoSeconds();
-  double next_line = start + 2.0;  // progress lines only for a map that takes a while
   busy_ = true;
   PublishStats();
-  struct Stopped {};
-  // Between episodes and every 50 iterations: stop requests, stats, and a line every 5 s.
-  auto tick = [&](const std::string& line) {
-    if (StopRequested()) throw Stopped{};
-    if (MonoSeconds() >= next_stats_time_) PublishStats();
-    if (MonoSeconds() >= next_line) {
-      Log("evaluator: t-SNE map of %s: %s (%.0f s)\n", record.checkpoint.c_str(), line.c_str(),
-          MonoSeconds() - start);
-      next_line = MonoSeconds() + 5.0;
-    }
-  };
-  bool written = false;
-  try {
-    const StateSamples samples = CollectStates(
-        &*tsne_net_, config_.env_id, config_.tsne, config_.seed_base, config_.gamma,
-        [&](int states) {
-          tick(std::to_string(states) + " of " + std::to_string(config_.tsne) + " states");
-        });
-    const double collected = MonoSeconds();
-    TsneConfig tsne;
-    const TsneMapResult map = WriteTsneMap(
-        samples, tsne, (std::filesystem::path(report_dir_) / kTsneMap).string(),
-        [&](const TsneProgress& p) {
-          char line[96];
-          std::snprintf(line, sizeof(line), "t-SNE iteration %d of %d, KL divergence %.3f",
-                        p.iteration, p.iterations, p.kl_divergence);
-          tick(line);
-        });
-    const double seconds = MonoSeconds() - start;
-    char gamma[32];
-    std::snprintf(gamma, sizeof(gamma), "%g", config_.gamma);
-    const std::string colour =
-        samples.value_is_return
-            ? std::string("the discounted return (gamma ") + gamma +
-                  ") that followed the state in its episode, as the checkpoint holds the actor "
-                  "network only, which has no value estimate (in an episode cut by its time "
-                  "limit, the return up to the cut: short of the truth near the cut)"
-            : std::string("the network's value estimate of the state, max_a Q(s, a)");
-    char distinct[96] = "";
-    if (map.distinct < map.states) {
-      std::snprintf(distinct, sizeof(distinct),
-                    " (%d distinct: a state seen k times is a disc of up to 9 times the area)",
-                    map.distinct);
-    }
-    char caption[1536];
-    std::snprintf(
-        caption, sizeof(caption),
-        "The last hidden layer of %s (update %lld, evaluation mean %.2f) as in Mnih et al. 2015, "
-        "Figure 4: the %d activations (the input of its %s layer) in %d states%s of %d greedy "
-        "episodes (epsilon 0, seeds from %llu), embedded in 2-D with t-SNE (van der Maaten and "
-        "Hinton 2008; perplexity %.3g, %d iterations, KL divergence %.2f). States the network "
-        "represents alike lie close together. Colour: %s, from %.3g to %.3g. Beside the map, "
-        "the newest input frame of %zu states from the lowest to the highest value, each joined "
-        "to its point (ringed).",
-        record.checkpoint.c_str(), static_cast<long long>(record.update), record.mean, map.features,
-        samples.layer_description.c_str(), map.states, distinct, map.episodes,
-        static_cast<unsigned long long>(config_.seed_base), map.perplexity, tsne.iterations,
-        map.kl_divergence, colour.c_str(), map.value_min, map.value_max, map.thumbnails.size());
-    tsne_caption_ = caption;
-    Log("evaluator: t-SNE map of %s (update %lld): %d states of %d greedy episodes (%d "
-        "distinct), %d features, KL divergence %.2f (%.1f s: %.1f s playing, %.1f s "
-        "embedding)\n",
-        record.checkpoint.c_str(), static_cast<long long>(record.update), map.states, map.episodes,
-        map.distinct, map.features, map.kl_divergence, seconds, collected - start,
-        MonoSeconds() - collected);
-    written = true;
-    tsne_net_.reset();
-  } catch (const Stopped&) {
-    Log("evaluator: stopped during the t-SNE map of %s\n", record.checkpoint.c_str());
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "evaluator: no t-SNE map: %s\n", e.what());
-    std::fflush(stderr);
-    tsne_net_.reset();
-  }
+  const bool written = tsne_.Make([this] { Tick(); });
   busy_ = false;
-  const double seconds = MonoSeconds() - start;
-  tsne_seconds_ += seconds;
-  if (written) last_tsne_seconds_ = seconds;
   return written;
 }
 
-void EvaluatorService::RecordVideo(const nn::Checkpoint& ckpt, const std::string& path,
-                                   const EvalRecord& record) {
-  // One network serves the video and the frame grid.
-  nn::Sequential net;
-  try {
-    net = PolicyNetwork(ckpt, path, config_.env_id);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "evaluator: no video: %s\n", e.what());
-    std::fflush(stderr);
-    return;
-  }
-  try {
-    const VideoResult v = RecordGreedyVideo(
-        &net, config_.env_id, config_.seed_base, config_.video_width, config_.video_height,
-        config_.video_fps, (std::filesystem::path(report_dir_) / kBestVideo).string());
-    best_video_mean_ = record.mean;
-    char caption[256];
-    std::snprintf(caption, sizeof(caption),
-                  "Greedy episode (epsilon 0, seed %llu) of the best checkpoint, %s (update %lld, "
-                  "evaluation mean %s): return %s over %d frames.",
-                  static_cast<unsigned long long>(config_.seed_base), record.checkpoint.c_str(),
-                  static_cast<long long>(record.update), rl::Score(record.mean).c_str(),
-                  rl::Score(v.episode_return).c_str(), v.frames);
-    video_caption_ = caption;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "evaluator: no video: %s\n", e.what());
-    std::fflush(stderr);
-  }
-  if (!has_frames_) return;
-  try {
-    const FrameGridResult g = WriteFrameGrid(
-        &net, config_.env_id, config_.seed_base, kFrameGridEpisodes, kFrameGridColumns,
-        (std::filesystem::path(report_dir_) / kFrameGrid).string());
-    char caption[384];
-    std::snprintf(caption, sizeof(caption),
-                  "%d greedy episodes (epsilon 0, seeds %llu to %llu) of %s (update %lld), one row "
-                  "each: the camera image as rendered (left) and the frame the network receives "
-                  "(right) after reset and after every step; mean return %.2f.",
-                  g.episodes, static_cast<unsigned long long>(config_.seed_base),
-                  static_cast<unsigned long long>(config_.seed_base + g.episodes - 1),
-                  record.checkpoint.c_str(), static_cast<long long>(record.update), g.mean_return);
-    frames_caption_ = caption;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "evaluator: no frame grid: %s\n", e.what());
-    std::fflush(stderr);
-  }
+void EvaluatorService::MakeDueTsneMap() {
+  if (!tsne_.due() || StopRequested() || !tsne_.fits_share()) return;
+  if (MakeTsneMap()) WriteReportNow();
 }
 
 void EvaluatorService::WriteReportNow() {
   if (report_dir_.empty()) return;
-  ReportInfo info;
-  info.env_id = config_.env_id;
-  info.run_name = run_name_;
-  info.run_id = bus_->config().run_id;
-  info.goal = goal_;
-  if (!video_caption_.empty()) {
-    info.video_file = kBestVideo;
-    info.video_caption = video_caption_;
-  }
-  if (!frames_caption_.empty()) {
-    info.frames_file = kFrameGrid;
-    info.frames_caption = frames_caption_;
-  }
-  if (!tsne_caption_.empty()) {
-    info.tsne_file = kTsneMap;
-    info.tsne_caption = tsne_caption_;
-  }
-  info.run_config = config_.run_config_text;
-  info.eval_settings = eval_settings_;
-  if (!config_.second_env.empty()) {
-    info.second_name = (config_.second_name.empty() ? config_.second_env : config_.second_name) +
-                       ", " + std::to_string(config_.second_episodes) + " episodes";
-  }
-  info.checkpoints_skipped = skipped_;
+  ReportInfo info = report_;
+  media_.AddTo(&info);
+  tsne_.AddTo(&info);
+  info.checkpoints_skipped = queue_.skipped();
   info.checkpoints_refused = refused_;
-  if (!config_.out_dir.empty()) {
-    info.metrics_file = (std::filesystem::path(config_.out_dir) / "metrics.jsonl").string();
-    info.restarts_file = (std::filesystem::path(config_.out_dir) / "restarts").string();
-  }
   try {
-    WriteReport(report_dir_, records_, info);
+    WriteReport(report_dir_, history_.records(), info);
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "evaluator: cannot write the report: %s\n", e.what());
-    std::fflush(stderr);
+    LogError(std::string("cannot write the report: ") + e.what());
   }
 }
 
 void EvaluatorService::PublishStats() {
   rlmsg::stats_evaluator_t s{};
   s.checkpoints_scored = scored_;
-  s.checkpoints_skipped = skipped_;
+  s.checkpoints_skipped = queue_.skipped();
   s.checkpoints_refused = refused_;
-  s.last_mean = last_mean_;
+  s.last_mean = scored_ > 0 ? history_.records().back().mean : 0.0;
   const EvalRecord* b = best();
   s.best_mean = b != nullptr ? b->mean : 0.0;
   s.best_update = b != nullptr ? b->update : -1;
@@ -594,7 +315,7 @@ void EvaluatorService::PublishStats() {
 }
 
 std::string EvaluatorService::FinalLine() const {
-  if (goal_reached_) return "evaluator: goal reached";
+  if (goal_reached()) return "evaluator: goal reached";
   const EvalRecord* b = best();
   if (b == nullptr) return "evaluator: goal not reached (no checkpoint scored)";
   return "evaluator: goal not reached (best " + rl::Score(b->mean) + ")";

@@ -1,5 +1,6 @@
-// Learning-curve plots as standalone SVG documents: evaluation mean as a line with a shaded
-// band of plus/minus one std, a dashed horizontal goal line, axes with tick labels and titles.
+// Learning-curve plots as standalone SVG documents (drawn with plot.h): evaluation mean as a line
+// with a shaded band of plus/minus one std, a dashed horizontal goal line, axes with tick labels
+// and titles.
 #pragma once
 
 #include <cmath>
@@ -36,11 +37,7 @@ struct CurveStyle {
 };
 
 /// Renders the curve (points are sorted by x; points with a non-finite x, mean or std are left
-/// out). With no points
-/// the plot shows its axes and a "no checkpoint scored yet" note.
+/// out). With no points the plot shows its axes and a "no checkpoint scored yet" note.
 std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveStyle& style);
-
-/// Up to about `target` round tick values (1, 2 or 5 times a power of ten) covering [lo, hi].
-std::vector<double> NiceTicks(double lo, double hi, int target);
 
 }  // namespace rl::evaluator

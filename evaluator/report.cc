@@ -1,37 +1,22 @@
 #include "evaluator/report.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <utility>
 
 #include "common/atomic_file.h"
 #include "common/text_format.h"
-#include "evaluator/flat_json.h"
 #include "evaluator/learning_curve.h"
 #include "evaluator/training_curves.h"
 
 namespace rl::evaluator {
 namespace {
-
-// ---- Files ----
-
-[[noreturn]] void ThrowIo(const std::string& what, const std::string& path) {
-  throw std::runtime_error("cannot " + what + " '" + path + "': " + std::strerror(errno));
-}
-
-// ---- HTML pieces ----
 
 std::string Format(const char* fmt, double v) { return FormatDouble(fmt, v); }
 
@@ -76,156 +61,39 @@ pre { background: var(--soft); border-radius: 6px; padding: 12px; overflow: auto
 .empty { color: var(--muted); }
 )css";
 
-}  // namespace
+// The records the summary and the table point out.
+struct Highlights {
+  const EvalRecord* best = nullptr;        // the best mean (the first checkpoint to reach it)
+  const EvalRecord* first_goal = nullptr;  // the first (lowest update) at the goal
+  const EvalRecord* latest = nullptr;      // the highest update
+  const EvalRecord* second = nullptr;      // the best with a second metric
+};
 
-std::string ToJson(const EvalRecord& r) {
-  std::string s = "{\"checkpoint\": ";
-  AppendJsonString(&s, r.checkpoint);
-  s += ", \"update\": " + std::to_string(r.update);
-  s += ", \"env_steps\": " + std::to_string(r.env_steps);
-  s += ", \"wall_seconds\": " + JsonNumber(r.wall_seconds);
-  s += ", \"mean\": " + JsonNumber(r.mean);
-  s += ", \"std\": " + JsonNumber(r.std);
-  s += ", \"min\": " + JsonNumber(r.min);
-  s += ", \"max\": " + JsonNumber(r.max);
-  s += ", \"episodes\": " + std::to_string(r.episodes);
-  s += ", \"eval_seconds\": " + JsonNumber(r.eval_seconds);
-  if (r.value_steps > 0) {
-    s += ", \"value_steps\": " + std::to_string(r.value_steps);
-    s += ", \"value_estimate\": " + JsonNumber(r.value_estimate);
-    s += ", \"value_return\": " + JsonNumber(r.value_return);
-    s += ", \"value_correlation\": " +
-         (r.value_correlation ? JsonNumber(*r.value_correlation) : std::string("null"));
-  }
-  if (r.second_episodes > 0) {
-    s += ", \"second_mean\": " + JsonNumber(r.second_mean);
-    s += ", \"second_std\": " + JsonNumber(r.second_std);
-    s += ", \"second_episodes\": " + std::to_string(r.second_episodes);
-  }
-  s += "}";
-  return s;
-}
-
-bool ParseJson(const std::string& line, EvalRecord* record) {
-  JsonObject obj;
-  if (!ParseFlatJsonObject(line, &obj)) return false;
-  const auto name = obj.find("checkpoint");
-  if (name == obj.end() || !name->second.is_string) return false;
-  const std::optional<int64_t> update = GetJsonInt(obj, "update");
-  const std::optional<double> mean = GetJsonDouble(obj, "mean");
-  if (!update || !mean) return false;
-  EvalRecord r;
-  r.checkpoint = name->second.text;
-  r.update = *update;
-  r.mean = *mean;
-  r.env_steps = GetJsonInt(obj, "env_steps").value_or(0);
-  r.wall_seconds = GetJsonDouble(obj, "wall_seconds").value_or(0);
-  r.std = GetJsonDouble(obj, "std").value_or(0);
-  r.min = GetJsonDouble(obj, "min").value_or(r.mean);
-  r.max = GetJsonDouble(obj, "max").value_or(r.mean);
-  r.episodes = static_cast<int>(GetJsonInt(obj, "episodes").value_or(0));
-  r.eval_seconds = GetJsonDouble(obj, "eval_seconds").value_or(0);
-  r.value_steps = GetJsonInt(obj, "value_steps").value_or(0);
-  if (r.value_steps > 0) {
-    r.value_estimate = GetJsonDouble(obj, "value_estimate").value_or(0);
-    r.value_return = GetJsonDouble(obj, "value_return").value_or(0);
-    const std::optional<double> c = GetJsonDouble(obj, "value_correlation");
-    if (c && std::isfinite(*c)) r.value_correlation = *c;
-  }
-  r.second_episodes = static_cast<int>(GetJsonInt(obj, "second_episodes").value_or(0));
-  if (r.second_episodes > 0) {
-    r.second_mean = GetJsonDouble(obj, "second_mean").value_or(0);
-    r.second_std = GetJsonDouble(obj, "second_std").value_or(0);
-  }
-  *record = std::move(r);
-  return true;
-}
-
-void AppendJsonLine(const std::string& path, const EvalRecord& record) {
-  const std::string line = ToJson(record) + "\n";
-  std::FILE* f = std::fopen(path.c_str(), "a");
-  if (f == nullptr) ThrowIo("open", path);
-  const bool written = std::fwrite(line.data(), 1, line.size(), f) == line.size();
-  const bool flushed = written && std::fflush(f) == 0 && ::fsync(fileno(f)) == 0;
-  const int saved_errno = errno;
-  std::fclose(f);
-  errno = saved_errno;
-  if (!flushed) ThrowIo("append to", path);
-}
-
-std::vector<EvalRecord> LoadJsonLines(const std::string& path, int* skipped_lines) {
-  std::vector<EvalRecord> records;
-  int skipped = 0;
-  std::ifstream in(path);
-  std::string line;
-  while (in && std::getline(in, line)) {
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    EvalRecord r;
-    if (ParseJson(line, &r)) {
-      records.push_back(std::move(r));
-    } else {
-      ++skipped;
-    }
-  }
-  if (skipped_lines != nullptr) *skipped_lines = skipped;
-  return records;
-}
-
-std::string HtmlEscape(const std::string& text) {
-  std::string out;
-  out.reserve(text.size() + text.size() / 8);
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&#39;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
-                 const ReportInfo& info) {
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw std::runtime_error("cannot create '" + dir + "': " + ec.message());
-  const bool has_goal = std::isfinite(info.goal);
-
-  // Best mean (the first checkpoint to reach it), the first to reach the goal, the latest.
-  const EvalRecord* best = nullptr;
-  const EvalRecord* first_goal = nullptr;
-  const EvalRecord* latest = nullptr;
+Highlights FindHighlights(const std::vector<EvalRecord>& records, double goal) {
+  Highlights h;
   for (const EvalRecord& r : records) {
-    if (best == nullptr || r.mean > best->mean) best = &r;
-    if (has_goal && r.mean >= info.goal &&
-        (first_goal == nullptr || r.update < first_goal->update)) {
-      first_goal = &r;
+    if (h.best == nullptr || r.mean > h.best->mean) h.best = &r;
+    if (std::isfinite(goal) && r.mean >= goal &&
+        (h.first_goal == nullptr || r.update < h.first_goal->update)) {
+      h.first_goal = &r;
     }
-    if (latest == nullptr || r.update >= latest->update) latest = &r;
+    if (h.latest == nullptr || r.update >= h.latest->update) h.latest = &r;
+    // A tie with a later checkpoint leaves the later one without a second metric.
+    if (r.second_episodes > 0 && (h.second == nullptr || r.mean > h.second->mean)) h.second = &r;
   }
+  return h;
+}
 
-  // The two learning curves.
+// curve_env_steps.svg and curve_wall_time.svg.
+void WriteLearningCurves(const std::string& dir, const std::vector<EvalRecord>& records,
+                         double goal) {
   std::vector<CurvePoint> by_steps, by_time;
   for (const EvalRecord& r : records) {
     by_steps.push_back({static_cast<double>(r.env_steps), r.mean, r.std, r.min, r.max});
     by_time.push_back({r.wall_seconds, r.mean, r.std, r.min, r.max});
   }
   CurveStyle style;
-  style.goal = has_goal ? info.goal : std::nan("");
+  style.goal = std::isfinite(goal) ? goal : std::nan("");
   style.title = "Evaluation return vs. environment steps";
   style.x_label = "environment steps";
   style.x_kind = XAxisKind::kCount;
@@ -234,23 +102,29 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
   style.x_label = "wall time since the learner started";
   style.x_kind = XAxisKind::kSeconds;
   WriteFileAtomically(dir + "/" + kCurveWallTime, RenderLearningCurveSvg(by_time, style));
+}
 
-  // The training curves, from the metrics the monitor keeps.
+// The training curves from the metrics the monitor keeps; returns what was drawn.
+std::vector<TrainingSeries> WriteTrainingCurves(const std::string& dir,
+                                                const std::string& metrics_file) {
   std::vector<TrainingSeries> training;
-  if (!info.metrics_file.empty()) training = LoadTrainingSeries(info.metrics_file);
+  if (!metrics_file.empty()) training = LoadTrainingSeries(metrics_file);
   for (TrainingSeries& s : training) {
-    CurveStyle ts;
-    ts.title = s.title;
-    ts.x_label = "time since the launch";
-    ts.y_label = s.y_label;
-    ts.x_kind = XAxisKind::kSeconds;
-    ts.goal = std::nan("");
-    ts.width = 560;
-    ts.height = 300;
-    WriteFileAtomically(dir + "/" + s.file, RenderLearningCurveSvg(std::move(s.points), ts));
+    CurveStyle style;
+    style.title = s.title;
+    style.x_label = "time since the launch";
+    style.y_label = s.y_label;
+    style.x_kind = XAxisKind::kSeconds;
+    style.goal = std::nan("");
+    style.width = 560;
+    style.height = 300;
+    WriteFileAtomically(dir + "/" + s.file, RenderLearningCurveSvg(std::move(s.points), style));
   }
+  return training;
+}
 
-  // Title.
+// The document's head, the title and the line under it.
+std::string Header(const ReportInfo& info, size_t records) {
   std::string run;
   if (!info.run_name.empty() && info.run_id != 0) {
     run = "run " + info.run_name + " (id " + std::to_string(info.run_id) + ")";
@@ -269,8 +143,7 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
   if (!run.empty()) h += " <span class=\"run\">\xC2\xB7 " + HtmlEscape(run) + "</span>";
   h += "</h1>\n";
   h += "<p class=\"meta\">Evaluation report, updated " + HtmlEscape(UtcNow()) + ". " +
-       std::to_string(records.size()) + " checkpoint" + (records.size() == 1 ? "" : "s") +
-       " scored";
+       std::to_string(records) + " checkpoint" + (records == 1 ? "" : "s") + " scored";
   if (info.checkpoints_skipped > 0) {
     h += ", " + std::to_string(info.checkpoints_skipped) + " skipped (superseded)";
   }
@@ -280,56 +153,61 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
   h += ".";
   if (!info.eval_settings.empty()) h += " " + HtmlEscape(info.eval_settings);
   h += "</p>\n";
+  return h;
+}
 
-  // Summary cards.
-  h += "<section class=\"summary\">\n<h2>Summary</h2>\n<div class=\"cards\">\n";
+// "update 1,200, 4,800 env steps, 12 s".
+std::string Where(const EvalRecord& r) {
+  return "update " + Thousands(r.update) + ", " + Thousands(r.env_steps) + " env steps, " +
+         Duration(r.wall_seconds);
+}
+
+// A card's value: the mean and its std.
+std::string MeanValue(const EvalRecord& r) {
+  return "<div class=\"value\">" + Score(r.mean) + " <small>\xC2\xB1 " + Score(r.std) +
+         "</small></div>";
+}
+
+// The summary cards: the goal, the best mean, the latest checkpoint.
+std::string SummarySection(const Highlights& hl, const ReportInfo& info) {
+  std::string h = "<section class=\"summary\">\n<h2>Summary</h2>\n<div class=\"cards\">\n";
   h += "<div class=\"card\"><div class=\"label\">Goal</div><div class=\"value\">";
-  if (!has_goal) {
+  const std::string goal = HtmlEscape(Format("%g", info.goal));
+  if (!std::isfinite(info.goal)) {
     h += "<span class=\"badge no\">none set</span>";
-  } else if (first_goal != nullptr) {
+  } else if (hl.first_goal != nullptr) {
     h += "<span class=\"badge yes\">reached</span></div><div class=\"detail\">mean \xE2\x89\xA5 " +
-         HtmlEscape(Format("%g", info.goal)) + " first at update " + Thousands(first_goal->update) +
-         ", " + Thousands(first_goal->env_steps) + " env steps, " +
-         Duration(first_goal->wall_seconds);
+         goal + " first at " + Where(*hl.first_goal);
   } else {
     h += "<span class=\"badge no\">not reached</span></div><div class=\"detail\">goal: mean "
          "\xE2\x89\xA5 " +
-         HtmlEscape(Format("%g", info.goal));
+         goal;
   }
-  h += "</div></div>\n";
-  h += "<div class=\"card\"><div class=\"label\">Best mean return</div>";
-  if (best != nullptr) {
-    h += "<div class=\"value\">" + Score(best->mean) + " <small>\xC2\xB1 " + Score(best->std) +
-         "</small></div><div class=\"detail\">update " + Thousands(best->update) + ", " +
-         Thousands(best->env_steps) + " env steps, " + Duration(best->wall_seconds) + "</div>";
-    // The second metric of the best checkpoint that has one (a tie with a later checkpoint
-    // leaves the later one without).
-    const EvalRecord* second = nullptr;
-    for (const EvalRecord& r : records) {
-      if (r.second_episodes > 0 && (second == nullptr || r.mean > second->mean)) second = &r;
-    }
-    if (second != nullptr) {
-      h += "<div class=\"detail\">second metric (update " + Thousands(second->update) +
-           "): " + Score(second->second_mean) + " \xC2\xB1 " + Score(second->second_std) +
-           " over " + std::to_string(second->second_episodes) + " episodes</div>";
+  h += "</div></div>\n<div class=\"card\"><div class=\"label\">Best mean return</div>";
+  if (hl.best != nullptr) {
+    h += MeanValue(*hl.best) + "<div class=\"detail\">" + Where(*hl.best) + "</div>";
+    if (hl.second != nullptr) {
+      h += "<div class=\"detail\">second metric (update " + Thousands(hl.second->update) +
+           "): " + Score(hl.second->second_mean) + " \xC2\xB1 " + Score(hl.second->second_std) +
+           " over " + std::to_string(hl.second->second_episodes) + " episodes</div>";
     }
   } else {
     h += "<div class=\"value\">\xE2\x80\x94</div><div class=\"detail\">no checkpoint scored "
          "yet</div>";
   }
-  h += "</div>\n";
-  h += "<div class=\"card\"><div class=\"label\">Latest checkpoint</div>";
-  if (latest != nullptr) {
-    h += "<div class=\"value\">" + Score(latest->mean) + " <small>\xC2\xB1 " + Score(latest->std) +
-         "</small></div><div class=\"detail\">update " + Thousands(latest->update) + ", " +
-         Thousands(latest->env_steps) + " env steps, " + Duration(latest->wall_seconds) + "</div>";
+  h += "</div>\n<div class=\"card\"><div class=\"label\">Latest checkpoint</div>";
+  if (hl.latest != nullptr) {
+    h += MeanValue(*hl.latest) + "<div class=\"detail\">" + Where(*hl.latest) + "</div>";
   } else {
     h += "<div class=\"value\">\xE2\x80\x94</div>";
   }
   h += "</div>\n</div>\n</section>\n";
+  return h;
+}
 
-  // Learning curves.
-  h += "<section>\n<h2>Learning curves</h2>\n";
+// The learning curves and, with metrics, the training curves.
+std::string CurvesSections(const std::vector<TrainingSeries>& training) {
+  std::string h = "<section>\n<h2>Learning curves</h2>\n";
   h += "<figure><img src=\"" + std::string(kCurveEnvSteps) +
        "\" alt=\"evaluation mean return with a band of one standard deviation against "
        "environment steps\" width=\"720\" height=\"380\"></figure>\n";
@@ -337,141 +215,162 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
        "\" alt=\"evaluation mean return with a band of one standard deviation against wall "
        "time\" width=\"720\" height=\"380\"></figure>\n";
   h += "</section>\n";
-
-  // Training curves.
-  if (!training.empty()) {
-    h += "<section>\n<h2>Training</h2>\n<p>What the processes reported while the run went "
-         "(metrics.jsonl): whether it learns, stalls or diverges, and why.</p>\n";
-    for (const TrainingSeries& s : training) {
-      h += "<figure><img src=\"" + HtmlEscape(s.file) + "\" alt=\"" + HtmlEscape(s.title) +
-           " against time\" width=\"560\" height=\"300\"></figure>\n";
-    }
-    h += "</section>\n";
-  }
-
-  // The greedy policy at work.
-  if (!info.video_file.empty()) {
-    h += "<section>\n<h2>Greedy policy</h2>\n<figure><video src=\"" + HtmlEscape(info.video_file) +
-         "\" controls autoplay loop muted playsinline width=\"480\"></video><figcaption>" +
-         HtmlEscape(info.video_caption) + "</figcaption></figure>\n</section>\n";
-  }
-
-  // What the network sees.
-  if (!info.frames_file.empty()) {
-    h += "<section>\n<h2>Camera frames</h2>\n<figure><img src=\"" + HtmlEscape(info.frames_file) +
-         "\" alt=\"a grid of camera frames and network inputs, one row per greedy "
-         "episode\"><figcaption>" +
-         HtmlEscape(info.frames_caption) + "</figcaption></figure>\n</section>\n";
-  }
-
-  // How the network tells states apart.
-  if (!info.tsne_file.empty()) {
-    h += "<section>\n<h2>Last hidden layer (t-SNE)</h2>\n<figure><img src=\"" +
-         HtmlEscape(info.tsne_file) +
-         "\" alt=\"a t-SNE map of the network's last hidden layer in states of greedy episodes, "
-         "coloured by value, with some of their frames\"><figcaption>" +
-         HtmlEscape(info.tsne_caption) + "</figcaption></figure>\n</section>\n";
-  }
-
-  // Table of every checkpoint, newest first.
-  h += "<section>\n<h2>Checkpoints</h2>\n";
-  if (records.empty()) {
-    h += "<p class=\"empty\">No checkpoint scored yet.</p>\n";
-  } else {
-    std::vector<const EvalRecord*> rows;
-    for (const EvalRecord& r : records) rows.push_back(&r);
-    std::stable_sort(rows.begin(), rows.end(), [](const EvalRecord* a, const EvalRecord* b) {
-      return a->update > b->update;
-    });
-    double bar_scale = has_goal ? info.goal : 0;
-    for (const EvalRecord* r : rows) bar_scale = std::max(bar_scale, r->mean);
-    const bool has_values = std::any_of(records.begin(), records.end(),
-                                        [](const EvalRecord& r) { return r.value_steps > 0; });
-    if (has_values) {
-      h += "<p>Q is the network's mean value estimate of the actions taken in the evaluation "
-           "episodes; G is the mean discounted return that followed them (van Hasselt et al. "
-           "2016: Q well above G is overestimation); r is the correlation of the two across the "
-           "steps (near 0: the network cannot tell good states from bad ones).</p>\n";
-    }
-    const bool has_second = !info.second_name.empty();
-    if (has_second) {
-      h += "<p>Second metric (new best checkpoints only): " + HtmlEscape(info.second_name) +
-           ".</p>\n";
-    }
-    h += "<div class=\"scroll\"><table>\n<thead><tr><th>checkpoint</th><th>update</th>"
-         "<th>env steps</th><th>wall time</th><th>mean</th><th>std</th><th>min</th><th>max</th>"
-         "<th>episodes</th><th>eval time</th>";
-    if (has_values) h += "<th>Q</th><th>G</th><th>r</th>";
-    if (has_second) h += "<th>second metric</th>";
-    h += "</tr></thead>\n<tbody>\n";
-    for (const EvalRecord* r : rows) {
-      std::string cls;
-      if (r == best) cls += "best";
-      if (has_goal && r->mean >= info.goal) cls += cls.empty() ? "goal" : " goal";
-      const double bar = bar_scale > 0 ? std::clamp(r->mean / bar_scale, 0.0, 1.0) * 100.0 : 0.0;
-      h += cls.empty() ? "<tr>" : "<tr class=\"" + cls + "\">";
-      h += "<td>" + HtmlEscape(r->checkpoint) + "</td>";
-      h += "<td>" + Thousands(r->update) + "</td>";
-      h += "<td>" + Thousands(r->env_steps) + "</td>";
-      h += "<td>" + Duration(r->wall_seconds) + "</td>";
-      h += "<td class=\"mean\"><span class=\"bar\" style=\"width:" + Format("%.1f", bar) +
-           "%\"></span>" + Score(r->mean) + "</td>";
-      h += "<td>" + Score(r->std) + "</td>";
-      h += "<td>" + Format("%g", r->min) + "</td>";
-      h += "<td>" + Format("%g", r->max) + "</td>";
-      h += "<td>" + std::to_string(r->episodes) + "</td>";
-      h += "<td>" + Format("%.2f s", r->eval_seconds) + "</td>";
-      if (has_values && r->value_steps > 0) {
-        h += "<td>" + Score(r->value_estimate) + "</td><td>" + Score(r->value_return) +
-             "</td><td>" +
-             (r->value_correlation ? Format("%.2f", *r->value_correlation) : "\xE2\x80\x94") +
-             "</td>";
-      } else if (has_values) {
-        h += "<td></td><td></td><td></td>";
-      }
-      if (has_second) {
-        h += "<td>" +
-             (r->second_episodes > 0 ? Score(r->second_mean) + " \xC2\xB1 " + Score(r->second_std) +
-                                           " (" + std::to_string(r->second_episodes) + ")"
-                                     : std::string()) +
-             "</td>";
-      }
-      h += "</tr>\n";
-    }
-    h += "</tbody>\n</table></div>\n";
+  if (training.empty()) return h;
+  h += "<section>\n<h2>Training</h2>\n<p>What the processes reported while the run went "
+       "(metrics.jsonl): whether it learns, stalls or diverges, and why.</p>\n";
+  for (const TrainingSeries& s : training) {
+    h += "<figure><img src=\"" + HtmlEscape(s.file) + "\" alt=\"" + HtmlEscape(s.title) +
+         " against time\" width=\"560\" height=\"300\"></figure>\n";
   }
   h += "</section>\n";
+  return h;
+}
 
-  // Processes the launch script restarted (crashes, kills).
-  if (!info.restarts_file.empty()) {
-    std::ifstream in(info.restarts_file);
-    std::string rows;
-    std::map<std::string, int> by_role;
-    int n = 0;
-    for (std::string line; std::getline(in, line);) {
-      std::istringstream fields(line);
-      std::string time, role, status_word, code, restart_word, count;
-      if (!(fields >> time >> role >> status_word >> code >> restart_word >> count)) continue;
-      ++n;
-      ++by_role[role];
-      rows += "<tr><td>" + HtmlEscape(time) + "</td><td>" + HtmlEscape(role) + "</td><td>" +
-              HtmlEscape(code) + "</td><td>" + HtmlEscape(count) + "</td></tr>\n";
-    }
-    if (n > 0) {
-      std::string summary;
-      for (const auto& [role, k] : by_role) {
-        summary += (summary.empty() ? "" : ", ") + role + " " + std::to_string(k);
-      }
-      h += "<section>\n<h2>Restarts</h2>\n<p>" + std::to_string(n) + " process restart" +
-           (n == 1 ? "" : "s") + " (" + HtmlEscape(summary) +
-           "): the launch script restarted each after it exited (status above 128: killed by "
-           "signal status - 128).</p>\n<div class=\"scroll\"><table>\n<thead><tr><th>time</th>"
-           "<th>process</th><th>exit status</th><th>restart</th></tr></thead>\n<tbody>\n" +
-           rows + "</tbody>\n</table></div>\n</section>\n";
-    }
+// A section of one figure with its caption.
+std::string FigureSection(const std::string& heading, const std::string& media,
+                          const std::string& caption) {
+  return "<section>\n<h2>" + heading + "</h2>\n<figure>" + media + "<figcaption>" +
+         HtmlEscape(caption) + "</figcaption></figure>\n</section>\n";
+}
+
+// The greedy policy at work, what the network sees and how it tells states apart.
+std::string MediaSections(const ReportInfo& info) {
+  std::string h;
+  if (!info.video_file.empty()) {
+    h += FigureSection("Greedy policy",
+                       "<video src=\"" + HtmlEscape(info.video_file) +
+                           "\" controls autoplay loop muted playsinline width=\"480\"></video>",
+                       info.video_caption);
   }
+  if (!info.frames_file.empty()) {
+    h += FigureSection("Camera frames",
+                       "<img src=\"" + HtmlEscape(info.frames_file) +
+                           "\" alt=\"a grid of camera frames and network inputs, one row per "
+                           "greedy episode\">",
+                       info.frames_caption);
+  }
+  if (!info.tsne_file.empty()) {
+    h += FigureSection("Last hidden layer (t-SNE)",
+                       "<img src=\"" + HtmlEscape(info.tsne_file) +
+                           "\" alt=\"a t-SNE map of the network's last hidden layer in states of "
+                           "greedy episodes, coloured by value, with some of their frames\">",
+                       info.tsne_caption);
+  }
+  return h;
+}
 
-  // The run's config.
+// One row of the checkpoint table.
+std::string CheckpointRow(const EvalRecord& r, const Highlights& hl, const ReportInfo& info,
+                          double bar_scale, bool has_values, bool has_second) {
+  std::string cls;
+  if (&r == hl.best) cls += "best";
+  if (std::isfinite(info.goal) && r.mean >= info.goal) cls += cls.empty() ? "goal" : " goal";
+  const double bar = bar_scale > 0 ? std::clamp(r.mean / bar_scale, 0.0, 1.0) * 100.0 : 0.0;
+  std::string h = cls.empty() ? "<tr>" : "<tr class=\"" + cls + "\">";
+  h += "<td>" + HtmlEscape(r.checkpoint) + "</td><td>" + Thousands(r.update) + "</td><td>" +
+       Thousands(r.env_steps) + "</td><td>" + Duration(r.wall_seconds) + "</td>";
+  h += "<td class=\"mean\"><span class=\"bar\" style=\"width:" + Format("%.1f", bar) +
+       "%\"></span>" + Score(r.mean) + "</td>";
+  h += "<td>" + Score(r.std) + "</td><td>" + Format("%g", r.min) + "</td><td>" +
+       Format("%g", r.max) + "</td><td>" + std::to_string(r.episodes) + "</td><td>" +
+       Format("%.2f s", r.eval_seconds) + "</td>";
+  if (has_values && r.value_steps > 0) {
+    h += "<td>" + Score(r.value_estimate) + "</td><td>" + Score(r.value_return) + "</td><td>" +
+         (r.value_correlation ? Format("%.2f", *r.value_correlation) : "\xE2\x80\x94") + "</td>";
+  } else if (has_values) {
+    h += "<td></td><td></td><td></td>";
+  }
+  if (has_second) {
+    h += "<td>" +
+         (r.second_episodes > 0 ? Score(r.second_mean) + " \xC2\xB1 " + Score(r.second_std) + " (" +
+                                      std::to_string(r.second_episodes) + ")"
+                                : std::string()) +
+         "</td>";
+  }
+  return h + "</tr>\n";
+}
+
+// The table of every checkpoint, newest first.
+std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Highlights& hl,
+                               const ReportInfo& info) {
+  std::string h = "<section>\n<h2>Checkpoints</h2>\n";
+  if (records.empty()) return h + "<p class=\"empty\">No checkpoint scored yet.</p>\n</section>\n";
+  std::vector<const EvalRecord*> rows;
+  for (const EvalRecord& r : records) rows.push_back(&r);
+  std::stable_sort(rows.begin(), rows.end(),
+                   [](const EvalRecord* a, const EvalRecord* b) { return a->update > b->update; });
+  double bar_scale = std::isfinite(info.goal) ? info.goal : 0;
+  for (const EvalRecord* r : rows) bar_scale = std::max(bar_scale, r->mean);
+  const bool has_values = std::any_of(records.begin(), records.end(),
+                                      [](const EvalRecord& r) { return r.value_steps > 0; });
+  if (has_values) {
+    h += "<p>Q is the network's mean value estimate of the actions taken in the evaluation "
+         "episodes; G is the mean discounted return that followed them (van Hasselt et al. "
+         "2016: Q well above G is overestimation); r is the correlation of the two across the "
+         "steps (near 0: the network cannot tell good states from bad ones).</p>\n";
+  }
+  const bool has_second = !info.second_name.empty();
+  if (has_second) {
+    h +=
+        "<p>Second metric (new best checkpoints only): " + HtmlEscape(info.second_name) + ".</p>\n";
+  }
+  h += "<div class=\"scroll\"><table>\n<thead><tr><th>checkpoint</th><th>update</th>"
+       "<th>env steps</th><th>wall time</th><th>mean</th><th>std</th><th>min</th><th>max</th>"
+       "<th>episodes</th><th>eval time</th>";
+  if (has_values) h += "<th>Q</th><th>G</th><th>r</th>";
+  if (has_second) h += "<th>second metric</th>";
+  h += "</tr></thead>\n<tbody>\n";
+  for (const EvalRecord* r : rows)
+    h += CheckpointRow(*r, hl, info, bar_scale, has_values, has_second);
+  return h + "</tbody>\n</table></div>\n</section>\n";
+}
+
+// Processes the launch script restarted (crashes, kills); empty when there were none.
+std::string RestartsSection(const std::string& restarts_file) {
+  if (restarts_file.empty()) return "";
+  std::ifstream in(restarts_file);
+  std::string rows;
+  std::map<std::string, int> by_role;
+  int n = 0;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream fields(line);
+    std::string time, role, status_word, code, restart_word, count;
+    if (!(fields >> time >> role >> status_word >> code >> restart_word >> count)) continue;
+    ++n;
+    ++by_role[role];
+    rows += "<tr><td>" + HtmlEscape(time) + "</td><td>" + HtmlEscape(role) + "</td><td>" +
+            HtmlEscape(code) + "</td><td>" + HtmlEscape(count) + "</td></tr>\n";
+  }
+  if (n == 0) return "";
+  std::string summary;
+  for (const auto& [role, k] : by_role) {
+    summary += (summary.empty() ? "" : ", ") + role + " " + std::to_string(k);
+  }
+  return "<section>\n<h2>Restarts</h2>\n<p>" + std::to_string(n) + " process restart" +
+         (n == 1 ? "" : "s") + " (" + HtmlEscape(summary) +
+         "): the launch script restarted each after it exited (status above 128: killed by "
+         "signal status - 128).</p>\n<div class=\"scroll\"><table>\n<thead><tr><th>time</th>"
+         "<th>process</th><th>exit status</th><th>restart</th></tr></thead>\n<tbody>\n" +
+         rows + "</tbody>\n</table></div>\n</section>\n";
+}
+
+}  // namespace
+
+void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
+                 const ReportInfo& info) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create '" + dir + "': " + ec.message());
+  WriteLearningCurves(dir, records, info.goal);
+  const std::vector<TrainingSeries> training = WriteTrainingCurves(dir, info.metrics_file);
+
+  const Highlights highlights = FindHighlights(records, info.goal);
+  std::string h = Header(info, records.size());
+  h += SummarySection(highlights, info);
+  h += CurvesSections(training);
+  h += MediaSections(info);
+  h += CheckpointsSection(records, highlights, info);
+  h += RestartsSection(info.restarts_file);
   h += "<section>\n<h2>Run config</h2>\n<pre>" +
        HtmlEscape(info.run_config.empty() ? "(none given)" : info.run_config) +
        "</pre>\n</section>\n";

@@ -1,62 +1,20 @@
-// The evaluator's outputs: eval.jsonl (one JSON line per scored checkpoint, appended and synced,
-// so a restarted evaluator keeps the history) and report/ (index.html with the summary, two
-// learning-curve SVGs, a table of every checkpoint and the run's config).
+// The run's report: report/index.html with the summary, the learning and training curves, the
+// evaluator's media, a table of every checkpoint, the restarts and the run's config, written from
+// the evaluation history (eval_history.h) and what the run folder holds. No physics, rendering or
+// OpenCV: the compare page (tools/compare_runs.h) links it too.
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <vector>
 
+#include "evaluator/eval_history.h"
+#include "evaluator/svg_canvas.h"
+
 namespace rl::evaluator {
 
-/// The score of one checkpoint.
-struct EvalRecord {
-  std::string checkpoint;   // file name of the checkpoint (no directory)
-  int64_t update = 0;       // learner update count of the checkpoint
-  int64_t env_steps = 0;    // transitions the replay had received at the checkpoint
-  double wall_seconds = 0;  // seconds since the learner started, at the checkpoint
-  double mean = 0;          // mean undiscounted return of the evaluation episodes
-  double std = 0;           // population std of the returns
-  double min = 0;
-  double max = 0;
-  int episodes = 0;         // evaluation episodes
-  double eval_seconds = 0;  // seconds the scoring took
-  // The network's value estimates against the returns that followed (ValueCalibration); all
-  // zero and no correlation when not measured (value_steps 0).
-  int64_t value_steps = 0;
-  double value_estimate = 0;                // mean Q(s_t, a_t) of the actions taken
-  double value_return = 0;                  // mean discounted return that followed them
-  std::optional<double> value_correlation;  // unset when undefined (a constant series)
-  // The checkpoint on the second metric (EvaluatorConfig::second_env), scored for new best
-  // checkpoints only; second_episodes 0: not scored.
-  int second_episodes = 0;
-  double second_mean = 0;
-  double second_std = 0;
-
-  bool operator==(const EvalRecord&) const = default;
-};
-
-/// One line of eval.jsonl, without the newline: {"checkpoint": ..., "update": ..., "env_steps":
-/// ..., "wall_seconds": ..., "mean": ..., "std": ..., "min": ..., "max": ..., "episodes": ...,
-/// "eval_seconds": ...}, and when value_steps > 0 also "value_steps", "value_estimate",
-/// "value_return" and "value_correlation" (null when unset), and when second_episodes > 0
-/// "second_mean", "second_std" and "second_episodes". Numbers are written in their
-/// shortest form that reads back exactly; a non-finite number is written as null.
-std::string ToJson(const EvalRecord& record);
-
-/// Parses one line written by ToJson (keys in any order, unknown keys ignored, whitespace
-/// allowed). Returns false, leaving *record unspecified, when the line is not such an object or
-/// lacks "checkpoint", "update" or "mean".
-bool ParseJson(const std::string& line, EvalRecord* record);
-
-/// Appends ToJson(record) and a newline to the file at `path` (created if missing), then
-/// flushes and fsyncs it. Throws std::runtime_error naming the file on an I/O error.
-void AppendJsonLine(const std::string& path, const EvalRecord& record);
-
-/// Reads the records of an eval.jsonl. A missing file gives no records; a line that does not
-/// parse (such as a line torn by a crash) is skipped and counted in *skipped_lines if given.
-std::vector<EvalRecord> LoadJsonLines(const std::string& path, int* skipped_lines = nullptr);
+/// Escapes &, <, >, " and ' for HTML text and attribute values.
+using plot::HtmlEscape;
 
 /// What the report shows besides the records.
 struct ReportInfo {
@@ -103,8 +61,5 @@ inline constexpr int kFrameGridColumns = 8;
 /// error.
 void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
                  const ReportInfo& info);
-
-/// Escapes &, <, >, " and ' for HTML text and attribute values.
-std::string HtmlEscape(const std::string& text);
 
 }  // namespace rl::evaluator

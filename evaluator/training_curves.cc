@@ -5,7 +5,7 @@
 #include <map>
 #include <optional>
 
-#include "evaluator/flat_json.h"
+#include "evaluator/json_line.h"
 
 namespace rl::evaluator {
 namespace {
@@ -23,14 +23,14 @@ std::vector<TrainingSeries> LoadTrainingSeries(const std::string& path) {
   std::ifstream in(path);
   std::map<double, Row> rows;  // by t
   for (std::string line; std::getline(in, line);) {
-    JsonObject obj;
-    if (!ParseFlatJsonObject(line, &obj)) continue;
-    const std::optional<double> t = GetJsonDouble(obj, "t");
-    const auto role = obj.find("role");
-    if (!t || !std::isfinite(*t) || role == obj.end() || !role->second.is_string) continue;
+    const std::optional<nlohmann::json> obj = ParseJsonLine(line);
+    if (!obj) continue;
+    const std::optional<double> t = JsonNumberAt(*obj, "t");
+    const std::optional<std::string> role = JsonStringAt(*obj, "role");
+    if (!t || !std::isfinite(*t) || !role) continue;
     Row& row = rows[*t];
-    const std::string& who = role->second.text;
-    const auto get = [&obj](const char* key) { return GetJsonDouble(obj, key); };
+    const std::string& who = *role;
+    const auto get = [&obj](const char* key) { return JsonNumberAt(*obj, key); };
     if (who.rfind("actor-", 0) == 0) {
       const auto ret = get("mean_return"), exploration = get("exploration"),
                  speed = get("steps_per_second");

@@ -19,7 +19,8 @@
 
 #include "common/atomic_file.h"
 #include "envs/registry.h"
-#include "evaluator/learning_curve.h"
+#include "evaluator/plot.h"
+#include "evaluator/raster_canvas.h"
 #include "nn/dueling.h"
 #include "nn/linear.h"
 
@@ -197,30 +198,132 @@ namespace {
 constexpr int kPlotSide = 560;  // the square scatter plot
 constexpr int kMargin = 16;
 constexpr int kTitleHeight = 34;
-constexpr int kColumnGap = 36;      // between a column of thumbnails and the plot
-constexpr int kThumbSide = 96;      // the longer side of a thumbnail
-constexpr int kLabelHeight = 18;    // below a thumbnail
-constexpr int kBarWidth = 16;       // the colour bar
-constexpr int kBarLabels = 64;      // room for its tick labels
-constexpr double kFont = 0.45;      // FONT_HERSHEY_SIMPLEX scale
-const cv::Scalar kInk(40, 40, 40);  // BGR
-const cv::Scalar kLine(110, 110, 110);
+constexpr int kColumnGap = 36;    // between a column of thumbnails and the plot
+constexpr int kThumbSide = 96;    // the longer side of a thumbnail
+constexpr int kLabelHeight = 18;  // below a thumbnail
+constexpr int kBarWidth = 16;     // the colour bar
+constexpr int kBarLabels = 64;    // room for its tick labels
+// Text: labels at OpenCV's Hershey scale 0.45, the title at 0.55 at most.
+constexpr double kFontSize = 0.45 * RasterCanvas::kPixelsPerScale;
+constexpr double kTitleSize = 0.55 * RasterCanvas::kPixelsPerScale;
+constexpr plot::Colour kInk = plot::Colour::Hex(0x282828);
+constexpr plot::Colour kLine = plot::Colour::Hex(0x6e6e6e);
+constexpr plot::Colour kFrame = plot::Colour::Hex(0xd2d2d2);
 
-// The viridis colour map, 256 BGR entries.
-std::vector<cv::Vec3b> Viridis() {
+// The viridis colour map (OpenCV's), 256 entries.
+std::vector<plot::Colour> Viridis() {
   cv::Mat ramp(1, 256, CV_8UC1);
   for (int i = 0; i < 256; ++i) ramp.at<uint8_t>(0, i) = static_cast<uint8_t>(i);
   cv::Mat colours;
   cv::applyColorMap(ramp, colours, cv::COLORMAP_VIRIDIS);
-  std::vector<cv::Vec3b> lut(256);
-  for (int i = 0; i < 256; ++i) lut[static_cast<size_t>(i)] = colours.at<cv::Vec3b>(0, i);
-  return lut;
+  std::vector<plot::Colour> palette;
+  for (int i = 0; i < 256; ++i) {
+    const cv::Vec3b c = colours.at<cv::Vec3b>(0, i);  // BGR
+    palette.push_back({c[2], c[1], c[0]});
+  }
+  return palette;
 }
 
 std::string Number(double v) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.3g", v);
   return buf;
+}
+
+plot::Font TextFont(double size = kFontSize) {
+  plot::Font f;
+  f.size = size;
+  f.colour = kInk;
+  return f;
+}
+
+// Where the parts of the picture go: thumbnails left and right of the square plot, then the
+// colour bar.
+struct Layout {
+  int thumb_w = 0, thumb_h = 0;  // frames scaled up by a whole factor to at most kThumbSide
+  int plot_x = 0, plot_y = kTitleHeight;
+  int right_x = 0;  // the right column of thumbnails
+  int bar_x = 0;
+  int width = 0, height = 0;
+};
+
+Layout MakeLayout(int frame_height, int frame_width) {
+  Layout l;
+  const int scale = std::max(1, kThumbSide / std::max(frame_height, frame_width));
+  l.thumb_w = frame_width * scale;
+  l.thumb_h = frame_height * scale;
+  l.plot_x = kMargin + l.thumb_w + kColumnGap;
+  l.right_x = l.plot_x + kPlotSide + kColumnGap;
+  l.bar_x = l.right_x + l.thumb_w + kColumnGap;
+  l.width = l.bar_x + kBarWidth + kBarLabels;
+  l.height = l.plot_y + kPlotSide + kMargin;
+  return l;
+}
+
+// The title, shrunk to end before the colour bar's label.
+void DrawTitle(RasterCanvas* canvas, const Layout& l, const std::string& title) {
+  double size = kTitleSize;
+  const double room = l.bar_x - kColumnGap / 2 - kMargin;
+  while (size > 0.3 * RasterCanvas::kPixelsPerScale + 1e-9 &&
+         canvas->TextWidth(title, size) > room) {
+    size -= 0.05 * RasterCanvas::kPixelsPerScale;
+  }
+  canvas->Text({kMargin, 22}, title, TextFont(size));
+}
+
+// The points of the map and how they are drawn.
+struct Scatter {
+  std::vector<plot::Point> at;  // pixels
+  std::vector<double> radius;
+  const std::vector<double>* values = nullptr;
+};
+
+// The thumbnails: the left half of the chosen points (by x) in the left column, the rest in the
+// right one, each column ordered by y so that the lines do not cross; each joined to its ringed
+// point and labelled with its value.
+void DrawThumbnails(RasterCanvas* canvas, const Layout& l, const StateSamples& samples,
+                    const std::vector<int>& chosen, const Scatter& scatter,
+                    const plot::ColourScale& colour) {
+  std::vector<int> by_x = chosen;
+  std::stable_sort(by_x.begin(), by_x.end(), [&](int a, int b) {
+    return std::lround(scatter.at[static_cast<size_t>(a)].x) <
+           std::lround(scatter.at[static_cast<size_t>(b)].x);
+  });
+  const size_t left_count = by_x.size() / 2;
+  const size_t frame_bytes = static_cast<size_t>(samples.frame_height) * samples.frame_width;
+  for (int side = 0; side < 2; ++side) {
+    std::vector<int> column(side == 0 ? by_x.begin() : by_x.begin() + left_count,
+                            side == 0 ? by_x.begin() + left_count : by_x.end());
+    std::stable_sort(column.begin(), column.end(), [&](int a, int b) {
+      return std::lround(scatter.at[static_cast<size_t>(a)].y) <
+             std::lround(scatter.at[static_cast<size_t>(b)].y);
+    });
+    const int x = side == 0 ? kMargin : l.right_x;
+    for (size_t k = 0; k < column.size(); ++k) {
+      const auto i = static_cast<size_t>(column[k]);
+      const double slot = static_cast<double>(kPlotSide) / static_cast<double>(column.size());
+      const int centre_y = l.plot_y + static_cast<int>((static_cast<double>(k) + 0.5) * slot);
+      const int top = centre_y - (l.thumb_h + kLabelHeight) / 2;
+      const plot::Point anchor{static_cast<double>(side == 0 ? x + l.thumb_w + 2 : x - 3),
+                               static_cast<double>(top + l.thumb_h / 2)};
+      canvas->Line(anchor, scatter.at[i], plot::Paint::Stroke(kLine));
+      canvas->Circle(scatter.at[i], std::lround(scatter.radius[i]) + 4,
+                     plot::Paint::Stroke(kInk, 2));
+      const cv::Mat frame(samples.frame_height, samples.frame_width, CV_8UC1,
+                          const_cast<uint8_t*>(samples.frames.data()) + frame_bytes * i);
+      cv::Mat big, bgr;
+      cv::resize(frame, big, cv::Size(l.thumb_w, l.thumb_h), 0, 0, cv::INTER_NEAREST);
+      cv::cvtColor(big, bgr, cv::COLOR_GRAY2BGR);
+      bgr.copyTo(canvas->image()(cv::Rect(x, top, l.thumb_w, l.thumb_h)));
+      const double v = (*scatter.values)[i];
+      plot::Paint border = plot::Paint::Stroke(colour(v), 2);
+      border.crisp = true;
+      canvas->Rect({x - 2.0, top - 2.0}, l.thumb_w + 4, l.thumb_h + 4, border);
+      canvas->Text(
+          {static_cast<double>(x), static_cast<double>(top + l.thumb_h + kLabelHeight - 3)},
+          (samples.value_is_return ? "G " : "Q ") + Number(v), TextFont());
+    }
+  }
 }
 
 }  // namespace
@@ -298,7 +401,6 @@ TsneMapResult WriteTsneMap(const StateSamples& all, const TsneConfig& config,
   std::vector<int> counts;
   const StateSamples samples = DistinctStates(all, &counts);
   const auto n = static_cast<int>(samples.activations.cols());
-  const size_t frame_bytes = static_cast<size_t>(samples.frame_height) * samples.frame_width;
   if (n < kTsneMinPoints) {
     throw std::runtime_error("t-SNE map: only " + std::to_string(n) + " distinct states of " +
                              std::to_string(all.activations.cols()) +
@@ -314,134 +416,50 @@ TsneMapResult WriteTsneMap(const StateSamples& all, const TsneConfig& config,
   tsne.perplexity = std::min(config.perplexity, std::max(1.0, (n - 1) / 3.0));
   result.perplexity = tsne.perplexity;
   const Eigen::MatrixXd y = Tsne(samples.activations, tsne, progress, 50, &result.kl_divergence);
-
-  // Colours by value.
-  const auto [lo_it, hi_it] = std::minmax_element(samples.values.begin(), samples.values.end());
-  result.value_min = *lo_it;
-  result.value_max = *hi_it;
-  double lo = result.value_min, hi = result.value_max;
-  if (!(hi > lo)) {  // one value: the middle colour
-    lo -= 0.5;
-    hi += 0.5;
-  }
-  const std::vector<cv::Vec3b> lut = Viridis();
-  auto colour = [&](double v) {
-    const int k = static_cast<int>(std::lround(std::clamp((v - lo) / (hi - lo), 0.0, 1.0) * 255));
-    const cv::Vec3b c = lut[static_cast<size_t>(k)];
-    return cv::Scalar(c[0], c[1], c[2]);
-  };
-
-  // Thumbnails: frames scaled up by an integer factor to at most kThumbSide.
-  const int scale = std::max(1, kThumbSide / std::max(samples.frame_height, samples.frame_width));
-  const int thumb_w = samples.frame_width * scale;
-  const int thumb_h = samples.frame_height * scale;
+  const auto [lo, hi] = std::minmax_element(samples.values.begin(), samples.values.end());
+  result.value_min = *lo;
+  result.value_max = *hi;
+  const plot::ColourScale colour(*lo, *hi, Viridis());
   result.thumbnails = ThumbnailStates(samples, kTsneMapThumbnails);
 
-  // The page.
-  const int plot_x = kMargin + thumb_w + kColumnGap;
-  const int plot_y = kTitleHeight;
-  const int right_x = plot_x + kPlotSide + kColumnGap;
-  const int bar_x = right_x + thumb_w + kColumnGap;
-  const int width = bar_x + kBarWidth + kBarLabels;
-  const int height = plot_y + kPlotSide + kMargin;
-  cv::Mat page(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  // The title, shrunk to end before the colour bar's label.
-  const std::string title =
-      "t-SNE of the last hidden layer (" + std::to_string(result.features) +
-      " features): " + std::to_string(result.states) + " states" +
-      (n < result.states ? " (" + std::to_string(n) + " distinct)" : std::string()) + ", by " +
-      (samples.value_is_return ? "return" : "value");
-  double title_scale = 0.55;
-  int baseline = 0;
-  while (title_scale > 0.3 &&
-         cv::getTextSize(title, cv::FONT_HERSHEY_SIMPLEX, title_scale, 1, &baseline).width >
-             bar_x - kColumnGap / 2 - kMargin) {
-    title_scale -= 0.05;
-  }
-  cv::putText(page, title, cv::Point(kMargin, 22), cv::FONT_HERSHEY_SIMPLEX, title_scale, kInk, 1,
-              cv::LINE_AA);
-  cv::rectangle(page, cv::Rect(plot_x, plot_y, kPlotSide, kPlotSide), cv::Scalar(210, 210, 210), 1);
-
-  // Embedding to pixels: one scale for both axes (t-SNE distances are isotropic), centred, y up.
-  const double x_min = y.row(0).minCoeff(), x_max = y.row(0).maxCoeff();
-  const double y_min = y.row(1).minCoeff(), y_max = y.row(1).maxCoeff();
-  const double span = std::max({x_max - x_min, y_max - y_min, 1e-12});
-  const double pixels = (kPlotSide - 24) / span;
-  auto to_pixel = [&](int i) {
-    const double px = plot_x + kPlotSide / 2.0 + (y(0, i) - (x_min + x_max) / 2) * pixels;
-    const double py = plot_y + kPlotSide / 2.0 - (y(1, i) - (y_min + y_max) / 2) * pixels;
-    return cv::Point(static_cast<int>(std::lround(px)), static_cast<int>(std::lround(py)));
-  };
-  // A state that occurred k times is a disc of k times the area (at most 9 times).
-  const int radius = n <= 1000 ? 3 : 2;
-  auto disc = [&](int i) {
-    const double k = std::min(9.0, static_cast<double>(counts[static_cast<size_t>(i)]));
-    return static_cast<int>(std::lround(radius * std::sqrt(k)));
-  };
+  const Layout layout = MakeLayout(samples.frame_height, samples.frame_width);
+  RasterCanvas canvas(layout.width, layout.height);
+  DrawTitle(&canvas, layout,
+            "t-SNE of the last hidden layer (" + std::to_string(result.features) +
+                " features): " + std::to_string(result.states) + " states" +
+                (n < result.states ? " (" + std::to_string(n) + " distinct)" : std::string()) +
+                ", by " + (samples.value_is_return ? "return" : "value"));
+  plot::Paint frame = plot::Paint::Stroke(kFrame);
+  frame.crisp = true;
+  canvas.Rect({static_cast<double>(layout.plot_x), static_cast<double>(layout.plot_y)}, kPlotSide,
+              kPlotSide, frame);
+  // The embedding in the square, one scale for both axes (t-SNE distances are isotropic); a
+  // state that occurred k times is a disc of k times the area (at most 9 times).
+  std::vector<plot::Point> embedded;
+  for (int i = 0; i < n; ++i) embedded.push_back({y(0, i), y(1, i)});
+  const plot::SquareMap to_pixel(
+      embedded, {static_cast<double>(layout.plot_x), static_cast<double>(layout.plot_y)}, kPlotSide,
+      12);
+  Scatter scatter;
+  scatter.values = &samples.values;
+  const double radius = n <= 1000 ? 3 : 2;
   for (int i = 0; i < n; ++i) {
-    cv::circle(page, to_pixel(i), disc(i), colour(samples.values[static_cast<size_t>(i)]),
-               cv::FILLED, cv::LINE_AA);
+    const auto k = static_cast<size_t>(i);
+    scatter.at.push_back(to_pixel(embedded[k]));
+    scatter.radius.push_back(radius * std::sqrt(std::min(9.0, static_cast<double>(counts[k]))));
+    canvas.Circle(scatter.at[k], std::lround(scatter.radius[k]),
+                  plot::Paint::Fill(colour(samples.values[k])));
   }
-
-  // The thumbnails: the left half of the chosen points (by x) in the left column, the rest in the
-  // right one, each column ordered by y so that the lines do not cross.
-  std::vector<int> by_x = result.thumbnails;
-  std::stable_sort(by_x.begin(), by_x.end(),
-                   [&](int a, int b) { return to_pixel(a).x < to_pixel(b).x; });
-  const size_t left_count = by_x.size() / 2;
-  for (int side = 0; side < 2; ++side) {
-    std::vector<int> column(side == 0 ? by_x.begin() : by_x.begin() + left_count,
-                            side == 0 ? by_x.begin() + left_count : by_x.end());
-    std::stable_sort(column.begin(), column.end(),
-                     [&](int a, int b) { return to_pixel(a).y < to_pixel(b).y; });
-    const int x = side == 0 ? kMargin : right_x;
-    for (size_t k = 0; k < column.size(); ++k) {
-      const int i = column[k];
-      const double slot = static_cast<double>(kPlotSide) / static_cast<double>(column.size());
-      const int centre_y = plot_y + static_cast<int>((static_cast<double>(k) + 0.5) * slot);
-      const int top = centre_y - (thumb_h + kLabelHeight) / 2;
-      const cv::Point point = to_pixel(i);
-      const cv::Point anchor(side == 0 ? x + thumb_w + 2 : x - 3, top + thumb_h / 2);
-      cv::line(page, anchor, point, kLine, 1, cv::LINE_AA);
-      cv::circle(page, point, disc(i) + 4, kInk, 2, cv::LINE_AA);
-      const cv::Mat frame(samples.frame_height, samples.frame_width, CV_8UC1,
-                          const_cast<uint8_t*>(samples.frames.data()) + frame_bytes * i);
-      cv::Mat big, bgr;
-      cv::resize(frame, big, cv::Size(thumb_w, thumb_h), 0, 0, cv::INTER_NEAREST);
-      cv::cvtColor(big, bgr, cv::COLOR_GRAY2BGR);
-      bgr.copyTo(page(cv::Rect(x, top, thumb_w, thumb_h)));
-      const double v = samples.values[static_cast<size_t>(i)];
-      cv::rectangle(page, cv::Rect(x - 2, top - 2, thumb_w + 4, thumb_h + 4), colour(v), 2);
-      cv::putText(page, (samples.value_is_return ? "G " : "Q ") + Number(v),
-                  cv::Point(x, top + thumb_h + kLabelHeight - 3), cv::FONT_HERSHEY_SIMPLEX, kFont,
-                  kInk, 1, cv::LINE_AA);
-    }
-  }
-
-  // The colour bar: high values at the top.
-  for (int r = 0; r < kPlotSide; ++r) {
-    const double v = hi - (hi - lo) * r / (kPlotSide - 1);
-    cv::line(page, cv::Point(bar_x, plot_y + r), cv::Point(bar_x + kBarWidth - 1, plot_y + r),
-             colour(v));
-  }
-  cv::rectangle(page, cv::Rect(bar_x, plot_y, kBarWidth, kPlotSide), kInk, 1);
-  for (double t : NiceTicks(lo, hi, 6)) {
-    if (t < lo || t > hi) continue;
-    const int ty = plot_y + static_cast<int>(std::lround((hi - t) / (hi - lo) * (kPlotSide - 1)));
-    cv::line(page, cv::Point(bar_x + kBarWidth, ty), cv::Point(bar_x + kBarWidth + 4, ty), kInk);
-    cv::putText(page, Number(std::abs(t) < 1e-12 * (hi - lo) ? 0.0 : t),
-                cv::Point(bar_x + kBarWidth + 7, ty + 5), cv::FONT_HERSHEY_SIMPLEX, kFont, kInk, 1,
-                cv::LINE_AA);
-  }
-  cv::putText(page, samples.value_is_return ? "return G" : "max_a Q",
-              cv::Point(bar_x - 8, plot_y - 8), cv::FONT_HERSHEY_SIMPLEX, kFont, kInk, 1,
-              cv::LINE_AA);
+  DrawThumbnails(&canvas, layout, samples, result.thumbnails, scatter, colour);
+  plot::DrawColourBar(
+      &canvas, colour, {static_cast<double>(layout.bar_x), static_cast<double>(layout.plot_y)},
+      kBarWidth, kPlotSide, samples.value_is_return ? "return G" : "max_a Q", TextFont());
 
   std::vector<uchar> png;
-  if (!cv::imencode(".png", page, png)) throw std::runtime_error("cannot encode " + path);
+  if (!cv::imencode(".png", canvas.image(), png)) throw std::runtime_error("cannot encode " + path);
   WriteFileAtomically(path, std::string(png.begin(), png.end()), "t-SNE map");
-  result.width = width;
-  result.height = height;
+  result.width = layout.width;
+  result.height = layout.height;
   return result;
 }
 

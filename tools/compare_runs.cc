@@ -16,7 +16,8 @@
 
 #include "common/atomic_file.h"
 #include "common/text_format.h"
-#include "evaluator/learning_curve.h"
+#include "evaluator/plot.h"
+#include "evaluator/svg_canvas.h"
 
 namespace rl::tools {
 namespace {
@@ -62,35 +63,15 @@ std::string Format(const char* fmt, double v) { return FormatDouble(fmt, v); }
 std::string Thousands(double value) { return rl::Thousands(std::llround(value)); }
 std::string Duration(double seconds) { return rl::Duration(seconds, "\xE2\x80\x94"); }
 
-// A tick value: whole numbers in full, others with at most three significant digits.
-std::string Plain(double v) {
-  if (std::abs(v) < 1e-9) v = 0;
-  return Format(std::abs(v) < 1e15 && v == std::round(v) ? "%.0f" : "%.3g", v);
-}
-
-// An env-steps tick: 0, 800, 50k, 1.5M.
-std::string CountTick(double v) {
-  const double a = std::abs(v);
-  if (a >= 1e9) return Plain(v / 1e9) + "G";
-  if (a >= 1e6) return Plain(v / 1e6) + "M";
-  if (a >= 1e3) return Plain(v / 1e3) + "k";
-  return Plain(v);
-}
-
-// A pixel coordinate.
-std::string Px(double v) { return Format("%.1f", v); }
-
 constexpr char kDash[] = "\xE2\x80\x94";
 
 // ---- Colours ----
 
 // One colour per group, in order (none of them the goal's red).
-constexpr const char* kPalette[] = {"#1f6feb", "#bf3989", "#1a7f37", "#bc4c00",
-                                    "#8250df", "#0a7f86", "#9a6700", "#57606a"};
-constexpr char kGoalColor[] = "#d1242f";
-constexpr char kGridColor[] = "#e6e8eb";
-constexpr char kAxisColor[] = "#57606a";
-constexpr char kTextColor[] = "#24292f";
+constexpr plot::Colour kPalette[] = {plot::Colour::Hex(0x1f6feb), plot::Colour::Hex(0xbf3989),
+                                     plot::Colour::Hex(0x1a7f37), plot::Colour::Hex(0xbc4c00),
+                                     plot::Colour::Hex(0x8250df), plot::Colour::Hex(0x0a7f86),
+                                     plot::Colour::Hex(0x9a6700), plot::Colour::Hex(0x57606a)};
 
 // Plots with more runs than this name none of them at their ends (the lines' tooltips still do).
 constexpr size_t kMaxRunLabels = 12;
@@ -101,7 +82,7 @@ struct Group {
   std::string preset;
   std::string env_id;
   double goal = kNaN;
-  std::string color;
+  plot::Colour color;
   std::vector<const CompareRun*> runs;
 };
 
@@ -138,53 +119,29 @@ struct Plot {
   int height = 420;
 };
 
-struct Scale {
-  double lo, hi, p0, p1;
-  double operator()(double v) const { return p0 + (v - lo) / (hi - lo) * (p1 - p0); }
+// A group's curves against one axis: each run's best so far, and their combination.
+struct GroupCurves {
+  std::vector<std::vector<StepPoint>> runs;
+  std::vector<GroupPoint> combined;
 };
 
-// "M x0,y0 H x1 V y1 H x2 V y2 ...": a step function drawn as it holds.
-std::string StepPath(const std::vector<std::pair<double, double>>& pts, const Scale& sx,
-                     const Scale& sy) {
-  std::string d;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    if (i == 0) {
-      d += "M" + Px(sx(pts[i].first)) + "," + Px(sy(pts[i].second));
-    } else {
-      d += " H" + Px(sx(pts[i].first)) + " V" + Px(sy(pts[i].second));
-    }
-  }
-  return d;
+std::vector<plot::Point> ToPoints(const std::vector<StepPoint>& steps) {
+  std::vector<plot::Point> points;
+  for (const StepPoint& p : steps) points.push_back({p.x, p.y});
+  return points;
 }
 
-std::string RenderPlot(const std::vector<Group>& groups, const Plot& plot) {
-  constexpr double kLeft = 72, kRight = 24, kTop = 40, kBottom = 56;
-  // The curves of every group, in the axis' units.
-  struct Curves {
-    std::vector<std::vector<StepPoint>> runs;
-    std::vector<GroupPoint> combined;
-  };
-  std::vector<Curves> curves;
-  for (const Group& g : groups) {
-    Curves c;
-    for (const CompareRun* run : g.runs) c.runs.push_back(BestSoFar(*run, plot.axis));
-    c.combined = CombineSteps(c.runs);
-    curves.push_back(std::move(c));
-  }
-  std::set<double> goals;
-  for (const Group& g : groups) {
-    if (std::isfinite(g.goal)) goals.insert(g.goal);
-  }
-
-  // Ranges: x from 0, y covering every value, 0 and the goals.
+// The chart: x from 0, y covering every value, 0 and the goals.
+plot::ChartSpec PlotSpec(const std::vector<GroupCurves>& curves, const std::set<double>& goals,
+                         const Plot& p) {
   double x_hi = 0, y_lo = 0, y_hi = 0;
   bool any = false;
-  for (const Curves& c : curves) {
+  for (const GroupCurves& c : curves) {
     for (const std::vector<StepPoint>& run : c.runs) {
-      for (const StepPoint& p : run) {
-        x_hi = std::max(x_hi, p.x);
-        y_lo = std::min(y_lo, p.y);
-        y_hi = std::max(y_hi, p.y);
+      for (const StepPoint& point : run) {
+        x_hi = std::max(x_hi, point.x);
+        y_lo = std::min(y_lo, point.y);
+        y_hi = std::max(y_hi, point.y);
         any = true;
       }
     }
@@ -193,167 +150,92 @@ std::string RenderPlot(const std::vector<Group>& groups, const Plot& plot) {
     y_lo = std::min(y_lo, g);
     y_hi = std::max(y_hi, g);
   }
-  double unit = 1;
-  std::string x_label = plot.x_label;
-  if (plot.axis == CurveAxis::kWallSeconds) {
-    std::string unit_name = "s";
-    if (x_hi >= 2 * 3600.0) {
-      unit = 3600;
-      unit_name = "h";
-    } else if (x_hi >= 120.0) {
-      unit = 60;
-      unit_name = "min";
-    }
-    x_label += " (" + unit_name + ")";
+  plot::ChartSpec spec;
+  spec.width = p.width;
+  spec.height = p.height;
+  spec.title = p.title;
+  spec.x_label = p.x_label;
+  spec.y_label = "best evaluation mean so far";
+  if (p.axis == CurveAxis::kWallSeconds) {
+    const plot::TimeUnit unit = plot::PickTimeUnit(x_hi);
+    spec.x_unit = unit.seconds;
+    spec.x_label += " (" + unit.name + ")";
+  } else {
+    spec.x_format = plot::TickFormat::kCount;
   }
-  if (!any || x_hi <= 0) x_hi = unit;
-  const std::vector<double> x_ticks = evaluator::NiceTicks(0, x_hi / unit, 8);
-  const std::vector<double> y_ticks = evaluator::NiceTicks(y_lo, y_hi, 6);
-  const double w = plot.width, h = plot.height;
-  const Scale sx{x_ticks.front() * unit, x_ticks.back() * unit, kLeft, w - kRight};
-  const Scale sy{y_ticks.front(), y_ticks.back(), h - kBottom, kTop};
+  spec.x_min = 0;
+  spec.x_max = !any || x_hi <= 0 ? spec.x_unit : x_hi;
+  spec.y_min = y_lo;
+  spec.y_max = y_hi;
+  spec.x_ticks = 8;
+  spec.y_ticks = 6;
+  return spec;
+}
 
-  std::string s;
-  s += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + std::to_string(plot.width) +
-       "\" height=\"" + std::to_string(plot.height) + "\" viewBox=\"0 0 " +
-       std::to_string(plot.width) + " " + std::to_string(plot.height) +
-       "\" font-family=\"-apple-system, 'Segoe UI', Helvetica, Arial, sans-serif\" "
-       "font-size=\"12\" fill=\"" +
-       kTextColor + "\" role=\"img\">\n";
-  s += "<title>" + HtmlEscape(plot.title) + "</title>\n";
-  s += "<rect width=\"100%\" height=\"100%\" fill=\"#ffffff\"/>\n";
-  s += "<text x=\"" + Px(kLeft) + "\" y=\"22\" font-size=\"14\" font-weight=\"600\">" +
-       HtmlEscape(plot.title) + "</text>\n";
+// The min-max band of a group of several runs.
+void DrawBand(plot::Canvas* canvas, const plot::Chart& chart, const Group& g,
+              const GroupCurves& c) {
+  if (c.combined.empty() || g.runs.size() < 2) return;
+  std::vector<plot::Point> hi, lo;
+  for (const GroupPoint& p : c.combined) {
+    hi.push_back({p.x, p.max});
+    lo.push_back({p.x, p.min});
+  }
+  canvas->Path(chart.At(plot::StepBand(hi, lo)), true, plot::Paint::Fill(g.color, 0.14),
+               {"band", g.preset + ": min to max of " + std::to_string(g.runs.size()) + " runs"});
+}
 
-  // Grid, ticks, axes.
-  s += "<g stroke=\"" + std::string(kGridColor) + "\" stroke-width=\"1\">";
-  for (double t : x_ticks) {
-    s += "<line x1=\"" + Px(sx(t * unit)) + "\" y1=\"" + Px(sy.p1) + "\" x2=\"" + Px(sx(t * unit)) +
-         "\" y2=\"" + Px(sy.p0) + "\"/>";
+// Each run thin (thick when alone) with a dot at its last evaluation, and the group's mean.
+void DrawLines(plot::Canvas* canvas, const plot::Chart& chart, const Group& g, const GroupCurves& c,
+               std::vector<plot::EndLabel>* labels) {
+  const bool alone = g.runs.size() == 1;
+  plot::Paint run_paint = plot::Paint::Stroke(g.color, alone ? 2.2 : 1);
+  run_paint.stroke_opacity = alone ? 1 : 0.55;
+  run_paint.round_joins = true;
+  for (size_t ri = 0; ri < g.runs.size(); ++ri) {
+    const std::vector<StepPoint>& run = c.runs[ri];
+    if (run.empty()) continue;
+    const std::string& label = g.runs[ri]->label;
+    canvas->Path(chart.At(plot::StepCorners(ToPoints(run))), false, run_paint, {"run", label});
+    const plot::Point end = chart.At(run.back().x, run.back().y);
+    canvas->Circle(end, alone ? 3.5 : 2.5, plot::Paint::Fill(g.color),
+                   {"", label + ": last evaluation"});
+    labels->push_back({end, label, g.color});
   }
-  for (double t : y_ticks) {
-    s += "<line x1=\"" + Px(sx.p0) + "\" y1=\"" + Px(sy(t)) + "\" x2=\"" + Px(sx.p1) + "\" y2=\"" +
-         Px(sy(t)) + "\"/>";
-  }
-  s += "</g>\n<g font-size=\"11\" fill=\"" + std::string(kAxisColor) + "\">";
-  for (double t : x_ticks) {
-    const std::string label = plot.axis == CurveAxis::kEnvSteps ? CountTick(t) : Plain(t);
-    s += "<text x=\"" + Px(sx(t * unit)) + "\" y=\"" + Px(sy.p0 + 16) +
-         "\" text-anchor=\"middle\">" + HtmlEscape(label) + "</text>";
-  }
-  for (double t : y_ticks) {
-    s += "<text x=\"" + Px(sx.p0 - 8) + "\" y=\"" + Px(sy(t) + 4) + "\" text-anchor=\"end\">" +
-         HtmlEscape(Plain(t)) + "</text>";
-  }
-  s += "</g>\n";
-  s += "<path d=\"M" + Px(sx.p0) + "," + Px(sy.p1) + " V" + Px(sy.p0) + " H" + Px(sx.p1) +
-       "\" fill=\"none\" stroke=\"" + kAxisColor + "\" stroke-width=\"1\"/>\n";
-  s += "<text x=\"" + Px((sx.p0 + sx.p1) / 2) + "\" y=\"" + Px(h - 14) +
-       "\" text-anchor=\"middle\">" + HtmlEscape(x_label) + "</text>\n";
-  s += "<text transform=\"translate(18," + Px((sy.p0 + sy.p1) / 2) +
-       ") rotate(-90)\" text-anchor=\"middle\">best evaluation mean so far</text>\n";
+  if (alone || c.combined.empty()) return;
+  std::vector<plot::Point> mean;
+  for (const GroupPoint& p : c.combined) mean.push_back({p.x, p.mean});
+  plot::Paint mean_paint = plot::Paint::Stroke(g.color, 2.6);
+  mean_paint.round_joins = true;
+  canvas->Path(chart.At(plot::StepCorners(mean)), false, mean_paint,
+               {"mean", g.preset + ": mean of " + std::to_string(g.runs.size()) + " runs"});
+}
 
-  // Names at the runs' last evaluations (placed after the lines; see below).
-  struct Label {
-    double x, y;  // the dot
-    std::string text, color;
-  };
-  std::vector<Label> labels;
-
-  // Per group: the band, each run thin, the mean thick (bands first, so no band hides a line).
+std::string RenderPlot(const std::vector<Group>& groups, const Plot& p) {
+  std::vector<GroupCurves> curves;
+  std::set<double> goals;
+  for (const Group& g : groups) {
+    GroupCurves c;
+    for (const CompareRun* run : g.runs) c.runs.push_back(BestSoFar(*run, p.axis));
+    c.combined = CombineSteps(c.runs);
+    curves.push_back(std::move(c));
+    if (std::isfinite(g.goal)) goals.insert(g.goal);
+  }
+  plot::SvgCanvas canvas(p.width, p.height, p.title, plot::kTextColour);
+  const plot::Chart chart(PlotSpec(curves, goals, p));
+  chart.DrawFrame(&canvas);
+  // Bands first, so that no band hides a line.
+  for (size_t gi = 0; gi < groups.size(); ++gi) DrawBand(&canvas, chart, groups[gi], curves[gi]);
+  std::vector<plot::EndLabel> labels;
   for (size_t gi = 0; gi < groups.size(); ++gi) {
-    const std::vector<GroupPoint>& c = curves[gi].combined;
-    if (c.empty() || groups[gi].runs.size() < 2) continue;
-    std::vector<std::pair<double, double>> hi, lo;
-    for (const GroupPoint& p : c) {
-      hi.emplace_back(p.x, p.max);
-      lo.emplace_back(p.x, p.min);
-    }
-    std::string d = StepPath(hi, sx, sy);
-    // Back along the lower edge: at each x, down to the value before it, then left.
-    d += " V" + Px(sy(lo.back().second));
-    for (size_t i = lo.size() - 1; i > 0; --i) {
-      d += " H" + Px(sx(lo[i].first)) + " V" + Px(sy(lo[i - 1].second));
-    }
-    d += " H" + Px(sx(lo.front().first)) + " Z";
-    s += "<path class=\"band\" d=\"" + d + "\" fill=\"" + groups[gi].color +
-         "\" fill-opacity=\"0.14\" stroke=\"none\"><title>" + HtmlEscape(groups[gi].preset) +
-         ": min to max of " + std::to_string(groups[gi].runs.size()) + " runs</title></path>\n";
+    DrawLines(&canvas, chart, groups[gi], curves[gi], &labels);
   }
-  for (size_t gi = 0; gi < groups.size(); ++gi) {
-    const Group& g = groups[gi];
-    const bool alone = g.runs.size() == 1;
-    for (size_t ri = 0; ri < g.runs.size(); ++ri) {
-      const std::vector<StepPoint>& run = curves[gi].runs[ri];
-      if (run.empty()) continue;
-      std::vector<std::pair<double, double>> pts;
-      for (const StepPoint& p : run) pts.emplace_back(p.x, p.y);
-      s += "<path class=\"run\" d=\"" + StepPath(pts, sx, sy) + "\" fill=\"none\" stroke=\"" +
-           g.color + "\" stroke-width=\"" + (alone ? "2.2" : "1") + "\" stroke-opacity=\"" +
-           (alone ? "1" : "0.55") + "\" stroke-linejoin=\"round\"><title>" +
-           HtmlEscape(g.runs[ri]->label) + "</title></path>";
-      // Where the run's evaluations end.
-      s += "<circle cx=\"" + Px(sx(run.back().x)) + "\" cy=\"" + Px(sy(run.back().y)) + "\" r=\"" +
-           (alone ? "3.5" : "2.5") + "\" fill=\"" + g.color + "\"><title>" +
-           HtmlEscape(g.runs[ri]->label) + ": last evaluation</title></circle>\n";
-      labels.push_back({sx(run.back().x), sy(run.back().y), g.runs[ri]->label, g.color});
-    }
-    if (!alone && !curves[gi].combined.empty()) {
-      std::vector<std::pair<double, double>> pts;
-      for (const GroupPoint& p : curves[gi].combined) pts.emplace_back(p.x, p.mean);
-      s += "<path class=\"mean\" d=\"" + StepPath(pts, sx, sy) + "\" fill=\"none\" stroke=\"" +
-           g.color + "\" stroke-width=\"2.6\" stroke-linejoin=\"round\"><title>" +
-           HtmlEscape(g.preset) + ": mean of " + std::to_string(g.runs.size()) +
-           " runs</title></path>\n";
-    }
-  }
-
-  // Each run's name left of its last dot, above it or else below it (clear of the line, which
-  // comes in level from the left), the nearest spot that overlaps no other name and stays in the
-  // plot (11 px text: about 6.2 px a character); left out when there are too many to read.
-  if (labels.size() <= kMaxRunLabels) {
-    std::stable_sort(labels.begin(), labels.end(),
-                     [](const Label& a, const Label& b) { return a.y < b.y; });
-    std::vector<std::array<double, 3>> placed;  // left, right, baseline
-    std::string text;
-    for (const Label& l : labels) {
-      const double right = l.x - 5, left = right - 6.2 * static_cast<double>(l.text.size());
-      const auto free = [&](double y) {
-        if (y < sy.p1 - 6 || y > sy.p0 - 3) return false;  // may reach into the top margin
-        for (const auto& [pl, pr, py] : placed) {
-          if (left < pr && pl < right && std::abs(py - y) < 12) return false;
-        }
-        return true;
-      };
-      double y = l.y - 6;
-      for (int k = 0; k < 40; ++k) {
-        // Above at -6, -19, -32, ...; below at +15, +28, ...
-        const double candidate = k % 2 == 0 ? l.y - 6 - 13.0 * (k / 2) : l.y + 15 + 13.0 * (k / 2);
-        if (free(candidate)) {
-          y = candidate;
-          break;
-        }
-      }
-      placed.push_back({left, right, y});
-      text += "<text x=\"" + Px(right) + "\" y=\"" + Px(y) + "\" text-anchor=\"end\" fill=\"" +
-              l.color + "\">" + HtmlEscape(l.text) + "</text>";
-    }
-    s += "<g class=\"names\" font-size=\"11\" stroke=\"#ffffff\" stroke-width=\"3\" "
-         "paint-order=\"stroke\" stroke-linejoin=\"round\">" +
-         text + "</g>\n";
-  }
-
-  // The goals, dashed and labelled at the left.
-  for (double goal : goals) {
-    const double gy = sy(goal);
-    s += "<line class=\"goal\" x1=\"" + Px(sx.p0) + "\" y1=\"" + Px(gy) + "\" x2=\"" + Px(sx.p1) +
-         "\" y2=\"" + Px(gy) + "\" stroke=\"" + kGoalColor +
-         "\" stroke-width=\"1.2\" stroke-dasharray=\"6 4\"/>\n";
-    s += "<text x=\"" + Px(sx.p0 + 6) + "\" y=\"" + Px(gy - 5) + "\" font-size=\"11\" fill=\"" +
-         kGoalColor + "\">goal " + HtmlEscape(Format("%g", goal)) + "</text>\n";
-  }
-  s += "</svg>\n";
-  return s;
+  // Too many names to read: none (the lines' tooltips still name them).
+  if (labels.size() <= kMaxRunLabels) plot::DrawEndLabels(&canvas, chart, std::move(labels));
+  plot::Paint goal = plot::Paint::Stroke(plot::kGoalColour, 1.2);
+  goal.dash = {6, 4};
+  for (double g : goals) chart.DrawRule(&canvas, g, "goal " + Format("%g", g), goal, {"goal", ""});
+  return canvas.Document();
 }
 
 // ---- The page ----
@@ -399,8 +281,8 @@ td, th { vertical-align: top; }
 a { color: inherit; }
 )css";
 
-std::string Swatch(const std::string& color) {
-  return "<span class=\"swatch\" style=\"background:" + color + "\"></span>";
+std::string Swatch(plot::Colour color) {
+  return "<span class=\"swatch\" style=\"background:" + color.ToHex() + "\"></span>";
 }
 
 double Mean(const std::vector<double>& values) {
@@ -443,6 +325,165 @@ std::string RunName(const CompareRun& run, const std::string& page_dir) {
   if (ec || rel.empty()) return name;
   return "<a href=\"" + HtmlEscape(rel.generic_string()) + "\" title=\"the run's report\">" + name +
          "</a>";
+}
+
+// The summaries of the runs, by run.
+class Summaries {
+ public:
+  explicit Summaries(const std::vector<CompareRun>& runs) : runs_(runs) {
+    for (const CompareRun& run : runs) summaries_.push_back(Summarize(run));
+  }
+  const RunSummary& of(const CompareRun* run) const {
+    return summaries_[static_cast<size_t>(run - runs_.data())];
+  }
+
+ private:
+  const std::vector<CompareRun>& runs_;
+  std::vector<RunSummary> summaries_;
+};
+
+// The document's head, the title and the line under it.
+std::string PageHeader(const std::vector<CompareRun>& runs, const std::vector<Group>& groups) {
+  const std::string count = std::to_string(runs.size()) + " run" + (runs.size() == 1 ? "" : "s");
+  std::string h;
+  h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
+  h += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
+  h += "<title>Comparing " + count + "</title>\n";
+  h += "<style>" + std::string(kCss) + "</style>\n</head>\n<body>\n<main>\n";
+  std::string presets;
+  for (size_t i = 0; i < groups.size(); ++i) {
+    presets += (i == 0 ? "" : i + 1 == groups.size() ? " and " : ", ") + groups[i].preset;
+  }
+  h += "<h1>Comparing " + count + " <small class=\"meta\">of " + HtmlEscape(presets) +
+       "</small></h1>\n";
+  int skipped = 0;
+  for (const CompareRun& run : runs) skipped += run.skipped_lines;
+  h += "<p class=\"meta\">Written " + HtmlEscape(UtcNow()) +
+       " by scripts/compare.sh from each run's eval.jsonl.";
+  if (skipped > 0) {
+    h += " " + std::to_string(skipped) + " line" + (skipped == 1 ? "" : "s") +
+         " of eval.jsonl did not parse and " + (skipped == 1 ? "was" : "were") + " skipped.";
+  }
+  return h + "</p>\n";
+}
+
+// The legend and the two plots of the groups of one env.
+std::string CurvesSection(const std::string& env, const std::vector<Group>& here) {
+  std::string h = "<section class=\"curves\">\n<h2>Learning curves";
+  if (!env.empty()) h += " <span class=\"env\">\xC2\xB7 " + HtmlEscape(env) + "</span>";
+  h += "</h2>\n<div class=\"legend\">";
+  for (const Group& g : here) {
+    h += "<span>" + Swatch(g.color) + "<b>" + HtmlEscape(g.preset) + "</b> <small>(" +
+         std::to_string(g.runs.size()) + " run" + (g.runs.size() == 1 ? "" : "s") +
+         ")</small></span>";
+  }
+  h += "<span class=\"keys\">" + std::string(kLegendKeys) + "</span></div>\n";
+  h += "<p class=\"how\">Every line is a <b>best evaluation mean so far</b>, not raw scores "
+       "(the tables give the final ones): a thin line per run, with a dot at its last "
+       "evaluation; for a preset of several runs, the mean across them and their lowest to "
+       "highest as a band, drawn from where every run has been scored, each run holding its "
+       "last value once it has stopped (a run stops at its goal). Wall time counts from each "
+       "run's learner start.</p>\n";
+  Plot plot;
+  plot.title = "Best evaluation mean so far vs. environment steps";
+  plot.x_label = "environment steps";
+  plot.axis = CurveAxis::kEnvSteps;
+  h += "<figure>" + RenderPlot(here, plot) + "</figure>\n";
+  plot.title = "Best evaluation mean so far vs. wall time";
+  plot.x_label = "wall time since the learner started";
+  plot.axis = CurveAxis::kWallSeconds;
+  return h + "<figure>" + RenderPlot(here, plot) + "</figure>\n</section>\n";
+}
+
+// One row of the presets table: the mean over the group's runs, with their range.
+std::string PresetRow(const Group& g, const Summaries& summaries) {
+  std::vector<double> best, best_steps, best_wall, final, goal_steps, goal_wall;
+  int evaluations = 0, reached = 0;
+  for (const CompareRun* run : g.runs) {
+    const RunSummary& s = summaries.of(run);
+    evaluations += s.evaluations;
+    best.push_back(s.best.mean);
+    best_steps.push_back(static_cast<double>(s.best.env_steps));
+    best_wall.push_back(s.best.wall_seconds);
+    final.push_back(s.final.mean);
+    if (s.goal_reached) {
+      ++reached;
+      goal_steps.push_back(static_cast<double>(s.first_goal.env_steps));
+      goal_wall.push_back(s.first_goal.wall_seconds);
+    }
+  }
+  std::string h = "<tr class=\"group\"><td>" + Swatch(g.color) + HtmlEscape(g.preset) +
+                  "</td><td>" + std::to_string(g.runs.size()) + "</td><td>" +
+                  std::to_string(evaluations) + "</td>";
+  if (std::isfinite(g.goal)) {
+    h += std::string("<td") + (reached == static_cast<int>(g.runs.size()) ? " class=\"yes\"" : "") +
+         ">" + std::to_string(reached) + " of " + std::to_string(g.runs.size()) +
+         "<small>mean \xE2\x89\xA5 " + HtmlEscape(Format("%g", g.goal)) + "</small></td>";
+  } else {
+    h += std::string("<td>") + kDash + "</td>";
+  }
+  h += "<td>" + MeanRange(best, Score) + "</td><td>" + MeanRange(best_steps, Thousands) +
+       "</td><td>" + MeanRange(best_wall, Duration) + "</td><td>" + MeanRange(final, Score) +
+       "</td><td>";
+  if (goal_steps.empty()) {
+    h += kDash;
+  } else {
+    h += Thousands(Mean(goal_steps)) + " steps, " + Duration(Mean(goal_wall)) + "<small>";
+    if (goal_steps.size() < g.runs.size()) {
+      h += "the " + std::to_string(goal_steps.size()) + " that reached it";
+    } else if (goal_steps.size() > 1) {
+      h += "mean of " + std::to_string(goal_steps.size());
+    }
+    h += "</small>";
+  }
+  return h + "</td></tr>\n";
+}
+
+std::string PresetsSection(const std::vector<Group>& groups, const Summaries& summaries) {
+  std::string h =
+      "<section>\n<h2>Presets</h2>\n<p class=\"how\">The mean over a preset's runs, and below "
+      "it the lowest and the highest run.</p>\n<div class=\"scroll\"><table>\n<thead><tr>"
+      "<th>preset</th><th>runs</th><th>evaluations</th><th>goal reached</th>"
+      "<th>best mean</th><th>env steps at best</th><th>wall time at best</th>"
+      "<th>final mean</th><th>goal first reached at</th></tr></thead>\n<tbody>\n";
+  for (const Group& g : groups) h += PresetRow(g, summaries);
+  return h + "</tbody>\n</table></div>\n</section>\n";
+}
+
+// The runs, by group.
+std::string RunsSection(const std::vector<Group>& groups, const Summaries& summaries,
+                        const std::string& page_dir) {
+  std::string h =
+      "<section>\n<h2>Runs</h2>\n<p class=\"how\">Best: the first evaluation with the highest "
+      "mean; final: the evaluation of the last checkpoint. A run's name links to its "
+      "report.</p>\n<div class=\"scroll\"><table>\n<thead><tr><th>run</th><th>seed</th>"
+      "<th>evaluations</th><th>best mean</th><th>env steps at best</th><th>wall time at best</th>"
+      "<th>final mean</th><th>last evaluation at</th><th>goal first reached at</th></tr>"
+      "</thead>\n";
+  for (const Group& g : groups) {
+    h += "<tbody>\n<tr class=\"sub\"><th colspan=\"9\">" + Swatch(g.color) + HtmlEscape(g.preset) +
+         "</th></tr>\n";
+    for (const CompareRun* run : g.runs) {
+      const RunSummary& s = summaries.of(run);
+      h += "<tr><td>" + RunName(*run, page_dir) + "</td><td>" +
+           (run->seed >= 0 ? std::to_string(run->seed) : std::string(kDash)) + "</td><td>" +
+           std::to_string(s.evaluations) + "</td><td>" + ScoreStd(s.best) + "</td><td>" +
+           Thousands(static_cast<double>(s.best.env_steps)) + "</td><td>" +
+           Duration(s.best.wall_seconds) + "</td><td>" + ScoreStd(s.final) + "</td><td>" +
+           StepsAndTime(s.final) + "</td>";
+      if (s.goal_reached) {
+        h += "<td class=\"yes\">" + StepsAndTime(s.first_goal) + "</td>";
+      } else if (std::isfinite(run->goal)) {
+        h += "<td>not reached <small class=\"inline\">(\xE2\x89\xA5 " +
+             HtmlEscape(Format("%g", run->goal)) + ")</small></td>";
+      } else {
+        h += std::string("<td>") + kDash + "</td>";
+      }
+      h += "</tr>\n";
+    }
+    h += "</tbody>\n";
+  }
+  return h + "</table></div>\n</section>\n";
 }
 
 }  // namespace
@@ -614,34 +655,8 @@ std::vector<GroupPoint> CombineSteps(const std::vector<std::vector<StepPoint>>& 
 
 std::string RenderComparePage(const std::vector<CompareRun>& runs, const std::string& page_dir) {
   const std::vector<Group> groups = MakeGroups(runs);
-  std::vector<RunSummary> summaries;
-  for (const CompareRun& run : runs) summaries.push_back(Summarize(run));
-  const auto summary_of = [&](const CompareRun* run) -> const RunSummary& {
-    return summaries[static_cast<size_t>(run - runs.data())];
-  };
-
-  std::string h;
-  h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
-  h += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
-  h += "<title>Comparing " + std::to_string(runs.size()) + " run" + (runs.size() == 1 ? "" : "s") +
-       "</title>\n";
-  h += "<style>" + std::string(kCss) + "</style>\n</head>\n<body>\n<main>\n";
-  std::string presets;
-  for (size_t i = 0; i < groups.size(); ++i) {
-    presets += (i == 0 ? "" : i + 1 == groups.size() ? " and " : ", ") + groups[i].preset;
-  }
-  h += "<h1>Comparing " + std::to_string(runs.size()) + " run" + (runs.size() == 1 ? "" : "s") +
-       " <small class=\"meta\">of " + HtmlEscape(presets) + "</small></h1>\n";
-  int skipped = 0;
-  for (const CompareRun& run : runs) skipped += run.skipped_lines;
-  h += "<p class=\"meta\">Written " + HtmlEscape(UtcNow()) +
-       " by scripts/compare.sh from each run's eval.jsonl.";
-  if (skipped > 0) {
-    h += " " + std::to_string(skipped) + " line" + (skipped == 1 ? "" : "s") +
-         " of eval.jsonl did not parse and " + (skipped == 1 ? "was" : "were") + " skipped.";
-  }
-  h += "</p>\n";
-
+  Summaries summaries(runs);
+  std::string h = PageHeader(runs, groups);
   // One section of curves per env (returns of different envs do not share a scale).
   std::vector<std::string> envs;
   for (const Group& g : groups) {
@@ -652,113 +667,11 @@ std::string RenderComparePage(const std::vector<CompareRun>& runs, const std::st
     for (const Group& g : groups) {
       if (g.env_id == env) here.push_back(g);
     }
-    h += "<section class=\"curves\">\n<h2>Learning curves";
-    if (!env.empty()) h += " <span class=\"env\">\xC2\xB7 " + HtmlEscape(env) + "</span>";
-    h += "</h2>\n<div class=\"legend\">";
-    for (const Group& g : here) {
-      h += "<span>" + Swatch(g.color) + "<b>" + HtmlEscape(g.preset) + "</b> <small>(" +
-           std::to_string(g.runs.size()) + " run" + (g.runs.size() == 1 ? "" : "s") +
-           ")</small></span>";
-    }
-    h += "<span class=\"keys\">" + std::string(kLegendKeys) + "</span></div>\n";
-    h += "<p class=\"how\">Every line is a <b>best evaluation mean so far</b>, not raw scores "
-         "(the tables give the final ones): a thin line per run, with a dot at its last "
-         "evaluation; for a preset of several runs, the mean across them and their lowest to "
-         "highest as a band, drawn from where every run has been scored, each run holding its "
-         "last value once it has stopped (a run stops at its goal). Wall time counts from each "
-         "run's learner start.</p>\n";
-    Plot plot;
-    plot.title = "Best evaluation mean so far vs. environment steps";
-    plot.x_label = "environment steps";
-    plot.axis = CurveAxis::kEnvSteps;
-    h += "<figure>" + RenderPlot(here, plot) + "</figure>\n";
-    plot.title = "Best evaluation mean so far vs. wall time";
-    plot.x_label = "wall time since the learner started";
-    plot.axis = CurveAxis::kWallSeconds;
-    h += "<figure>" + RenderPlot(here, plot) + "</figure>\n</section>\n";
+    h += CurvesSection(env, here);
   }
-
-  // Groups.
-  h += "<section>\n<h2>Presets</h2>\n<p class=\"how\">The mean over a preset's runs, and below it "
-       "the lowest and the highest run.</p>\n<div class=\"scroll\"><table>\n<thead><tr>"
-       "<th>preset</th><th>runs</th><th>evaluations</th><th>goal reached</th>"
-       "<th>best mean</th><th>env steps at best</th><th>wall time at best</th>"
-       "<th>final mean</th><th>goal first reached at</th></tr></thead>\n<tbody>\n";
-  for (const Group& g : groups) {
-    std::vector<double> best, best_steps, best_wall, final, goal_steps, goal_wall;
-    int evaluations = 0, reached = 0;
-    for (const CompareRun* run : g.runs) {
-      const RunSummary& s = summary_of(run);
-      evaluations += s.evaluations;
-      best.push_back(s.best.mean);
-      best_steps.push_back(static_cast<double>(s.best.env_steps));
-      best_wall.push_back(s.best.wall_seconds);
-      final.push_back(s.final.mean);
-      if (s.goal_reached) {
-        ++reached;
-        goal_steps.push_back(static_cast<double>(s.first_goal.env_steps));
-        goal_wall.push_back(s.first_goal.wall_seconds);
-      }
-    }
-    h += "<tr class=\"group\"><td>" + Swatch(g.color) + HtmlEscape(g.preset) + "</td><td>" +
-         std::to_string(g.runs.size()) + "</td><td>" + std::to_string(evaluations) + "</td>";
-    if (std::isfinite(g.goal)) {
-      h += std::string("<td") +
-           (reached == static_cast<int>(g.runs.size()) ? " class=\"yes\"" : "") + ">" +
-           std::to_string(reached) + " of " + std::to_string(g.runs.size()) +
-           "<small>mean \xE2\x89\xA5 " + HtmlEscape(Format("%g", g.goal)) + "</small></td>";
-    } else {
-      h += std::string("<td>") + kDash + "</td>";
-    }
-    h += "<td>" + MeanRange(best, Score) + "</td><td>" + MeanRange(best_steps, Thousands) +
-         "</td><td>" + MeanRange(best_wall, Duration) + "</td><td>" + MeanRange(final, Score) +
-         "</td><td>";
-    if (goal_steps.empty()) {
-      h += kDash;
-    } else {
-      h += Thousands(Mean(goal_steps)) + " steps, " + Duration(Mean(goal_wall)) + "<small>";
-      if (goal_steps.size() < g.runs.size()) {
-        h += "the " + std::to_string(goal_steps.size()) + " that reached it";
-      } else if (goal_steps.size() > 1) {
-        h += "mean of " + std::to_string(goal_steps.size());
-      }
-      h += "</small>";
-    }
-    h += "</td></tr>\n";
-  }
-  h += "</tbody>\n</table></div>\n</section>\n";
-
-  // Runs, by group.
-  h += "<section>\n<h2>Runs</h2>\n<p class=\"how\">Best: the first evaluation with the highest "
-       "mean; final: the evaluation of the last checkpoint. A run's name links to its "
-       "report.</p>\n<div class=\"scroll\"><table>\n<thead><tr><th>run</th><th>seed</th>"
-       "<th>evaluations</th><th>best mean</th><th>env steps at best</th><th>wall time at best</th>"
-       "<th>final mean</th><th>last evaluation at</th><th>goal first reached at</th></tr>"
-       "</thead>\n";
-  for (const Group& g : groups) {
-    h += "<tbody>\n<tr class=\"sub\"><th colspan=\"9\">" + Swatch(g.color) + HtmlEscape(g.preset) +
-         "</th></tr>\n";
-    for (const CompareRun* run : g.runs) {
-      const RunSummary& s = summary_of(run);
-      h += "<tr><td>" + RunName(*run, page_dir) + "</td><td>" +
-           (run->seed >= 0 ? std::to_string(run->seed) : std::string(kDash)) + "</td><td>" +
-           std::to_string(s.evaluations) + "</td><td>" + ScoreStd(s.best) + "</td><td>" +
-           Thousands(static_cast<double>(s.best.env_steps)) + "</td><td>" +
-           Duration(s.best.wall_seconds) + "</td><td>" + ScoreStd(s.final) + "</td><td>" +
-           StepsAndTime(s.final) + "</td>";
-      if (s.goal_reached) {
-        h += "<td class=\"yes\">" + StepsAndTime(s.first_goal) + "</td>";
-      } else if (std::isfinite(run->goal)) {
-        h += "<td>not reached <small class=\"inline\">(\xE2\x89\xA5 " +
-             HtmlEscape(Format("%g", run->goal)) + ")</small></td>";
-      } else {
-        h += std::string("<td>") + kDash + "</td>";
-      }
-      h += "</tr>\n";
-    }
-    h += "</tbody>\n";
-  }
-  h += "</table></div>\n</section>\n</main>\n</body>\n</html>\n";
+  h += PresetsSection(groups, summaries);
+  h += RunsSection(groups, summaries, page_dir);
+  h += "</main>\n</body>\n</html>\n";
   return h;
 }
 

@@ -6,92 +6,96 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 
 #include "common/messages.h"
+#include "evaluator/json_line.h"
 
 namespace rl::tools {
 namespace {
 
-// Builds {"t": ..., "role": "...", "key": value, ...} one field at a time.
+// Builds {"t": ..., "role": "...", "key": value, ...} one field at a time (json_line.h).
 class Line {
  public:
   Line(double t, const std::string& role) {
-    char seconds[32];
-    std::snprintf(seconds, sizeof(seconds), "%.3f", t);  // milliseconds are plenty
-    text_ = std::string("{\"t\": ") + seconds + ", \"role\": \"" + role + "\"";
+    fields_["t"] = std::round(t * 1000) / 1000;  // milliseconds are plenty
+    fields_["role"] = role;
   }
-  Line& Add(const char* key, double value) {
-    text_ += std::string(", \"") + key + "\": " + Number(value);
+  Line& Add(const char* key, int64_t value) {
+    fields_[key] = value;
     return *this;
   }
-  std::string Done() { return text_ + "}\n"; }
+  // Ten significant digits are plenty, and keep the lines short.
+  Line& Add(const char* key, double value) {
+    if (std::isfinite(value)) {
+      char digits[32];
+      std::snprintf(digits, sizeof(digits), "%.10g", value);
+      value = std::strtod(digits, nullptr);
+    }
+    fields_[key] = value;
+    return *this;
+  }
+  std::string Done() const { return JsonLine(fields_) + "\n"; }
 
  private:
-  // Shortest round-trippable form; JSON has no NaN or infinity, so those are null.
-  static std::string Number(double v) {
-    if (!std::isfinite(v)) return "null";
-    char buf[32];
-    std::snprintf(buf, sizeof(buf), "%.10g", v);
-    return buf;
-  }
-  std::string text_;
+  nlohmann::ordered_json fields_;
 };
 
 template <class Stats>
 Line& AddDrops(Line& line, const Stats& s) {
-  return line.Add("lost", static_cast<double>(s.lost))
-      .Add("dropped", static_cast<double>(Dropped(s)))
-      .Add("replayed", static_cast<double>(s.dropped_replayed))
-      .Add("unauthenticated", static_cast<double>(s.dropped_unauthenticated));
+  return line.Add("lost", static_cast<int64_t>(s.lost))
+      .Add("dropped", static_cast<int64_t>(Dropped(s)))
+      .Add("replayed", static_cast<int64_t>(s.dropped_replayed))
+      .Add("unauthenticated", static_cast<int64_t>(s.dropped_unauthenticated));
 }
 
 }  // namespace
 
 std::string MetricsLine(double t, const rlmsg::stats_actor_t& s) {
   Line line(t, s.header.sender);
-  line.Add("env_steps", static_cast<double>(s.env_steps))
-      .Add("episodes", static_cast<double>(s.episodes))
+  line.Add("env_steps", static_cast<int64_t>(s.env_steps))
+      .Add("episodes", static_cast<int64_t>(s.episodes))
       .Add("mean_return", s.mean_return)
       .Add("exploration", s.epsilon)
       .Add("steps_per_second", s.steps_per_second)
-      .Add("weights_version", static_cast<double>(s.weights_version))
-      .Add("paused", s.paused);
+      .Add("weights_version", static_cast<int64_t>(s.weights_version))
+      .Add("paused", static_cast<int64_t>(s.paused));
   return AddDrops(line, s).Done();
 }
 
 std::string MetricsLine(double t, const rlmsg::stats_replay_t& s) {
   Line line(t, s.header.sender);
-  line.Add("size", static_cast<double>(s.size))
-      .Add("capacity", static_cast<double>(s.capacity))
-      .Add("inserts", static_cast<double>(s.total_inserts))
-      .Add("samples", static_cast<double>(s.total_samples))
+  line.Add("size", static_cast<int64_t>(s.size))
+      .Add("capacity", static_cast<int64_t>(s.capacity))
+      .Add("inserts", static_cast<int64_t>(s.total_inserts))
+      .Add("samples", static_cast<int64_t>(s.total_samples))
       .Add("inserts_per_second", s.inserts_per_second)
       .Add("samples_per_second", s.samples_per_second)
       .Add("samples_per_insert", s.samples_per_insert)
-      .Add("insert_allowed", s.insert_allowed)
-      .Add("memory_bytes", static_cast<double>(s.memory_bytes));
+      .Add("insert_allowed", static_cast<int64_t>(s.insert_allowed))
+      .Add("memory_bytes", static_cast<int64_t>(s.memory_bytes));
   return AddDrops(line, s).Done();
 }
 
 std::string MetricsLine(double t, const rlmsg::stats_learner_t& s) {
   Line line(t, s.header.sender);
-  line.Add("updates", static_cast<double>(s.updates))
+  line.Add("updates", static_cast<int64_t>(s.updates))
       .Add("updates_per_second", s.updates_per_second)
       .Add("loss", s.loss)
       .Add("mean_q", s.mean_q)
-      .Add("env_steps", static_cast<double>(s.env_steps))
-      .Add("weights_version", static_cast<double>(s.weights_version));
+      .Add("env_steps", static_cast<int64_t>(s.env_steps))
+      .Add("weights_version", static_cast<int64_t>(s.weights_version));
   return AddDrops(line, s).Done();
 }
 
 std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s) {
   Line line(t, s.header.sender);
-  line.Add("checkpoints_scored", static_cast<double>(s.checkpoints_scored))
+  line.Add("checkpoints_scored", static_cast<int64_t>(s.checkpoints_scored))
       .Add("last_mean", s.last_mean)
       .Add("best_mean", s.best_mean)
-      .Add("busy", s.busy);
+      .Add("busy", static_cast<int64_t>(s.busy));
   return AddDrops(line, s).Done();
 }
 

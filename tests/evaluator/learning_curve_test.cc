@@ -9,25 +9,6 @@
 namespace rl::evaluator {
 namespace {
 
-TEST(NiceTicksTest, CoverTheRangeWithRoundSteps) {
-  const std::vector<double> t = NiceTicks(0, 475, 5);
-  ASSERT_GE(t.size(), 2U);
-  EXPECT_LE(t.front(), 0);
-  EXPECT_GE(t.back(), 475);
-  EXPECT_EQ(t, (std::vector<double>{0, 100, 200, 300, 400, 500}));
-  const std::vector<double> big = NiceTicks(0, 1.3e6, 6);
-  EXPECT_EQ(big.back(), 1.4e6);
-  EXPECT_DOUBLE_EQ(big[1] - big[0], 2e5);
-}
-
-TEST(NiceTicksTest, AnEmptyRangeIsWidened) {
-  const std::vector<double> t = NiceTicks(10, 10, 5);
-  ASSERT_GE(t.size(), 2U);
-  EXPECT_LT(t.front(), t.back());
-  EXPECT_LE(t.front(), 10);
-  EXPECT_GE(t.back(), 10);
-}
-
 TEST(LearningCurveTest, DrawsLineBandGoalAndAxisTitles) {
   CurveStyle style;
   style.title = "return vs steps";

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "sample_record.h"
 #include "temp_dir.h"
 
 namespace rl::evaluator {
@@ -16,20 +17,8 @@ using testing::CountOccurrences;
 using testing::ReadFile;
 using testing::TempDir;
 
-EvalRecord Record(const std::string& name, int64_t update, double mean) {
-  EvalRecord r;
-  r.checkpoint = name;
-  r.update = update;
-  r.env_steps = update * 4;
-  r.wall_seconds = static_cast<double>(update) / 30.0;
-  r.mean = mean;
-  r.std = mean / 7.0;
-  r.min = mean / 2;
-  r.max = mean * 1.5;
-  r.episodes = 100;
-  r.eval_seconds = 0.1 + static_cast<double>(update) * 1e-6;
-  return r;
-}
+// A record with plausible numbers.
+constexpr auto& Record = testing::SampleRecord;
 
 ReportInfo Info(double goal) {
   ReportInfo info;
@@ -39,97 +28,6 @@ ReportInfo Info(double goal) {
   info.goal = goal;
   info.run_config = "env = CartPole-v1\n[learner]\nlr = 0.0005\n";
   return info;
-}
-
-TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
-  TempDir dir;
-  const std::string path = dir / "eval.jsonl";
-  EvalRecord a = Record("ckpt_000001000.bin", 1000, 1.0 / 3.0);
-  a.wall_seconds = 0.1;
-  EvalRecord b = Record("odd \"name\" \\ tab\t\xC3\xA9.bin", 2000, 475.25);
-  b.min = -1e-300;
-  // With value estimates, one of them without a correlation (written as null).
-  EvalRecord c = Record("c.bin", 3000, 0.36);
-  c.value_steps = 1234;
-  c.value_estimate = 0.291;
-  c.value_return = 0.2705;
-  c.value_correlation = -0.125;
-  EvalRecord d = c;
-  d.value_correlation.reset();
-  // With a second metric.
-  d.second_episodes = 100;
-  d.second_mean = 642.125;
-  d.second_std = -0.5;
-  for (const EvalRecord& r : {a, b, c, d}) AppendJsonLine(path, r);
-
-  const std::string text = ReadFile(path);
-  EXPECT_EQ(CountOccurrences(text, "\n"), 4);
-  EXPECT_EQ(CountOccurrences(text, "\"second_mean\": 642.125"), 1);
-  EXPECT_EQ(CountOccurrences(text, "\"value_correlation\": null"), 1);
-  int skipped = -1;
-  const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
-  EXPECT_EQ(skipped, 0);
-  ASSERT_EQ(back.size(), 4U);
-  EXPECT_EQ(back[0], a);
-  EXPECT_EQ(back[1], b);
-  EXPECT_EQ(back[2], c);
-  EXPECT_EQ(back[3], d);
-}
-
-TEST(JsonLinesTest, ALineHasTheDocumentedFields) {
-  const std::string line = ToJson(Record("c.bin", 10, 9.5));
-  for (const char* key : {"\"checkpoint\": \"c.bin\"", "\"update\": 10", "\"env_steps\": 40",
-                          "\"wall_seconds\":", "\"mean\": 9.5",
-                          "\"std\":", "\"min\":", "\"max\":", "\"episodes\": 100"}) {
-    EXPECT_NE(line.find(key), std::string::npos) << key << " missing in " << line;
-  }
-  EXPECT_EQ(line.find('\n'), std::string::npos);
-}
-
-TEST(JsonLinesTest, ATornLastLineIsSkippedAndCounted) {
-  TempDir dir;
-  const std::string path = dir / "eval.jsonl";
-  AppendJsonLine(path, Record("a.bin", 1, 10));
-  AppendJsonLine(path, Record("b.bin", 2, 20));
-  {
-    std::ofstream out(path, std::ios::app);
-    out << "{\"checkpoint\": \"c.bin\", \"upd";
-  }
-  int skipped = 0;
-  const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
-  EXPECT_EQ(skipped, 1);
-  ASSERT_EQ(back.size(), 2U);
-  EXPECT_EQ(back[1].checkpoint, "b.bin");
-}
-
-TEST(JsonLinesTest, AMissingFileGivesNoRecords) {
-  TempDir dir;
-  int skipped = -1;
-  EXPECT_TRUE(LoadJsonLines(dir / "nothing.jsonl", &skipped).empty());
-  EXPECT_EQ(skipped, 0);
-}
-
-TEST(JsonLinesTest, ParseAcceptsOtherKeyOrderAndRejectsNonObjects) {
-  EvalRecord r;
-  ASSERT_TRUE(ParseJson(R"({ "mean" : 12.5, "extra": "y", "update": 3, "checkpoint": "x" })", &r));
-  EXPECT_EQ(r.checkpoint, "x");
-  EXPECT_EQ(r.update, 3);
-  EXPECT_EQ(r.mean, 12.5);
-  EXPECT_FALSE(ParseJson("[1, 2]", &r));
-  EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3})", &r));  // no mean
-  EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1} trailing)", &r));
-  EXPECT_FALSE(ParseJson("", &r));
-}
-
-TEST(JsonLinesTest, AppendingToAnUnwritablePathThrowsNamingIt) {
-  TempDir dir;
-  const std::string path = dir / "no/such/dir/eval.jsonl";
-  try {
-    AppendJsonLine(path, Record("a.bin", 1, 1));
-    FAIL() << "expected an exception";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-  }
 }
 
 TEST(ReportTest, WritesIndexWithOneRowPerCheckpointNewestFirstAndBothCurves) {

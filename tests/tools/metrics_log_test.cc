@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "evaluator/json_line.h"
+
 namespace rl::tools {
 namespace {
 
@@ -34,7 +36,7 @@ TEST(MetricsLineTest, WritesOneJsonObjectPerRoleWithTheStatsFields) {
   learner.dropped_invalid = 3;
   learner.dropped_replayed = 4;  // counted in "dropped" and on its own
   EXPECT_EQ(MetricsLine(12.5, learner),
-            "{\"t\": 12.500, \"role\": \"learner\", \"updates\": 5000, \"updates_per_second\": 0, "
+            "{\"t\": 12.5, \"role\": \"learner\", \"updates\": 5000, \"updates_per_second\": 0.0, "
             "\"loss\": 0.25, \"mean_q\": null, \"env_steps\": 0, \"weights_version\": 0, "
             "\"lost\": 2, \"dropped\": 7, \"replayed\": 4, \"unauthenticated\": 0}\n");
   rlmsg::stats_actor_t actor{};
@@ -42,7 +44,7 @@ TEST(MetricsLineTest, WritesOneJsonObjectPerRoleWithTheStatsFields) {
   actor.env_steps = 1234567;
   actor.epsilon = 0.1;
   const std::string a = MetricsLine(1, actor);
-  EXPECT_EQ(a.rfind("{\"t\": 1.000, \"role\": \"actor-3\", \"env_steps\": 1234567,", 0), 0u) << a;
+  EXPECT_EQ(a.rfind("{\"t\": 1.0, \"role\": \"actor-3\", \"env_steps\": 1234567,", 0), 0u) << a;
   EXPECT_NE(a.find("\"exploration\": 0.1,"), std::string::npos) << a;
   rlmsg::stats_replay_t replay{};
   replay.header.sender = "replay";
@@ -52,6 +54,21 @@ TEST(MetricsLineTest, WritesOneJsonObjectPerRoleWithTheStatsFields) {
   evaluator.header.sender = "evaluator";
   evaluator.best_mean = -150.5;
   EXPECT_NE(MetricsLine(1, evaluator).find("\"best_mean\": -150.5,"), std::string::npos);
+}
+
+TEST(MetricsLineTest, LinesReadBackAsJsonWithTenSignificantDigits) {
+  rlmsg::stats_actor_t actor{};
+  actor.header.sender = "actor-0";
+  actor.steps_per_second = 1234.567890123456;
+  actor.mean_return = 1.0 / 3.0;
+  const std::string line = MetricsLine(3.0004, actor);
+  EXPECT_NE(line.find("\"mean_return\": 0.3333333333,"), std::string::npos) << line;
+  const std::optional<nlohmann::json> back = ParseJsonLine(line);
+  ASSERT_TRUE(back.has_value()) << line;
+  EXPECT_EQ(JsonNumberAt(*back, "t"), 3.0);  // milliseconds
+  EXPECT_EQ(JsonNumberAt(*back, "steps_per_second"), 1234.56789);
+  EXPECT_EQ(JsonStringAt(*back, "role"), "actor-0");
+  EXPECT_EQ(JsonIntegerAt(*back, "paused"), 0);
 }
 
 class MetricsLogTest : public ::testing::Test {

@@ -1,0 +1,47 @@
+// The report's pictures of the best checkpoint so far: a greedy episode as a video
+// (report/best.webm, video.h) and, for pixel envs, a grid of its camera frames
+// (report/frames.png, frame_grid.h).
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+
+#include "evaluator/eval_history.h"
+#include "evaluator/report.h"
+#include "nn/checkpoint.h"
+
+namespace rl::evaluator {
+
+struct BestMediaConfig {
+  std::string env_id;
+  uint64_t seed_base = 0;  // the video's episode seed, and the first of the frame grid's
+  int video_width = 360;   // pixels
+  int video_height = 240;
+  double video_fps = 30;
+  std::string report_dir;  // where the files go
+};
+
+/// Records the media of every new best checkpoint. Not thread-safe.
+class BestMedia {
+ public:
+  /// Throws std::invalid_argument for an unknown env id.
+  explicit BestMedia(BestMediaConfig config);
+
+  /// When `record` is better than the best recorded so far, records the video of the checkpoint
+  /// `ckpt` (read from `path`) and, for a pixel env, its frame grid. Failures are logged (stderr);
+  /// a checkpoint whose video failed stays a candidate for the next one.
+  void RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path, const EvalRecord& record);
+
+  /// Names the written files and their captions in `info`.
+  void AddTo(ReportInfo* info) const;
+
+ private:
+  BestMediaConfig config_;
+  bool has_frames_ = false;  // a pixel env: a frame grid too
+  double best_mean_ = -std::numeric_limits<double>::infinity();
+  std::string video_caption_;   // empty until a video was recorded
+  std::string frames_caption_;  // empty until a frame grid was written
+};
+
+}  // namespace rl::evaluator
