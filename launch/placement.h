@@ -34,6 +34,11 @@ class Placement {
   /// node has left the job), or empty. May take a moment (a query to the cluster); not called
   /// otherwise.
   virtual std::string Lost(const PlannedProcess& /*process*/) const { return ""; }
+
+  /// Called when a process has exited while the run goes on: why the whole run is being ended
+  /// from outside (its Slurm job cancelled or requeued: Slurm has stopped its processes), or
+  /// empty. May take a moment.
+  virtual std::string Ending() const { return ""; }
 };
 
 /// Every process on this host, as planned.

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <charconv>
 #include <cstdlib>
 #include <sstream>
@@ -195,6 +196,20 @@ std::vector<std::string> SlurmPlacement::Command(const PlannedProcess& process) 
 
 int SlurmPlacement::StopSignal(const PlannedProcess& process) const {
   return IsStep(process) ? SIGUSR2 : SIGTERM;
+}
+
+std::string SlurmPlacement::Ending() const {
+  std::string state;
+  try {
+    const std::vector<std::string> words =
+        Words(RunAndCapture({FindOnPath("squeue"), "-h", "-j", job_.job_id, "-o", "%T"}));
+    if (!words.empty()) state = words[0];
+  } catch (const std::exception&) {
+    return "";  // Slurm did not answer: taken for a crash, restarted as usual
+  }
+  if (state.empty() || state == "RUNNING") return "";
+  for (char& c : state) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return "the Slurm job " + job_.job_id + " is " + state + " (cancelled or requeued)";
 }
 
 std::string SlurmPlacement::Lost(const PlannedProcess& process) const {

@@ -59,6 +59,8 @@ class SlurmPlacement final : public Placement {
   /// For an actor of another node: "its node node2 has left the job (down*)" once Slurm no longer
   /// counts the node in the job or has it down, not responding, drained or failed.
   std::string Lost(const PlannedProcess& process) const override;
+  /// "the Slurm job 12 is completing" once the job is no longer RUNNING (squeue).
+  std::string Ending() const override;
 
   /// The node of actor `id`.
   const std::string& NodeOf(int actor_id) const;

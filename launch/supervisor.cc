@@ -281,6 +281,12 @@ void Supervisor::OnExit(Proc* p, int wait_status) {
                             : RunEnd::kNotReached);
     return;
   }
+  // Its job ending (scancel, a requeue): Slurm stops every process; so does the launcher.
+  if (const std::string ending = placement_.Ending(); !ending.empty()) {
+    Tell(p, "launch: " + role + " " + HowItEnded(wait_status) + ": " + ending);
+    BeginStop(RunEnd::kInterrupted);
+    return;
+  }
   // A process whose node has left the job cannot be started again; the run goes on without it.
   if (!planned.essential) {
     if (const std::string lost = placement_.Lost(planned); !lost.empty()) {
