@@ -6,13 +6,15 @@
 # node2), node2's actors must have acted with the learner's weights, and the key must be
 # owner-only in the shared run folder.
 #
-#   slurm_cartpole.sh [udpm|tcp]      the transport: LCM multicast (default) or LCM's TCP hub
+#   slurm_cartpole.sh [udpm|tcp [LAUNCH_OPTIONS...]]
+#     the transport: LCM multicast (default) or LCM's TCP hub; options for the launch after it
 source "$(dirname "$0")/lib.sh"
 source "$(dirname "$0")/slurm_lib.sh"
 transport=${1:-udpm}
+[ $# -eq 0 ] || shift
 scratch
 t0=$SECONDS
-slurm_cartpole_submit --transport "$transport"
+slurm_cartpole_submit --transport "$transport" "$@"
 slurm_wait_steps
 best=$(slurm_expect_goal)
 grep -q "actors 4 " "$run/logs/monitor.log" || fail "the monitor never saw the four actors of both nodes at once"

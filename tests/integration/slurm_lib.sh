@@ -4,12 +4,14 @@ source "$root/tests/cluster/cluster.sh"
 
 # Brings up 2 nodes of 5 cores (the replay, learner and evaluator and 2 actors on node1) and
 # submits CartPole with the documented command, 2 actors on each node; sets job, run (the run
-# folder, shared) and out (the job's output).
+# folder, shared) and out (the job's output). The job's time limit: $slurm_time (sbatch options).
+slurm_time=${slurm_time:---time=8}
 slurm_cartpole_submit() {  # slurm_cartpole_submit [LAUNCH_OPTIONS...]
   cluster_up 2 --cpus 5
   run=$CLUSTER_SHARED/run
   out=$CLUSTER_SHARED/job.out
-  job=$(cd "$root" && RL_BUILD_DIR=$build_dir cluster_submit --nodes=2 --exclusive --time=8 \
+  # shellcheck disable=SC2086
+  job=$(cd "$root" && RL_BUILD_DIR=$build_dir cluster_submit --nodes=2 --exclusive $slurm_time \
     --output="$out" scripts/slurm.sbatch cartpole --out "$run" --actors-per-node 2 --seed 1 \
     --time-budget 240 "$@")
   echo "job $job submitted: $*"

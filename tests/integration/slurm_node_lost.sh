@@ -34,6 +34,8 @@ kill -CONT $held
 best=$(slurm_expect_goal)
 for a in 2 3; do
   grep -q " actor-$a status 0 lost 0$" "$run/restarts" || fail "RUN/restarts has no line for actor-$a lost"
+  grep -q "<td>actor-$a</td><td>0</td><td>node lost</td>" "$run/report/index.html" ||
+    fail "the report does not show actor-$a's node lost"
 done
 grep -q "restarts 2" "$run/logs/monitor.log" || fail "the progress line did not count the lost actors"
 grep -q "actors 2 " "$run/logs/monitor.log" || fail "the monitor never saw node1's two actors alone"

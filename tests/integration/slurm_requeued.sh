@@ -5,6 +5,13 @@
 # resumes the run folder: the learner at its update count, the replay from its snapshot, the
 # evaluations and best score kept. Once the resumed run has evaluated again, `scancel`: every
 # process stops cleanly (the replay's last snapshot, the report), nothing is killed.
+#
+#   slurm_requeued.sh [scontrol|timelimit]
+#     timelimit: no scontrol requeue; the job has a 2-minute limit and is warned 80 s before it
+#     (sbatch --time=2 --signal=B:USR1@80), when scripts/slurm.sbatch stops the run and requeues
+#     the job itself.
+mode=${1:-scontrol}
+[ "$mode" != timelimit ] || slurm_time="--time=2 --signal=B:USR1@80"
 source "$(dirname "$0")/lib.sh"
 source "$(dirname "$0")/slurm_lib.sh"
 scratch
@@ -13,8 +20,12 @@ slurm_wait_steps
 wait_line "$run/eval.jsonl" '"update"' 120
 timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$run/checkpoints/learner-state.bin" ||
   fail "no learner state after 60 s"
-cluster_exec ctl scontrol requeue "$job"
-echo "requeued job $job"
+if [ "$mode" = timelimit ]; then
+  wait_line "$out" "^slurm.sbatch: the time limit is near: stopping the run to requeue the job" 90
+else
+  cluster_exec ctl scontrol requeue "$job"
+  echo "requeued job $job"
+fi
 wait_line "$out" "^slurm.sbatch: job $job (restart 1)" 90
 wait_line "$out" "^launch: run .* on Slurm job $job: .*, resumed$" 30
 evals_before=$(grep -c '"update"' "$run/eval.jsonl")
@@ -48,4 +59,4 @@ awk -v a="$best" -v b="$best_before" 'BEGIN { exit !(a >= b) }' || fail "the bes
 grep -q '<img' "$run/report/index.html" || fail "the report has no learning curve"
 ! grep -q "did not stop; killing it" "$out" || fail "a process had to be killed"
 [ "$(grep -c '^launch: interrupted, stopping the run' "$out")" -eq 2 ] || fail "the launcher did not stop the run twice"
-echo "PASS: requeued at update $last_update_before (best $best_before), resumed at $resumed from a replay of $size, best $best; scancel stopped it cleanly"
+echo "PASS ($mode): requeued at update $last_update_before (best $best_before), resumed at $resumed from a replay of $size, best $best; scancel stopped it cleanly"
