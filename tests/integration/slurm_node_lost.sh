@@ -7,11 +7,11 @@
 #
 # CartPole learns faster than Slurm declares a node down, so the learner and the evaluator are
 # held (SIGSTOP) from the loss until the launcher has reported it, and let go then (SIGCONT);
-# --max-backoff 30 raises the monitor's silence limit to 65 s to allow for that.
+# --max-backoff 60 raises the monitor's silence limit to 95 s to allow for that.
 source "$(dirname "$0")/lib.sh"
 source "$(dirname "$0")/slurm_lib.sh"
 scratch
-slurm_cartpole_submit --max-backoff 30
+slurm_cartpole_submit --max-backoff 60
 slurm_wait_steps
 held=""
 for kind in learner evaluator; do
