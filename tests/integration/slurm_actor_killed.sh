@@ -19,7 +19,8 @@ for kind in learner evaluator; do
 done
 # shellcheck disable=SC2086
 kill -STOP $held
-trap 'kill -CONT $held 2> /dev/null || true; cleanup' EXIT
+# (cluster_up's trap, cluster_down then cleanup, after letting them go)
+trap 'kill -CONT $held 2> /dev/null || true; cluster_down; cleanup' EXIT
 # Past its start (a process that dies within 3 s of its start failed at its start): its first
 # progress line comes 5 s after it.
 wait_line "$run/logs/actor-3.log" "^actor-3: steps " 60

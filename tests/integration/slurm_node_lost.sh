@@ -21,7 +21,8 @@ for kind in learner evaluator; do
 done
 # shellcheck disable=SC2086
 kill -STOP $held
-trap 'kill -CONT $held 2> /dev/null || true; cleanup' EXIT
+# (cluster_up's trap, cluster_down then cleanup, after letting them go)
+trap 'kill -CONT $held 2> /dev/null || true; cluster_down; cleanup' EXIT
 t0=$SECONDS
 cluster_node_kill node2
 echo "node2 killed"
