@@ -13,6 +13,9 @@ source "$(dirname "$0")/slurm_lib.sh"
 scratch
 slurm_cartpole_submit --max-backoff 60
 slurm_wait_steps
+# Every process ready (a node lost before its actors are ready fails the run's start): the
+# monitor, started last, has seen the four actors.
+wait_line "$run/logs/monitor.log" "actors 4 " 60
 held=""
 for kind in learner evaluator; do
   pid=$(pgrep -f "^$bin/$kind --config $run/config.ini " | head -1)
