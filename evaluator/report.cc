@@ -338,8 +338,10 @@ std::string RestartsSection(const std::string& restarts_file) {
     if (!(fields >> time >> role >> status_word >> code >> restart_word >> count)) continue;
     ++n;
     ++by_role[role];
+    // "TIME ROLE status CODE lost 0": its node left the Slurm job; not restarted.
+    const std::string restart = restart_word == "lost" ? "node lost" : count;
     rows += "<tr><td>" + HtmlEscape(time) + "</td><td>" + HtmlEscape(role) + "</td><td>" +
-            HtmlEscape(code) + "</td><td>" + HtmlEscape(count) + "</td></tr>\n";
+            HtmlEscape(code) + "</td><td>" + HtmlEscape(restart) + "</td></tr>\n";
   }
   if (n == 0) return "";
   std::string summary;
@@ -349,7 +351,8 @@ std::string RestartsSection(const std::string& restarts_file) {
   return "<section>\n<h2>Restarts</h2>\n<p>" + std::to_string(n) + " process restart" +
          (n == 1 ? "" : "s") + " (" + HtmlEscape(summary) +
          "): the launch script restarted each after it exited (status above 128: killed by "
-         "signal status - 128).</p>\n<div class=\"scroll\"><table>\n<thead><tr><th>time</th>"
+         "signal status - 128), but those whose node was lost (a Slurm node down).</p>\n<div "
+         "class=\"scroll\"><table>\n<thead><tr><th>time</th>"
          "<th>process</th><th>exit status</th><th>restart</th></tr></thead>\n<tbody>\n" +
          rows + "</tbody>\n</table></div>\n</section>\n";
 }

@@ -54,8 +54,11 @@ void ParseRunOptions(const std::vector<std::string>& args, size_t i, LaunchOptio
       o->mode = Mode::kHelp;
       return;
     }
-    if (name == "--record" || name == "--dry-run") {
-      (name == "--record" ? o->record : o->dry_run) = true;
+    if (name == "--record" || name == "--dry-run" || name == "--slurm" || name == "--or-resume") {
+      (name == "--record"    ? o->record
+       : name == "--dry-run" ? o->dry_run
+       : name == "--slurm"   ? o->slurm
+                             : o->or_resume) = true;
       continue;
     }
     if (name.rfind("--", 0) != 0)
@@ -83,6 +86,14 @@ void ParseRunOptions(const std::vector<std::string>& args, size_t i, LaunchOptio
       o->seed = ParseWhole<uint64_t>(name, value, 0, UINT64_MAX, "a whole number");
     } else if (name == "--ttl") {
       o->ttl = ParseWhole(name, value, 0, 1, "0 or 1");
+    } else if (name == "--transport") {
+      if (value != "udpm" && value != "tcp") {
+        throw LaunchError("--transport must be udpm (LCM multicast) or tcp (LCM's TCP hub), not '" +
+                          value + "'");
+      }
+      o->transport = value;
+    } else if (name == "--actors-per-node") {
+      o->actors_per_node = ParseWhole(name, value, 0, 4096, "a whole number from 0 to 4096");
     } else if (name == "--port") {
       o->port = ParseWhole(name, value, 1024, 65534, "a UDP port from 1024 to 65534 (P and P+1)");
     } else if (name == "--run-id") {
@@ -104,6 +115,16 @@ void ParseRunOptions(const std::vector<std::string>& args, size_t i, LaunchOptio
     } else {
       throw LaunchError("unknown option '" + name + "' (see --help)");
     }
+  }
+  if (o->transport == "tcp" && !o->slurm) {
+    throw LaunchError("--transport tcp needs --slurm (on one host, multicast is the transport)");
+  }
+  if (o->actors_per_node && !o->slurm) throw LaunchError("--actors-per-node needs --slurm");
+  if (o->slurm && o->actors) {
+    throw LaunchError("--slurm places actors on every node: use --actors-per-node, not --actors");
+  }
+  if (o->or_resume && (resume || o->out.empty())) {
+    throw LaunchError("--or-resume goes with PRESET --out DIR");
   }
   if (o->actors && o->num_actors && *o->num_actors < *o->actors) {
     throw LaunchError("--num-actors (" + std::to_string(*o->num_actors) +
@@ -187,6 +208,7 @@ their last snapshot and state, and a watchdog kills those still running 10 s lat
   --goal SCORE           evaluation mean that ends the run (default: the preset's)
   --seed N               run seed (default 1)
   --ttl 0|1              LCM multicast TTL: 0 keeps traffic on this host, 1 reaches the LAN
+                         (--slurm: 1)
   --port P               LCM port of the run (P and P+1; default: a free random pair)
   --run-id ID            run id (default: random)
   --actor-args "..."     extra options for every actor, split at spaces (also --replay-args,
@@ -204,6 +226,16 @@ their last snapshot and state, and a watchdog kills those still running 10 s lat
   --reset-restarts-after SECONDS
                          a process that ran this long before it exited starts a new count of
                          restarts (default 300)
+  --slurm                run inside a Slurm job (scripts/slurm.sbatch passes it): the replay,
+                         learner and evaluator as steps on the job's first node (with the
+                         monitor, the hubs and the recorder beside the launcher), actors as
+                         steps on every node; a node lost leaves the run going on the others
+  --actors-per-node N    (--slurm) actors on each node (default: the job's cores there, less
+                         the replay, learner and evaluator on the first node)
+  --transport udpm|tcp   (--slurm) LCM multicast (default), or LCM's TCP hub on the first node
+                         for networks without multicast (java and Debian's liblcm-java)
+  --or-resume            with --out DIR: when DIR holds a run, resume it (a requeued job);
+                         --seed and --run-id, if given, must be the run's own
   --dry-run              check everything and print the run's processes and their command
                          lines; start nothing, create nothing
   --root DIR             the checkout: presets in DIR/configs, runs in DIR/runs (scripts/launch.sh

@@ -46,6 +46,7 @@ struct LaunchOptions {
   std::optional<std::string> goal;  // as given: the text is passed on to the processes
   std::optional<uint64_t> seed;
   int ttl = 0;
+  std::string transport = "udpm";  // "udpm" or "tcp"
   std::optional<int> port;
   std::optional<int64_t> run_id;
   // Extra options of every process of a kind ("actor", "replay", "learner", "evaluator"), split
@@ -55,6 +56,11 @@ struct LaunchOptions {
   int record_mb = 256;
   RestartLimits limits;
   bool dry_run = false;  // check the input and print the plan; start and create nothing
+  // --slurm: inside a Slurm job, every node of it (slurm_placement.h); actors on each node.
+  bool slurm = false;
+  std::optional<int> actors_per_node;
+  // --or-resume (with --out): a folder that holds a run already is resumed (a requeued job).
+  bool or_resume = false;
 };
 
 /// Parses the arguments after the program name. Throws LaunchError naming the option for an

@@ -27,6 +27,7 @@
 #include "launch/proc.h"
 #include "launch/run_folder.h"
 #include "launch/run_plan.h"
+#include "launch/slurm_placement.h"
 #include "launch/supervisor.h"
 #include "launch/watchdog.h"
 
@@ -228,6 +229,12 @@ CheckedInput CheckInput(const LaunchOptions& o, const std::string& root, const s
   }
   CheckPreset(preset, ListOptionNames(bin, {"actor", "replay", "learner", "evaluator"}));
   in.settings = ResolveSettings(o, preset, in.resumed ? &*in.resumed : nullptr, bin);
+  if (in.resumed && o.or_resume) {
+    if ((o.seed && *o.seed != in.resumed->seed) || (o.run_id && *o.run_id != in.resumed->run_id)) {
+      throw LaunchError("--seed and --run-id cannot change the run in " + in.run_dir +
+                        " (resumed: it holds a run already)");
+    }
+  }
   if (o.record && !OnPath("lcm-logger")) {
     throw LaunchError("--record needs lcm-logger (Debian's liblcm-bin: scripts/setup.sh)");
   }
@@ -235,7 +242,8 @@ CheckedInput CheckInput(const LaunchOptions& o, const std::string& root, const s
 }
 
 // --dry-run: the plan, as it would run (a new run's folder, id and port as they would be chosen).
-int SayPlan(const LaunchOptions& o, const CheckedInput& in, const std::string& root) {
+int SayPlan(const LaunchOptions& o, const CheckedInput& in, const std::string& root,
+            const Placement& placement) {
   RunIdentity id;
   if (in.resumed) {
     id = {in.run_dir, in.resumed->run_id, o.port.value_or(in.resumed->Port())};
@@ -245,7 +253,6 @@ int SayPlan(const LaunchOptions& o, const CheckedInput& in, const std::string& r
     id.port = o.port.value_or(0);
   }
   const RunPlan plan = BuildRunPlan(in.settings, id);
-  const LocalPlacement placement;
   std::string text =
       "launch: dry run of '" + plan.settings.preset + "' on " + placement.Describe() + " (" +
       (in.resumed ? "resumed" : "run id, port and folder not chosen yet") + "): nothing started\n";
@@ -258,13 +265,49 @@ int SayPlan(const LaunchOptions& o, const CheckedInput& in, const std::string& r
   return 0;
 }
 
-int Launch(const LaunchOptions& o) {
+// --slurm: the job's nodes and the actors of each, checked before anything starts.
+std::unique_ptr<SlurmPlacement> PlaceInSlurmJob(LaunchOptions* o) {
+  if (o->transport == "tcp" && access(kLcmJar, R_OK) != 0) {
+    throw LaunchError(std::string("--transport tcp needs LCM's TCP hub in ") + kLcmJar +
+                      " (Debian's liblcm-java)");
+  }
+  if (o->transport == "tcp" && !OnPath("java")) {
+    throw LaunchError("--transport tcp needs java on the PATH for LCM's TCP hub");
+  }
+  SlurmJob job = ReadSlurmJob();
+  std::vector<int> actors = ActorsPerNode(job.cpus, o->actors_per_node);
+  return std::make_unique<SlurmPlacement>(std::move(job), std::move(actors));
+}
+
+int Launch(LaunchOptions o) {
   std::error_code ec;
   const std::string root =
       fs::absolute(o.root.empty() ? RL_SOURCE_DIR : o.root, ec).lexically_normal().string();
   const std::string bin = ExecutableDir();
-  const CheckedInput in = CheckInput(o, root, bin);
-  if (o.dry_run) return SayPlan(o, in, root);
+  // --or-resume, and a run in --out already (a requeued job): a resume of it.
+  if (o.or_resume && fs::is_regular_file(o.out + "/config.ini", ec)) {
+    o.mode = Mode::kResume;
+    o.run_dir = o.out;
+  }
+  std::unique_ptr<SlurmPlacement> slurm;
+  if (o.slurm) slurm = PlaceInSlurmJob(&o);
+  CheckedInput in = CheckInput(o, root, bin);
+  if (slurm) {
+    // Every node's actors; the run's actor count may grow (a bigger job), never shrink.
+    in.settings.actors = slurm->TotalActors();
+    const int wanted = o.num_actors.value_or(0);
+    if (wanted != 0 && wanted < in.settings.actors) {
+      throw LaunchError("--num-actors (" + std::to_string(wanted) + ") must be at least the " +
+                        std::to_string(in.settings.actors) + " actors of the job's nodes");
+    }
+    in.settings.num_actors = std::max(
+        {in.settings.actors, wanted, in.resumed ? in.resumed->num_actors : in.settings.actors});
+    in.settings.ttl = 1;
+    in.settings.hub_host = slurm->job().first_address;
+  }
+  const LocalPlacement local;
+  const Placement& placement = slurm ? static_cast<const Placement&>(*slurm) : local;
+  if (o.dry_run) return SayPlan(o, in, root, placement);
 
   // The folder, created (or, resuming, found) and locked for the launcher's life.
   std::unique_ptr<RunLock> lock;
@@ -275,7 +318,7 @@ int Launch(const LaunchOptions& o) {
     id.run_id = in.resumed->run_id;
     // The resumed run keeps its port, so that its config.ini and scripts/spy.sh stay right.
     id.port = o.port.value_or(in.resumed->Port());
-    if (!o.port && (id.port == 0 || PortInUse(id.port) || PortInUse(id.port + 1))) {
+    if (!o.port && !slurm && (id.port == 0 || PortInUse(id.port) || PortInUse(id.port + 1))) {
       throw LaunchError("the run's LCM port " + std::to_string(id.port) +
                         " is in use: is the run still going? (or pass --port)");
     }
@@ -289,10 +332,12 @@ int Launch(const LaunchOptions& o) {
   const RunPlan plan = BuildRunPlan(in.settings, id);
   PrepareRunFolder(plan, in.preset_text);
 
-  const LocalPlacement placement;
-  Say(STDOUT_FILENO, "launch: run " + std::to_string(id.run_id) + " of '" + plan.settings.preset +
-                         "' in " + id.run_dir + " (LCM port " + std::to_string(id.port) + ", ttl " +
-                         std::to_string(plan.settings.ttl) + ")\n");
+  Say(STDOUT_FILENO,
+      "launch: run " + std::to_string(id.run_id) + " of '" + plan.settings.preset + "' in " +
+          id.run_dir + " (LCM port " + std::to_string(id.port) + ", " +
+          (plan.settings.transport == "tcp" ? "TCP hub " + plan.settings.hub_host
+                                            : "ttl " + std::to_string(plan.settings.ttl)) +
+          ") on " + placement.Describe() + (plan.settings.resume ? ", resumed" : "") + "\n");
   const int signal_fd = BlockRunSignals();
   Watchdog watchdog(Supervisor::kStopSeconds);
   Supervisor supervisor(plan, placement, signal_fd, &watchdog);

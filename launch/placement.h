@@ -6,6 +6,7 @@
 // restarts and stops like any other).
 #pragma once
 
+#include <csignal>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,21 @@ class Placement {
   /// The command the supervisor executes for `process` (argv[0] looked up on PATH when it has no
   /// '/'). Called for every start, restarts included; must not fail.
   virtual std::vector<std::string> Command(const PlannedProcess& process) const = 0;
+
+  /// The signal that asks the command started for `process` to stop cleanly (also its
+  /// parent-death signal): SIGTERM here; SIGUSR2 for an srun, which passes USR2 on to its task
+  /// where TERM would make it SIGKILL the task.
+  virtual int StopSignal(const PlannedProcess& /*process*/) const { return SIGTERM; }
+
+  /// Called when `process` has exited while the run goes on: why it cannot run any more (its
+  /// node has left the job), or empty. May take a moment (a query to the cluster); not called
+  /// otherwise.
+  virtual std::string Lost(const PlannedProcess& /*process*/) const { return ""; }
+
+  /// Called when a process has exited while the run goes on: why the whole run is being ended
+  /// from outside (its Slurm job cancelled or requeued: Slurm has stopped its processes), or
+  /// empty. May take a moment.
+  virtual std::string Ending() const { return ""; }
 };
 
 /// Every process on this host, as planned.

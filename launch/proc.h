@@ -30,6 +30,9 @@ int ShellExitCode(int wait_status);
 /// Whether the process `pid` has the file `path` open (its /proc/PID/fd links).
 bool HoldsFileOpen(pid_t pid, const std::string& path);
 
+/// Whether a TCP socket of this network namespace listens on `port` (/proc/net/tcp and tcp6).
+bool ListensOnTcp(int port);
+
 /// The directory of the running executable (/proc/self/exe).
 std::string ExecutableDir();
 

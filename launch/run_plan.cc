@@ -88,6 +88,7 @@ RunSettings ResolveSettings(const LaunchOptions& options, const Preset& preset,
   }
   s.time_budget = options.time_budget;
   s.ttl = options.ttl;
+  s.transport = options.transport;
   s.record = options.record;
   s.record_mb = options.record_mb;
   s.extra_args = options.extra_args;
@@ -98,6 +99,10 @@ RunSettings ResolveSettings(const LaunchOptions& options, const Preset& preset,
 std::string LcmUrl(int port, int ttl) {
   return "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=" + std::to_string(ttl) +
          "&recv_buf_size=4194304";
+}
+
+std::string TcpHubUrl(const std::string& host, int port) {
+  return "tcpq://" + host + ":" + std::to_string(port);
 }
 
 RunHeader RunPlan::Header(const std::string& started) const {
@@ -126,13 +131,29 @@ RunPlan BuildRunPlan(const RunSettings& settings, const RunIdentity& identity) {
   RunPlan plan;
   plan.settings = settings;
   plan.identity = identity;
-  plan.lcm_url = LcmUrl(identity.port, settings.ttl);
-  plan.lcm_bulk_url = LcmUrl(identity.port + 1, settings.ttl);
+  const bool tcp = settings.transport == "tcp";
+  plan.lcm_url =
+      tcp ? TcpHubUrl(settings.hub_host, identity.port) : LcmUrl(identity.port, settings.ttl);
+  plan.lcm_bulk_url = tcp ? TcpHubUrl(settings.hub_host, identity.port + 1)
+                          : LcmUrl(identity.port + 1, settings.ttl);
   const std::string& dir = identity.run_dir;
   plan.config_file = dir + "/config.ini";
   plan.key_file = dir + "/key";
   plan.monitor_silence = MonitorSilenceLimit(settings.limits);
   const std::string seed = std::to_string(settings.seed);
+
+  for (int k = 0; tcp && k < 2; ++k) {
+    // LCM's TCP hub (Debian's liblcm-java): one for each port, stateless, stopped last.
+    PlannedProcess hub;
+    hub.role = k == 0 ? "hub" : "hub-bulk";
+    hub.kind = "hub";
+    const std::string port = std::to_string(identity.port + k);
+    hub.argv = {"java", "-cp", kLcmJar, "lcm.lcm.TCPService", port};
+    hub.log = dir + "/logs/" + hub.role + ".log";
+    hub.ready = {Readiness::kListens, port};
+    hub.stops_last = true;
+    plan.processes.push_back(hub);
+  }
 
   if (settings.record) {
     // Rotating files of record_mb / 8 MB: main.lcmlog.0 is written, older ones are renamed up to

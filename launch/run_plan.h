@@ -15,11 +15,15 @@
 
 namespace rl::launch {
 
+/// LCM's TCP hub, lcm.lcm.TCPService, from Debian's liblcm-java.
+inline constexpr char kLcmJar[] = "/usr/share/java/lcm.jar";
+
 /// How the launcher knows that a process has started and may be relied on.
 struct Readiness {
   enum Kind {
     kLogLine,    // a line of its log, written since this start, begins with `text`
     kOpensFile,  // it holds the file `text` open (lcm-logger prints nothing when it starts)
+    kListens,    // a TCP socket of this host listens on port `text` (LCM's TCP hub)
     kAtStart,    // at once
   };
   Kind kind = kAtStart;
@@ -28,10 +32,10 @@ struct Readiness {
 
 /// One process of a run.
 struct PlannedProcess {
-  std::string role;  // its name in logs, RUN/pids and RUN/restarts: "replay", "actor-3", "monitor"
-  std::string
-      kind;  // its program: "recorder", "replay", "learner", "evaluator", "actor", "monitor"
-  int actor_id = -1;              // actors: the index, 0 .. num_actors - 1
+  std::string role;   // its name in logs, RUN/pids and RUN/restarts: "replay", "actor-3", "monitor"
+  std::string kind;   // its program: "hub", "recorder", "replay", "learner", "evaluator", "actor",
+                      // "monitor"
+  int actor_id = -1;  // actors: the index, 0 .. num_actors - 1
   std::vector<std::string> argv;  // argv[0]: the program (a path, or a name looked up on PATH)
   std::string log;                // its standard output and error are appended to this file
   Readiness ready;
@@ -39,7 +43,8 @@ struct PlannedProcess {
   bool essential = true;  // down for good, it ends the run (an actor down leaves the others going)
   bool ends_run = false;  // its exit ends the run (the monitor, which decides when it is over)
   bool shown = false;     // its output is also the launcher's (the monitor's progress line)
-  bool stops_last = false;  // stopped after every other process (the recorder, to record them all)
+  bool stops_last = false;  // stopped after every other process (the recorder, to record them
+                            // all; then the TCP hubs, which carry what it records)
 };
 
 /// What a run's plan is built from, resolved from the command line, the preset and, when
@@ -54,6 +59,8 @@ struct RunSettings {
   std::string goal;  // as given or as the preset has it
   double time_budget = 600;
   int ttl = 0;
+  std::string transport = "udpm";  // "udpm": LCM multicast; "tcp": LCM's TCP hub (tcpq://)
+  std::string hub_host;            // tcp: the numeric address the hubs listen on
   bool record = false;
   int record_mb = 256;
   std::map<std::string, std::vector<std::string>> extra_args;  // by kind
@@ -93,8 +100,13 @@ struct RunPlan {
 /// The LCM URL of a run's port on this host's multicast group.
 std::string LcmUrl(int port, int ttl);
 
-/// Builds the run's plan: the recorder (with --record), the replay, the learner, the evaluator,
-/// actors 0 .. actors - 1 and the monitor, in that order, each with its command line (the common
+/// The LCM URL of a run's port through LCM's TCP hub on `host` (a numeric address: liblcm 1.3.1
+/// resolves names in tcpq URLs to 0.0.0.0).
+std::string TcpHubUrl(const std::string& host, int port);
+
+/// Builds the run's plan: the TCP hubs of the main and bulk ports (transport "tcp"), the
+/// recorder (with --record), the replay, the learner, the evaluator, actors 0 .. actors - 1 and
+/// the monitor, in that order, each with its command line (the common
 /// options, its own, then the user's extra ones), log, readiness line and
 /// restart policy.
 RunPlan BuildRunPlan(const RunSettings& settings, const RunIdentity& identity);

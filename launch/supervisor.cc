@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
@@ -99,8 +100,8 @@ std::string HowItEnded(int wait_status) {
 std::string Seconds(double s) { return FormatDouble(s < 10 ? "%.1f" : "%.0f", s) + " s"; }
 
 // Forks and executes `command` with its output on `out_fd`, in this process group, SIGHUP ignored
-// and SIGTERM as its parent-death signal. Returns the pid.
-pid_t Spawn(const std::vector<std::string>& command, int out_fd) {
+// and `stop_signal` as its parent-death signal. Returns the pid.
+pid_t Spawn(const std::vector<std::string>& command, int out_fd, int stop_signal) {
   std::vector<char*> argv;
   for (const std::string& a : command) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
@@ -114,7 +115,7 @@ pid_t Spawn(const std::vector<std::string>& command, int out_fd) {
     signal(SIGHUP, SIG_IGN);
     signal(SIGPIPE, SIG_DFL);
     // The launcher may have died between fork() and prctl(): then the signal would never come.
-    if (prctl(PR_SET_PDEATHSIG, SIGTERM) != 0 || getppid() != parent) _exit(126);
+    if (prctl(PR_SET_PDEATHSIG, stop_signal) != 0 || getppid() != parent) _exit(126);
     if (null >= 0) dup2(null, STDIN_FILENO);
     dup2(out_fd, STDOUT_FILENO);
     dup2(out_fd, STDERR_FILENO);
@@ -194,7 +195,7 @@ Supervisor::Supervisor(const RunPlan& plan, const Placement& placement, int sign
 
 Supervisor::~Supervisor() {
   for (Proc& p : procs_) {
-    if (p.pid > 0) kill(p.pid, SIGTERM);
+    if (p.pid > 0) kill(p.pid, placement_.StopSignal(*p.plan));
   }
   const double deadline = MonoSeconds() + kStopSeconds;
   while (AnyRunning(true) || AnyRunning(false)) {
@@ -242,7 +243,7 @@ void Supervisor::Start(Proc* p) {
   }
   pid_t pid = 0;
   try {
-    pid = Spawn(placement_.Command(planned), out_fd);
+    pid = Spawn(placement_.Command(planned), out_fd, placement_.StopSignal(planned));
   } catch (...) {
     close(out_fd);
     throw;
@@ -279,6 +280,24 @@ void Supervisor::OnExit(Proc* p, int wait_status) {
               : code == 130 ? RunEnd::kInterrupted
                             : RunEnd::kNotReached);
     return;
+  }
+  // Its job ending (scancel, a requeue): Slurm stops every process; so does the launcher.
+  if (const std::string ending = placement_.Ending(); !ending.empty()) {
+    Tell(p, "launch: " + role + " " + HowItEnded(wait_status) + ": " + ending);
+    BeginStop(RunEnd::kInterrupted);
+    return;
+  }
+  // A process whose node has left the job cannot be started again; the run goes on without it.
+  if (!planned.essential) {
+    if (const std::string lost = placement_.Lost(planned); !lost.empty()) {
+      p->down = true;
+      AppendToFile(plan_.identity.run_dir + "/restarts",
+                   IsoNow() + " " + role + " status " + std::to_string(ShellExitCode(wait_status)) +
+                       " lost 0\n");
+      Tell(p, "launch: " + role + " " + HowItEnded(wait_status) + ": " + lost +
+                  "; the run goes on without it");
+      return;
+    }
   }
   const ExitDecision d =
       planned.restart ? p->policy.OnExit(ran, wait_status, p->ready) : ExitDecision{};
@@ -333,6 +352,8 @@ void Supervisor::CheckReadiness(Proc* p, double now) {
   const Readiness& r = p->plan->ready;
   if (r.kind == Readiness::kOpensFile) {
     p->ready = HoldsFileOpen(p->pid, r.text);
+  } else if (r.kind == Readiness::kListens) {
+    p->ready = ListensOnTcp(std::atoi(r.text.c_str()));
   } else if (r.kind == Readiness::kLogLine) {
     // The lines this start wrote, from where it began: never an earlier start's.
     const int fd = open(p->plan->log.c_str(), O_RDONLY | O_CLOEXEC);
@@ -377,7 +398,7 @@ void Supervisor::BeginStop(RunEnd end) {
   for (Proc& p : procs_) {
     p.restart_at = -1;
     if (p.pid > 0 && !p.plan->stops_last) {
-      kill(p.pid, SIGTERM);
+      kill(p.pid, placement_.StopSignal(*p.plan));
       p.termed = true;
     }
   }
@@ -411,16 +432,26 @@ void Supervisor::AdvanceStop(double now) {
     stop_deadline_ = now + 3;
     last_check_ = 0;
   }
+  // The recorder first, then what carries the traffic it records (a TCP hub).
+  bool recording = false;
+  for (const Proc& p : procs_) {
+    recording |= p.pid > 0 && p.plan->stops_last && p.plan->ready.kind == Readiness::kOpensFile;
+  }
   for (Proc& p : procs_) {
     if (p.pid == 0 || !p.plan->stops_last) continue;
-    if (!p.termed) {
+    if (!p.termed && p.plan->ready.kind != Readiness::kOpensFile) {
+      if (recording) continue;
+      kill(p.pid, placement_.StopSignal(*p.plan));
+      p.termed = true;
+      stop_deadline_ = std::max(stop_deadline_, now + 5);
+    } else if (!p.termed) {
       if (now - last_check_ < 0.1) continue;
       last_check_ = now;
       const int64_t bytes = RecordedBytes(p.plan->ready.text);
       steady_checks_ = bytes == recorded_bytes_ ? steady_checks_ + 1 : 0;
       recorded_bytes_ = bytes;
       if (steady_checks_ < 2 && now < stop_deadline_) continue;
-      kill(p.pid, SIGTERM);  // it closes its file; what it has not written yet is lost
+      kill(p.pid, placement_.StopSignal(*p.plan));  // it closes its file; the rest is lost
       p.termed = true;
       stop_deadline_ = now + 5;
     } else if (!p.killed && now >= stop_deadline_) {

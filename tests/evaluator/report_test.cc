@@ -153,6 +153,12 @@ TEST(ReportTest, ListsTheRestartsOfTheRunsProcesses) {
   EXPECT_NE(html.find("<h2>Restarts</h2>"), std::string::npos);
   EXPECT_NE(html.find("3 process restarts (learner 2, replay 1)"), std::string::npos);
   EXPECT_NE(html.find("<td>learner</td><td>134</td><td>2</td>"), std::string::npos);
+  // An actor whose Slurm node was lost: not restarted.
+  std::ofstream(info.restarts_file, std::ios::app)
+      << "2026-11-25T12:02:00+00:00 actor-3 status 0 lost 0\n";
+  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, info);
+  EXPECT_NE(ReadFile(dir / "index.html").find("<td>actor-3</td><td>0</td><td>node lost</td>"),
+            std::string::npos);
 }
 
 TEST(ReportTest, AnEmptyHistoryStillGivesAReportAndCurves) {
