@@ -31,15 +31,24 @@ slurm_wait_steps() {
   echo "steps: $steps"
 }
 
-# Waits for the job's end (330 s at most): it must complete with its goal reached and nothing
-# lost. Prints the best evaluation mean.
+# Waits for the job's end (330 s at most): it must complete with its goal reached, the replay
+# must have lost no transition (what flow control protects) and no process may have dropped a
+# message. Messages lost elsewhere (a weights chunk or a reply in a burst over the nodes' link:
+# UDP, and the next version or request makes up for it) are printed with their process. Prints
+# the best evaluation mean.
 slurm_expect_goal() {
-  local state last
+  local state last losses
   state=$(cluster_wait_job "$job" 330) || { tail -30 "$out" >&2; fail "job $job did not end"; }
   tail -12 "$out" >&2
   [ "$state" = COMPLETED ] || fail "job $job ended $state"
   grep -q "^launch: goal of 475 reached" "$out" || fail "the goal was not reached"
   last=$(grep -o 'lost [0-9]*  dropped [0-9]*' "$run/logs/monitor.log" | tail -1)
-  [ "$last" = "lost 0  dropped 0" ] || fail "the monitor's last line says: $last"
+  echo "monitor: $last" >&2
+  [ "${last##* }" = 0 ] || fail "the monitor's last line says: $last"
+  # The last count of each process that lost anything, from the run's metrics.
+  losses=$(sed -n 's/.*"role": "\([^"]*\)".*"lost": \([0-9]*\),.*/\1 \2/p' "$run/metrics.jsonl" |
+    awk '{ n[$1] = $2 } END { for (r in n) if (n[r] > 0) printf "%s lost %d; ", r, n[r] }')
+  [ -z "$losses" ] || echo "messages lost over UDP: $losses" >&2
+  case "$losses" in *"replay lost"*) fail "the replay lost transitions: $losses" ;; esac
   expect_best_mean "$run" 475 --at-least
 }
