@@ -32,7 +32,9 @@ done < "$run/pids"
 # replay's inserts and the learner's updates must grow, actor-0 must hold weights of a later update
 # and the evaluator must have scored a checkpoint of a later update.
 metrics="$run/metrics.jsonl"
-rows=$(grep -c '"role": "learner"' "$metrics")
+# (grep -c fails when it counts 0: a short run may have no learner row yet.)
+rows=$(grep -c '"role": "learner"' "$metrics" 2>/dev/null || true)
+rows=${rows:-0}
 timeout 30 bash -c 'until [ "$(grep -c "\"role\": \"learner\"" "$0")" -ge "$1" ]; do sleep 0.1; done' \
   "$metrics" $((rows + 2)) || fail "the monitor wrote no learner row for 30 s"
 inserts0=$(last_metric "$run" replay inserts)
