@@ -11,16 +11,7 @@ source "$(dirname "$0")/slurm_lib.sh"
 scratch
 slurm_cartpole_submit
 slurm_wait_steps
-held=""
-for kind in learner evaluator; do
-  pid=$(pgrep -f "^$bin/$kind --config $run/config.ini " | head -1)
-  [ -n "$pid" ] || fail "no $kind process"
-  held+=" $pid"
-done
-# shellcheck disable=SC2086
-kill -STOP $held
-# (cluster_up's trap, cluster_down then cleanup, after letting them go)
-trap 'kill -CONT $held 2> /dev/null || true; cluster_down; cleanup' EXIT
+slurm_hold_learner_and_evaluator
 # Past its start (a process that dies within 3 s of its start failed at its start): its first
 # progress line comes 5 s after it.
 wait_line "$run/logs/actor-3.log" "^actor-3: steps " 60

@@ -52,3 +52,19 @@ slurm_expect_goal() {
   case "$losses" in *"replay lost"*) fail "the replay lost transitions: $losses" ;; esac
   expect_best_mean "$run" 475 --at-least
 }
+
+# Freezes the run's learner and evaluator (SIGSTOP; their pids in $held), so that the run cannot
+# reach its goal before what the test waits for; lets them go (SIGCONT) on exit, before
+# cluster_up's trap (cluster_down, then cleanup). The test sends SIGCONT itself when it is time.
+slurm_hold_learner_and_evaluator() {
+  local kind pid
+  held=""
+  for kind in learner evaluator; do
+    pid=$(pgrep -f "^$bin/$kind --config $run/config.ini " | head -1)
+    [ -n "$pid" ] || fail "no $kind process"
+    held+=" $pid"
+  done
+  # shellcheck disable=SC2086
+  kill -STOP $held
+  trap 'kill -CONT $held 2> /dev/null || true; cluster_down; cleanup' EXIT
+}

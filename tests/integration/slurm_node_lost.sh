@@ -16,16 +16,7 @@ slurm_wait_steps
 # Every process ready (a node lost before its actors are ready fails the run's start): the
 # monitor, started last, has seen the four actors.
 wait_line "$run/logs/monitor.log" "actors 4 " 60
-held=""
-for kind in learner evaluator; do
-  pid=$(pgrep -f "^$bin/$kind --config $run/config.ini " | head -1)
-  [ -n "$pid" ] || fail "no $kind process"
-  held+=" $pid"
-done
-# shellcheck disable=SC2086
-kill -STOP $held
-# (cluster_up's trap, cluster_down then cleanup, after letting them go)
-trap 'kill -CONT $held 2> /dev/null || true; cluster_down; cleanup' EXIT
+slurm_hold_learner_and_evaluator
 t0=$SECONDS
 cluster_node_kill node2
 echo "node2 killed"
