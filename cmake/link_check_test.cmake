@@ -43,22 +43,22 @@ if(NOT result EQUAL 0)
   message(FATAL_ERROR "link_check_test: a graph that keeps the rules was refused:\n${out}")
 endif()
 
-# nn reaches OpenSSL through the helpers and the bus, by an alias and a $<LINK_ONLY:...>.
+# nn reaches the bus through rl_util, by an alias and a $<LINK_ONLY:...>.
 configure_case(reached [=[
 add_library(rl_base INTERFACE)
 add_library(rl_bus INTERFACE)
 add_library(rl::bus ALIAS rl_bus)
 target_link_libraries(rl_bus INTERFACE rl_base OpenSSL::Crypto)
-add_library(rl_helpers INTERFACE)
-set_property(TARGET rl_helpers PROPERTY INTERFACE_LINK_LIBRARIES "$<LINK_ONLY:rl::bus>")
+add_library(rl_util INTERFACE)
+set_property(TARGET rl_util PROPERTY INTERFACE_LINK_LIBRARIES "$<LINK_ONLY:rl::bus>")
 add_library(rl_nn INTERFACE)
-target_link_libraries(rl_nn INTERFACE rl_base rl_helpers)
+target_link_libraries(rl_nn INTERFACE rl_base rl_util)
 ]=] result out)
 string(REGEX REPLACE "[ \n]+" " " out "${out}")
 if(result EQUAL 0)
-  message(FATAL_ERROR "link_check_test: nn reaching the bus through a helper was not refused")
+  message(FATAL_ERROR "link_check_test: nn reaching the bus through another library was not refused")
 endif()
-if(NOT out MATCHES "rl_nn must not link rl_bus, but does: rl_nn -> rl_helpers -> rl_bus")
+if(NOT out MATCHES "rl_nn must not link rl_bus, but does: rl_nn -> rl_util -> rl_bus")
   message(FATAL_ERROR "link_check_test: the refusal does not name the chain:\n${out}")
 endif()
 
