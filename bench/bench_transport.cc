@@ -10,14 +10,15 @@
 // credit limit: the raw limit of the transport and the replay); with --window N, also no more
 // than N transitions published and not yet stored (a fixed share, as a replay with a ratio gives
 // each actor: nothing is lost while N fits in the receive buffers). Then it waits until the replay
-// has stored all it published, or until its count has not grown for --settle seconds, and prints
-// one JSON line:
+// has stored all it published, or until its flow messages have shown no growth for --settle
+// seconds, and prints one JSON line:
 //   published, messages, bytes     what it published (transitions, batches, encoded bytes)
 //   publish_failed                 publications LCM reported as failed
 //   stored                         what the replay stored of them (RL_FLOW's count for its id)
-//   start, end, last_stored        wall-clock seconds: publishing began, ended, and the last time
-//                                  the stored count grew (so stored / (last_stored - start) is
-//                                  the rate the replay took them in)
+//   start, end, last_stored        wall-clock seconds: publishing began, ended, and the arrival
+//                                  of the flow message that showed the last growth of the stored
+//                                  count (so stored / (last_stored - start) is the rate the
+//                                  replay took them in, or a little less)
 //   paused_s                       seconds the flow control held it back
 //   replay_lost, replay_missing_frames, replay_dropped
 //                                  the growth of the replay's counts over the measurement (every
@@ -64,11 +65,13 @@ struct ReplayView {
   int64_t credit = -1;         // the last flow message's insert credit (-1: no limit)
   int64_t stored = 0;          // transitions of this actor id the replay has stored
   double stored_changed = 0;   // wall-clock seconds of the last growth of `stored`
+  double last_flow = 0;        // wall-clock seconds of the last flow message
   bool stats_heard = false;
   int64_t lost = 0, missing_frames = 0, dropped = 0;  // the replay's counts, every sender's
 
   void OnFlow(const rlmsg::flow_control_t& f) {
     heard = true;
+    last_flow = 1e-6 * static_cast<double>(rl::WallMicros());
     insert_allowed = f.insert_allowed != 0;
     credit = f.insert_credit;
     for (size_t i = 0; i < f.actor_id.size(); ++i) {
@@ -125,8 +128,10 @@ int Main(int argc, char** argv) {
       ("seconds", rl::po::value(&seconds)->default_value(seconds), "seconds of publishing")  //
       ("start-at", rl::po::value(&start_at)->default_value(start_at),
        "wall-clock time to start publishing, seconds since the epoch (0: at once)")  //
-      ("settle", rl::po::value(&settle)->default_value(settle),
-       "seconds without a new stored transition that end the wait for the replay")  //
+      (
+          "settle", rl::po::value(&settle)->default_value(settle),
+          "seconds of flow messages without a new stored transition that end the wait for the "
+          "replay")  //
       ("window", rl::po::value(&window)->default_value(window),
        "transitions published and not yet stored at most (0: only the replay's flow control)")  //
       ("ready-timeout", rl::po::value(&ready_timeout)->default_value(ready_timeout),
@@ -181,9 +186,14 @@ int Main(int argc, char** argv) {
     now = WallSeconds();
   }
   const double end = now;
-  // Until everything is stored, or nothing more has been for `settle` seconds (the rest is lost).
+  // Until everything is stored, or the flow messages have shown no more for `settle` seconds
+  // (the rest is lost). A replay draining a backlog publishes no flow message until it is
+  // through (one Handle() call takes every message waiting), so silence is not an answer; at most
+  // kMaxSettle seconds in all.
+  constexpr double kMaxSettle = 60;
   while (replay.stored - stored_at_start < published &&
-         WallSeconds() - std::max(replay.stored_changed, end) < settle) {
+         replay.last_flow - std::max(replay.stored_changed, end) < settle &&
+         WallSeconds() - end < kMaxSettle) {
     bus.Handle(5);
   }
   // The replay's next stats message, so that its counts include this publisher's last batches.
