@@ -136,12 +136,20 @@ wait_line() {  # wait_line SECONDS FILE REGEX WHAT
   done
 }
 
-# CPU time (user and system, clock ticks) a process has used; 0 for none.
+# CPU time (user and system, clock ticks) a process has used; 0 for none. (Builtins only: the
+# trace below calls it ten times a second.)
 cpu_ticks() {  # cpu_ticks [PID]
-  local stat
+  local stat f
   [ -n "${1:-}" ] && read -r stat 2> /dev/null < "/proc/$1/stat" || { echo 0; return; }
-  stat=${stat##*) }  # the fields after the command's name, from the state (field 3) on
-  awk '{ print $12 + $13 }' <<< "$stat"
+  read -r -a f <<< "${stat##*) }"  # the fields after the command's name, from the state (3) on
+  echo $((f[11] + f[12]))
+}
+# Appends "TIME REPLAY_TICKS HUB_TICKS" to FILE every 0.1 s while the replay runs.
+cpu_trace() {  # cpu_trace FILE
+  while kill -0 "$replay_pid" 2> /dev/null; do
+    echo "$EPOCHREALTIME $(cpu_ticks "$replay_pid") $(cpu_ticks "$hub_pid")"
+    sleep 0.1
+  done >> "$1"
 }
 tick_us=$((1000000 / $(getconf CLK_TCK)))
 # "REPLAY_TICKS HUB_TICKS SECONDS" since the counts and time given (replay_pid, hub_pid).
@@ -193,12 +201,10 @@ measure() {  # measure PLACEMENT SERVER TRANSPORT KIND KEY WINDOW HOSTS...
   local replay_pid=$bg_pid
   wait_line 60 "$dir/replay.log" "replay: ready" "the replay's start"
   local jobs
-  # The CPU the replay and the hub use idle (flow and stats messages, timeouts), per second: the
-  # first line of cpu, taken out of each measurement's below.
   local cpu0 hub0 t0
-  cpu0=$(cpu_ticks "$replay_pid") hub0=$(cpu_ticks "$hub_pid") t0=$EPOCHREALTIME
-  sleep 2
-  cpu_line "$cpu0" "$hub0" "$t0" > "$dir/cpu"
+  : > "$dir/cpu"
+  cpu_trace "$dir/cpu-trace" &
+  local trace_job=$!
   for ((r = first; r < repeats; r++)); do
     cpu0=$(cpu_ticks "$replay_pid") hub0=$(cpu_ticks "$hub_pid") t0=$EPOCHREALTIME
     local at
@@ -215,7 +221,14 @@ measure() {  # measure PLACEMENT SERVER TRANSPORT KIND KEY WINDOW HOSTS...
     done
     [ "$r" -lt 0 ] || cpu_line "$cpu0" "$hub0" "$t0" >> "$dir/cpu"
   done
+  # The CPU the replay and the hub use idle (flow and stats messages, timeouts), per second, once
+  # the measurements are over (a replay's start and its first inserts cost more): the last line
+  # of cpu, taken out of each measurement's.
+  cpu0=$(cpu_ticks "$replay_pid") hub0=$(cpu_ticks "$hub_pid") t0=$EPOCHREALTIME
+  sleep 2
+  cpu_line "$cpu0" "$hub0" "$t0" >> "$dir/cpu"
   kill -TERM "$replay_pid"
+  wait "$trace_job" || true
   for p in "${pids[@]}"; do
     [[ " ${started[*]} " == *" $p "* ]] || kill -TERM "$p" 2> /dev/null || true
   done
@@ -226,10 +239,20 @@ measure() {  # measure PLACEMENT SERVER TRANSPORT KIND KEY WINDOW HOSTS...
   python3 - "$dir" "$repeats" "$placement" "$transport" "$kind" "$key" "$n" "$tick_us" "$window" << 'PY'
 import glob, json, statistics, sys
 d, repeats, placement, transport, kind, key, n, tick_us, window = sys.argv[1:]
-# CPU microseconds of the replay and the hub in each repeat, less what they use idle.
+# The CPU microseconds the replay and the hub use idle per second (the last line of cpu), and
+# their CPU microseconds from a repeat's first publication to its last transition stored (the
+# trace, interpolated), less that.
 lines = [[float(x) for x in l.split()] for l in open(f"{d}/cpu")]
-idle = [t * int(tick_us) / lines[0][2] for t in lines[0][:2]]
-cpu = [[max(0.0, t * int(tick_us) - i * l[2]) for t, i in zip(l[:2], idle)] for l in lines[1:]]
+idle = [t * int(tick_us) / lines[-1][2] for t in lines[-1][:2]]
+trace = [[float(x) for x in l.split()] for l in open(f"{d}/cpu-trace") if len(l.split()) == 3]
+def cpu_at(t, i):
+    """Process i's (0 replay, 1 hub) CPU microseconds at wall time t."""
+    for a, b in zip(trace, trace[1:]):
+        if a[0] <= t <= b[0]:
+            return int(tick_us) * (a[1 + i] + (b[1 + i] - a[1 + i]) * (t - a[0]) / max(b[0] - a[0], 1e-9))
+    return int(tick_us) * (trace[0][1 + i] if t < trace[0][0] else trace[-1][1 + i])
+def cpu_between(t0, t1):
+    return [max(0.0, cpu_at(t1, i) - cpu_at(t0, i) - idle[i] * (t1 - t0)) for i in (0, 1)]
 def summary(v):
     v = sorted(v)
     return v[0], statistics.median(v), v[-1]
@@ -248,8 +271,9 @@ for r in range(int(repeats)):
     paused.append(max(p["paused_s"] for p in pubs))
     # CPU time per transition stored: what one core of this machine can take in, whatever the
     # load beside it (its inverse).
-    replay_us.append(cpu[r][0] / max(stored, 1))
-    hub_us.append(cpu[r][1] / max(stored, 1))
+    used = cpu_between(min(p["start"] for p in pubs), max(p["last_stored"] for p in pubs))
+    replay_us.append(used[0] / max(stored, 1))
+    hub_us.append(used[1] / max(stored, 1))
 lo, med, hi = summary(rates)
 print(json.dumps({
     "bench": f"transport_ingest_{kind}", "value": round(med), "unit": "transitions/s",
