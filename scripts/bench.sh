@@ -77,7 +77,7 @@ fi
 if wanted kuka; then "$bin/kuka_probe" --json --episodes "${KUKA_EPISODES:-20}" >> "$ours"; fi
 # Transports: transitions/s one replay daemon stores and messages lost at the raw limit, udpm and
 # LCM's TCP hub, flat and pixel, without and with the key, publishers on this host and on nodes
-# of the test cluster (bench/transport.sh; about 10 minutes with the defaults).
+# of the test cluster (bench/transport.sh; 20 to 30 minutes with the defaults).
 if wanted transport && [ "$skip_transport" -eq 0 ]; then
   echo "bench: transport" >&2
   bench/transport.sh --build-dir "$build_dir" --repeats "${TRANSPORT_REPEATS:-3}" \
