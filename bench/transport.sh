@@ -31,8 +31,8 @@
 #          [--transports "udpm tcp"] [--keys "none gmac"] [--flows "raw window"]
 #          [--local "1 4"] [--nodes "1 3"]
 #   --local ""/--nodes "" leave a placement out; --nodes needs root and the test cluster's
-#   packages (scripts/setup.sh installs slurm-wlm and munge). Defaults: 3 repeats of 2 s; all of
-#   it takes about 25 minutes.
+#   packages (scripts/setup.sh installs slurm-wlm and munge). Defaults: 3 repeats of 2 s; with
+#   --local 1 it took 27 minutes on a loaded 2-core machine, the defaults take longer.
 # Every process of one measurement shares this machine's cores: on a machine shared with other
 # work the transitions/s are noisy (the CPU per transition much less), and "nodes" measures the
 # link and the processes, not more cores.
@@ -262,7 +262,8 @@ for r in range(int(repeats)):
             for l in open(f) if l.startswith("{")]
     published = sum(p["published"] for p in pubs)
     stored = sum(p["stored"] for p in pubs)
-    span = max(p["last_stored"] for p in pubs) - min(p["start"] for p in pubs)
+    # (A publisher that saw nothing stored reports the time of no growth: 0.)
+    span = max(1e-3, max(p["last_stored"] for p in pubs) - min(p["start"] for p in pubs))
     rates.append(stored / span)
     mb.append(sum(p["bytes"] * p["stored"] / max(p["published"], 1) for p in pubs) / span / 1e6)
     lost_pct.append(100.0 * (published - stored) / published)
