@@ -140,7 +140,7 @@ wait_line() {  # wait_line SECONDS FILE REGEX WHAT
 # trace below calls it ten times a second.)
 cpu_ticks() {  # cpu_ticks [PID]
   local stat f
-  [ -n "${1:-}" ] && read -r stat 2> /dev/null < "/proc/$1/stat" || { echo 0; return; }
+  if [ -z "${1:-}" ] || ! read -r stat 2> /dev/null < "/proc/$1/stat"; then echo 0; return; fi
   read -r -a f <<< "${stat##*) }"  # the fields after the command's name, from the state (3) on
   echo $((f[11] + f[12]))
 }
@@ -161,7 +161,7 @@ cpu_line() {  # cpu_line REPLAY_TICKS0 HUB_TICKS0 EPOCHREALTIME0
 port=17700
 # One configuration: the replay (and the hubs) on SERVER, publishers on HOSTS; prints its JSON line.
 measure() {  # measure PLACEMENT SERVER TRANSPORT KIND KEY WINDOW HOSTS...
-  local placement=$1 server=$2 transport=$3 kind=$4 key=$5 window=$6 addr url bulk r i h
+  local placement=$1 server=$2 transport=$3 kind=$4 key=$5 window=$6 addr url bulk r i
   shift 6
   local hosts=("$@") n=$#
   port=$((port + 2))
