@@ -5,6 +5,7 @@
 # of our lines gains "peer" (the peer's median) and "ratio" (how many times faster ours is).
 #
 # Usage: scripts/bench.sh [--no-setup] [--build-dir DIR] [--skip-goal] [--skip-peer]
+#                         [--skip-transport]
 # Environment: REPEATS (5), SECONDS_PER (1.0, per measurement), GOAL_SEEDS ("1 2 3"),
 #              PEER_REPEATS (3), PEER_DQN (1: also time the peer's full CartPole DQN run),
 #              CNN_REPEATS (REPEATS) and CNN_SECONDS (SECONDS_PER) for bench_cnn, CNN_THREADS
@@ -15,7 +16,10 @@
 #              --skip-goal: skip it), CAR_PIPELINE_SECONDS (300: the same for car_racing_td3, whose
 #              env steps are agent steps of 5 frames), TD3_SEEDS ("1": seeds of the Pendulum and
 #              LunarLanderContinuous runs to their goals), PEER_TD3 (1: run the peer's td3 mode),
-#              BENCHES ("env actor learner replay cnn kuka": which of our benchmarks run),
+#              BENCHES ("env actor learner replay cnn kuka transport": which of our benchmarks
+#              run), TRANSPORT_REPEATS (3), TRANSPORT_SECONDS (2), TRANSPORT_LOCAL ("1 4":
+#              publisher processes on this host) and TRANSPORT_NODES ("1 3": publisher nodes of
+#              the test cluster, root only; "" skips them) for bench/transport.sh,
 #              PEER_BF16 (1: also run the peer's update modes with --precision bf16, torch's CPU
 #              autocast, for the bf16 rows of ours), RL_BENCH_CLOCK (cpu: our one-thread rates
 #              per CPU second, for a shared machine; the peer's stay per wall second).
@@ -25,13 +29,14 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 cd "$root"
-setup=1 build_dir="$root/build" skip_goal=0 skip_peer=0
+setup=1 build_dir="$root/build" skip_goal=0 skip_peer=0 skip_transport=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --no-setup) setup=0 ;;
     --build-dir) build_dir="$2"; shift ;;
     --skip-goal) skip_goal=1 ;;
     --skip-peer) skip_peer=1 ;;
+    --skip-transport) skip_transport=1 ;;
     -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "bench.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -55,7 +60,7 @@ isolated() {
 
 ours="$work/ours.jsonl"
 echo "bench: ours" >&2
-benches=" ${BENCHES:-env actor learner replay cnn kuka} "
+benches=" ${BENCHES:-env actor learner replay cnn kuka transport} "
 wanted() { [[ "$benches" == *" $1 "* ]]; }
 if wanted env; then "$bin/bench_env" "$repeats" "$seconds" >> "$ours"; fi
 if wanted actor; then "$bin/bench_actor" "$repeats" "$seconds" >> "$ours"; fi
@@ -70,6 +75,15 @@ fi
 # KUKA grasping (Bullet, OSMesa at 48x48, one llvmpipe thread): rendered frames/s, physics and
 # env steps/s and episodes per hour of one actor (per CPU second), oracle and random success.
 if wanted kuka; then "$bin/kuka_probe" --json --episodes "${KUKA_EPISODES:-20}" >> "$ours"; fi
+# Transports: transitions/s one replay daemon stores and messages lost at the raw limit, udpm and
+# LCM's TCP hub, flat and pixel, without and with the key, publishers on this host and on nodes
+# of the test cluster (bench/transport.sh; 20 to 30 minutes with the defaults).
+if wanted transport && [ "$skip_transport" -eq 0 ]; then
+  echo "bench: transport" >&2
+  bench/transport.sh --build-dir "$build_dir" --repeats "${TRANSPORT_REPEATS:-3}" \
+    --seconds "${TRANSPORT_SECONDS:-2}" --local "${TRANSPORT_LOCAL:-1 4}" \
+    --nodes "${TRANSPORT_NODES-1 3}" >> "$ours"
+fi
 
 # Time from launch to goal for CartPole, start-up and evaluation included.
 if [ "$skip_goal" -eq 0 ]; then
