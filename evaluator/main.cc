@@ -91,7 +91,7 @@ int Main(int argc, char** argv) {
   std::string eval_env;
   std::string frames_file;
   std::string tsne_file;
-  std::string sched_policy = "normal";
+  std::string sched_policy;
   int nice = 0;
   double goal = 0;
 
@@ -162,21 +162,28 @@ int Main(int argc, char** argv) {
        rl::po::value(&config.screen_max_rejects)->default_value(config.screen_max_rejects),
        "service mode: after this many checkpoints screened out in a row, the next one is "
        "evaluated in full without a screen")  //
-      ("sched-policy", rl::po::value(&sched_policy)->default_value(sched_policy),
+      ("sched-policy", rl::po::value(&sched_policy),
        "CPU scheduling policy of the whole evaluator: normal, batch (no wake-up preemption) or "
-       "idle (runs only on cycles nothing else wants; the pixel presets' choice, so that scoring "
-       "never takes the learner's core)")  //
-      ("nice", rl::po::value(&nice)->default_value(nice),
+       "idle (runs only on cycles nothing else wants; the CarRacing presets' choice, so that "
+       "scoring never takes the learner's core). Default: the one it was started with")  //
+      ("nice", rl::po::value(&nice),
        "nice value of the whole evaluator, 0 .. 19 (higher: lower priority; no effect under "
-       "--sched-policy idle)")  //
+       "--sched-policy idle). Default: the one it was started with")  //
       ("run-config", rl::po::value(&run_config_file),
        "text file shown in the report as the run's config (default: the --config file)");
 
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "evaluator", kUsage, desc, &vm)) return 0;
-  // Before any thread starts: threads inherit the policy and nice value of their creator.
-  const rl::evaluator::Scheduling scheduling = rl::evaluator::ParseScheduling(sched_policy, nice);
-  rl::evaluator::ApplyScheduling(scheduling);
+  // Before any thread starts: threads inherit the policy and nice value of their creator. What
+  // is not given stays as inherited (raising a lowered priority back would need privileges).
+  if (vm.count("sched-policy") > 0 || vm.count("nice") > 0) {
+    rl::evaluator::Scheduling scheduling = rl::evaluator::CurrentScheduling();
+    if (vm.count("sched-policy") > 0) {
+      scheduling.policy = rl::evaluator::ParseSchedPolicy(sched_policy);
+    }
+    if (vm.count("nice") > 0) scheduling.nice = rl::evaluator::CheckNice(nice);
+    rl::evaluator::ApplyScheduling(scheduling);
+  }
   if (!eval_env.empty()) config.env_id = eval_env;
   if (rl::envs::LookupSpec(config.env_id).continuous()) {
     rl::RefuseGiven(vm, {"epsilon"},
@@ -213,7 +220,7 @@ int Main(int argc, char** argv) {
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("evaluator"));
   rl::evaluator::EvaluatorService service(config, &bus, stdout);
-  std::printf("evaluator: scheduling %s\n", rl::evaluator::Describe(scheduling).c_str());
+  std::printf("evaluator: scheduling %s\n", rl::evaluator::DescribeCurrent().c_str());
   std::printf("evaluator: ready\n");
   std::fflush(stdout);
   service.Run();

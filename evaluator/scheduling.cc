@@ -38,23 +38,23 @@ const char* SchedPolicyName(SchedPolicy policy) {
   return "normal";
 }
 
-Scheduling ParseScheduling(const std::string& policy, int nice) {
-  Scheduling s;
-  if (policy == "normal") {
-    s.policy = SchedPolicy::kNormal;
-  } else if (policy == "batch") {
-    s.policy = SchedPolicy::kBatch;
-  } else if (policy == "idle") {
-    s.policy = SchedPolicy::kIdle;
-  } else {
-    throw std::invalid_argument("--sched-policy '" + policy + "' is none of normal, batch, idle");
-  }
+SchedPolicy ParseSchedPolicy(const std::string& name) {
+  if (name == "normal") return SchedPolicy::kNormal;
+  if (name == "batch") return SchedPolicy::kBatch;
+  if (name == "idle") return SchedPolicy::kIdle;
+  throw std::invalid_argument("--sched-policy '" + name + "' is none of normal, batch, idle");
+}
+
+int CheckNice(int nice) {
   if (nice < 0 || nice > kMaxNice) {
     throw std::invalid_argument("--nice " + std::to_string(nice) +
                                 " is outside 0 .. 19 (the evaluator only lowers its priority)");
   }
-  s.nice = nice;
-  return s;
+  return nice;
+}
+
+Scheduling ParseScheduling(const std::string& policy, int nice) {
+  return {ParseSchedPolicy(policy), CheckNice(nice)};
 }
 
 void ApplyScheduling(const Scheduling& scheduling) {
@@ -100,6 +100,14 @@ Scheduling CurrentScheduling() {
 std::string Describe(const Scheduling& scheduling) {
   return std::string(SchedPolicyName(scheduling.policy)) + ", nice " +
          std::to_string(scheduling.nice);
+}
+
+std::string DescribeCurrent() {
+  try {
+    return Describe(CurrentScheduling());
+  } catch (const std::exception& e) {
+    return e.what();
+  }
 }
 
 }  // namespace rl::evaluator

@@ -28,8 +28,14 @@ struct Scheduling {
 /// "normal", "batch" or "idle".
 const char* SchedPolicyName(SchedPolicy policy);
 
-/// Scheduling from the option values: policy "normal", "batch" or "idle", nice 0 .. 19. Throws
-/// std::invalid_argument naming the bad value and the accepted ones.
+/// The policy named "normal", "batch" or "idle". Throws std::invalid_argument naming the bad
+/// value and the accepted ones.
+SchedPolicy ParseSchedPolicy(const std::string& name);
+
+/// `nice` when it is 0 .. 19; throws std::invalid_argument otherwise.
+int CheckNice(int nice);
+
+/// Scheduling from the option values (ParseSchedPolicy, CheckNice).
 Scheduling ParseScheduling(const std::string& policy, int nice);
 
 /// Sets the calling thread's policy (priority 0) and nice value; threads it starts afterwards
@@ -40,7 +46,11 @@ void ApplyScheduling(const Scheduling& scheduling);
 /// for a policy other than the three above (a real-time one, set by someone else).
 Scheduling CurrentScheduling();
 
-/// "idle, nice 19": what the evaluator prints when it starts.
+/// "idle, nice 19".
 std::string Describe(const Scheduling& scheduling);
+
+/// Describe(CurrentScheduling()), or what the kernel said when that throws: what the evaluator
+/// prints when it starts. Never throws.
+std::string DescribeCurrent();
 
 }  // namespace rl::evaluator
