@@ -164,10 +164,10 @@ int Main(int argc, char** argv) {
        "evaluated in full without a screen")  //
       ("sched-policy", rl::po::value(&sched_policy),
        "CPU scheduling policy of the whole evaluator: normal, batch (no wake-up preemption) or "
-       "idle (runs only on cycles nothing else wants; the CarRacing presets' choice, so that "
-       "scoring never takes the learner's core). Default: the one it was started with")  //
+       "idle (runs only on cycles nothing else wants). Default: the one it was started with")  //
       ("nice", rl::po::value(&nice),
-       "nice value of the whole evaluator, 0 .. 19 (higher: lower priority; no effect under "
+       "nice value of the whole evaluator, 0 .. 19 (higher: lower priority, so that scoring does "
+       "not take the learner's core: the CarRacing presets set 19; no effect under "
        "--sched-policy idle). Default: the one it was started with")  //
       ("run-config", rl::po::value(&run_config_file),
        "text file shown in the report as the run's config (default: the --config file)");
