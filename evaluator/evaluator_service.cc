@@ -115,6 +115,18 @@ void EvaluatorConfig::Validate() const {
                                   " does not take the observations and actions of " + env_id);
     }
   }
+  if (screen_episodes < 0 || screen_episodes >= episodes) {
+    throw std::invalid_argument("screen-episodes must be 0 (no screen) or 1 to episodes - 1 (" +
+                                std::to_string(episodes - 1) + "), got " +
+                                std::to_string(screen_episodes));
+  }
+  if (!(screen_margin >= 0.0) || std::isinf(screen_margin)) {
+    throw std::invalid_argument("screen-margin must be finite and at least 0");
+  }
+  if (screen_max_rejects < 1) {
+    throw std::invalid_argument("screen-max-rejects must be at least 1, got " +
+                                std::to_string(screen_max_rejects));
+  }
   if (tsne != 0 && (tsne < kTsneMapMinStates || tsne > kTsneMapMaxStates)) {
     throw std::invalid_argument("tsne must be 0 (no map) or " + std::to_string(kTsneMapMinStates) +
                                 " to " + std::to_string(kTsneMapMaxStates) + " states, got " +
@@ -203,6 +215,10 @@ std::optional<EvalRecord> EvaluatorService::Score(const rlmsg::checkpoint_t& ann
     // Stats keep flowing during a long evaluation (KUKA: about a second per episode), so the
     // monitor never mistakes a busy evaluator for a dead one, and a stop request is honoured
     // after the current episode.
+    if (!PassesScreen(*ckpt, announced)) {
+      busy_ = false;
+      return std::nullopt;
+    }
     record = ScoreCheckpoint(*ckpt, announced.path, config_.env_id, config_.episodes,
                              config_.epsilon, config_.seed_base, config_.gamma, [this] { Tick(); });
   } catch (const Interrupted&) {
@@ -224,6 +240,32 @@ std::optional<EvalRecord> EvaluatorService::Score(const rlmsg::checkpoint_t& ann
   second_.ScoreIfBest(*ckpt, announced.path, &record, [this] { Tick(); });
   busy_ = false;
   return record;
+}
+
+bool EvaluatorService::PassesScreen(const nn::Checkpoint& ckpt,
+                                    const rlmsg::checkpoint_t& announced) {
+  const EvalRecord* best = history_.best();
+  if (config_.screen_episodes == 0 || best == nullptr ||
+      rejects_in_row_ >= config_.screen_max_rejects) {
+    rejects_in_row_ = 0;
+    return true;
+  }
+  const EvalRecord screen =
+      ScoreCheckpoint(ckpt, announced.path, config_.env_id, config_.screen_episodes,
+                      config_.epsilon, config_.seed_base, config_.gamma, [this] { Tick(); });
+  const double bar = best->mean - config_.screen_margin;
+  if (screen.mean >= bar) {
+    rejects_in_row_ = 0;
+    return true;
+  }
+  ++screened_out_;
+  ++rejects_in_row_;
+  log_(
+      "evaluator: update %lld, env steps %lld: screened out, not scored (mean of %d episodes "
+      "%.2f < best %.2f less margin %g, %.2f s)\n",
+      static_cast<long long>(announced.update), static_cast<long long>(announced.env_steps),
+      screen.episodes, screen.mean, best->mean, config_.screen_margin, screen.eval_seconds);
+  return false;
 }
 
 bool EvaluatorService::ScorePending() {

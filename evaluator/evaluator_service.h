@@ -66,6 +66,16 @@ struct EvaluatorConfig {
   std::string second_env;
   int second_episodes = 100;
   std::string second_name;  // what the report calls it (default: the env id)
+  // The screen: before its full evaluation, a checkpoint plays the evaluation's first
+  // screen_episodes episodes (the same seeds, so nothing unseen is spent), and earns the full
+  // evaluation only when their mean is at least the best full evaluation's mean less
+  // screen_margin. A checkpoint that fails is not scored: no eval.jsonl line, no RL_EVAL, only a
+  // progress line and a count. The first checkpoint, and the next after screen_max_rejects
+  // failures in a row (so that the curve keeps going), are evaluated in full unscreened.
+  // screen_episodes 0: no screen, every checkpoint is evaluated in full.
+  int screen_episodes = 0;
+  double screen_margin = 0;
+  int screen_max_rejects = 3;
 
   /// Throws std::invalid_argument saying what is wrong.
   void Validate() const;
@@ -124,6 +134,8 @@ class EvaluatorService {
   int64_t checkpoints_scored() const { return scored_; }
   int64_t checkpoints_skipped() const { return queue_.skipped(); }
   int64_t checkpoints_refused() const { return refused_; }
+  /// Checkpoints that failed the screen (EvaluatorConfig::screen_episodes) and were not scored.
+  int64_t checkpoints_screened_out() const { return screened_out_; }
   /// Announcements of checkpoints already scored (by file name and update), ignored.
   int64_t duplicates_ignored() const { return queue_.duplicates(); }
   /// Best record so far (including resumed ones), or nullptr.
@@ -136,6 +148,11 @@ class EvaluatorService {
   // it (with its second metric when a new best); nullopt when it was refused or a stop was
   // requested.
   std::optional<EvalRecord> Score(const rlmsg::checkpoint_t& announced, nn::Checkpoint* ckpt);
+  // Whether the checkpoint earns its full evaluation: true without a screen (screen_episodes 0,
+  // no best yet, or screen_max_rejects failures in a row), else whether the mean of its first
+  // screen_episodes episodes reaches the best full mean less screen_margin. A failure is counted
+  // and printed. Throws as ScoreCheckpoint.
+  bool PassesScreen(const nn::Checkpoint& ckpt, const rlmsg::checkpoint_t& announced);
   // Publishes the result of `record` on RL_EVAL and prints its progress line.
   void Announce(const rlmsg::checkpoint_t& announced, const EvalRecord& record, bool reached);
   // <out_dir>/checkpoints, the only folder announced checkpoints are read from (empty without
@@ -160,6 +177,8 @@ class EvaluatorService {
   TsneScheduler tsne_;
   int64_t scored_ = 0;
   int64_t refused_ = 0;
+  int64_t screened_out_ = 0;
+  int rejects_in_row_ = 0;  // screen failures since the last full evaluation
   bool busy_ = false;
   double next_stats_time_ = 0;  // MonoSeconds() when stats are due
   // Points at this service while it lives; the bus handler holds a copy.

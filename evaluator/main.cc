@@ -15,6 +15,7 @@
 #include "evaluator/evaluator_service.h"
 #include "evaluator/frame_grid.h"
 #include "evaluator/report.h"
+#include "evaluator/scheduling.h"
 #include "evaluator/tsne_map.h"
 
 namespace {
@@ -90,6 +91,8 @@ int Main(int argc, char** argv) {
   std::string eval_env;
   std::string frames_file;
   std::string tsne_file;
+  std::string sched_policy;
+  int nice = 0;
   double goal = 0;
 
   rl::po::options_description desc("Options");
@@ -147,11 +150,40 @@ int Main(int argc, char** argv) {
        "episodes of the second metric")  //
       ("second-name", rl::po::value(&config.second_name),
        "what the report calls the second metric (default: its env id)")  //
+      ("screen-episodes",
+       rl::po::value(&config.screen_episodes)->default_value(config.screen_episodes),
+       "service mode: play a checkpoint's first N evaluation episodes first; only one whose mean "
+       "is at least the best full evaluation's less --screen-margin gets the full evaluation "
+       "(the others are not scored: no eval.jsonl line, no RL_EVAL); 0: no screen")  //
+      ("screen-margin", rl::po::value(&config.screen_margin)->default_value(config.screen_margin),
+       "service mode: how far below the best full mean a screened checkpoint may be and still "
+       "get its full evaluation (return units)")  //
+      ("screen-max-rejects",
+       rl::po::value(&config.screen_max_rejects)->default_value(config.screen_max_rejects),
+       "service mode: after this many checkpoints screened out in a row, the next one is "
+       "evaluated in full without a screen")  //
+      ("sched-policy", rl::po::value(&sched_policy),
+       "CPU scheduling policy of the whole evaluator: normal, batch (no wake-up preemption) or "
+       "idle (runs only on cycles nothing else wants). Default: the one it was started with")  //
+      ("nice", rl::po::value(&nice),
+       "nice value of the whole evaluator, 0 .. 19 (higher: lower priority, so that scoring does "
+       "not take the learner's core: the CarRacing presets set 19; no effect under "
+       "--sched-policy idle). Default: the one it was started with")  //
       ("run-config", rl::po::value(&run_config_file),
        "text file shown in the report as the run's config (default: the --config file)");
 
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "evaluator", kUsage, desc, &vm)) return 0;
+  // Before any thread starts: threads inherit the policy and nice value of their creator. What
+  // is not given stays as inherited (raising a lowered priority back would need privileges).
+  if (vm.count("sched-policy") > 0 || vm.count("nice") > 0) {
+    rl::evaluator::Scheduling scheduling = rl::evaluator::CurrentScheduling();
+    if (vm.count("sched-policy") > 0) {
+      scheduling.policy = rl::evaluator::ParseSchedPolicy(sched_policy);
+    }
+    if (vm.count("nice") > 0) scheduling.nice = rl::evaluator::CheckNice(nice);
+    rl::evaluator::ApplyScheduling(scheduling);
+  }
   if (!eval_env.empty()) config.env_id = eval_env;
   if (rl::envs::LookupSpec(config.env_id).continuous()) {
     rl::RefuseGiven(vm, {"epsilon"},
@@ -188,6 +220,7 @@ int Main(int argc, char** argv) {
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("evaluator"));
   rl::evaluator::EvaluatorService service(config, &bus, stdout);
+  std::printf("evaluator: scheduling %s\n", rl::evaluator::DescribeCurrent().c_str());
   std::printf("evaluator: ready\n");
   std::fflush(stdout);
   service.Run();

@@ -15,6 +15,7 @@
 #include "common/channels.h"
 #include "common/lcm_bus.h"
 #include "nn/checkpoint.h"
+#include "nn/linear.h"
 #include "nn/sequential.h"
 #include "temp_dir.h"
 
@@ -43,6 +44,28 @@ nn::Checkpoint AlwaysLeftCheckpoint(int64_t update) {
   return ckpt;
 }
 
+// A CartPole network that balances the pole: its Q(right) - Q(left) is the state feedback
+// u = x + x_dot + 10 theta + theta_dot (through relu(u) - relu(-u)), so it pushes towards the
+// side the pole falls to and lasts far longer than AlwaysLeftCheckpoint.
+nn::Checkpoint BalancingCheckpoint(int64_t update) {
+  nn::Checkpoint ckpt = AlwaysLeftCheckpoint(update);
+  std::mt19937 rng(3);
+  nn::Sequential net = nn::MakeMlp(4, {16}, 2, &rng);
+  std::vector<float> zero(static_cast<size_t>(net.NumParams()), 0.0f);
+  net.SetFlat(zero.data(), zero.size());
+  auto& hidden = dynamic_cast<nn::Linear&>(net.layer(0));
+  auto& out = dynamic_cast<nn::Linear&>(net.layer(net.num_layers() - 1));
+  const float gains[4] = {1, 1, 10, 1};
+  for (int j = 0; j < 4; ++j) {
+    hidden.weight()(0, j) = gains[j];
+    hidden.weight()(1, j) = -gains[j];
+  }
+  out.weight()(1, 0) = 1;
+  out.weight()(1, 1) = -1;
+  net.GetFlat(&ckpt.params);
+  return ckpt;
+}
+
 class EvaluatorServiceTest : public ::testing::Test {
  protected:
   EvaluatorServiceTest() : bus_(MemqConfig()) {
@@ -65,6 +88,12 @@ class EvaluatorServiceTest : public ::testing::Test {
   std::string WriteCheckpoint(int64_t update) {
     const std::string path = checkpoints_ + "/ckpt_" + std::to_string(update) + ".bin";
     nn::SaveCheckpoint(path, AlwaysLeftCheckpoint(update));
+    return path;
+  }
+
+  std::string WriteBalancingCheckpoint(int64_t update) {
+    const std::string path = checkpoints_ + "/ckpt_" + std::to_string(update) + ".bin";
+    nn::SaveCheckpoint(path, BalancingCheckpoint(update));
     return path;
   }
 
@@ -444,12 +473,103 @@ TEST_F(EvaluatorServiceTest, ProgressLinesGoToTheGivenStream) {
   EXPECT_NE(text.find("mean "), std::string::npos) << text;
 }
 
+// The screen decides which checkpoints get the full evaluation; every score published or written
+// is a full evaluation (5 episodes here), never the screen's.
+TEST_F(EvaluatorServiceTest, AScreenedOutCheckpointIsNeverScoredAndOneThatPassesGetsTheFullCount) {
+  std::FILE* out = std::tmpfile();
+  ASSERT_NE(out, nullptr);
+  EvaluatorConfig config = Config();
+  config.screen_episodes = 2;
+  config.screen_margin = 50;
+  EvaluatorService service(config, &bus_, out);
+  // The first checkpoint has no best to be screened against: full evaluation.
+  Announce(WriteBalancingCheckpoint(100), 100);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  const double best = results_.back().mean;
+  ASSERT_GT(best, 100.0);  // far above the always-left policy's nine steps
+  // Always left lasts about nine steps: below best - 50 on the screen, so not scored.
+  Announce(WriteCheckpoint(200), 200);
+  ASSERT_TRUE(PollUntil(&service, [&] { return service.checkpoints_screened_out() == 1; }));
+  for (int i = 0; i < 5; ++i) service.Poll(5);
+  EXPECT_EQ(results_.size(), 1U);
+  EXPECT_EQ(service.checkpoints_scored(), 1);
+  EXPECT_EQ(JsonLines(service).size(), 1U);
+  // A balancing checkpoint passes the screen and gets all 5 episodes, the same score as
+  // unscreened (the same seeds from the first).
+  const std::string passing = WriteBalancingCheckpoint(300);
+  Announce(passing, 300);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 2; }));
+  EXPECT_EQ(results_.back().update, 300);
+  EXPECT_EQ(results_.back().episodes, 5);
+  const EvalRecord unscreened = ScoreCheckpointFile(passing, config.env_id, config.episodes,
+                                                    config.epsilon, config.seed_base, config.gamma);
+  EXPECT_EQ(results_.back().mean, unscreened.mean);
+  for (const rlmsg::eval_result_t& r : results_) EXPECT_EQ(r.episodes, config.episodes);
+  const std::vector<std::string> lines = JsonLines(service);
+  ASSERT_EQ(lines.size(), 2U);
+  for (const std::string& line : lines) {
+    EvalRecord rec;
+    ASSERT_TRUE(ParseJson(line, &rec));
+    EXPECT_NE(rec.update, 200);
+    EXPECT_EQ(rec.episodes, config.episodes);
+  }
+  std::rewind(out);
+  std::string text;
+  for (int ch; (ch = std::fgetc(out)) != EOF;) text += static_cast<char>(ch);
+  std::fclose(out);
+  EXPECT_NE(text.find("evaluator: update 200, env steps 800: screened out, not scored (mean of 2 "
+                      "episodes"),
+            std::string::npos)
+      << text;
+}
+
+TEST_F(EvaluatorServiceTest, AfterTheMostScreenFailuresInARowTheNextCheckpointIsScoredInFull) {
+  EvaluatorConfig config = Config();
+  config.screen_episodes = 2;
+  config.screen_max_rejects = 2;
+  EvaluatorService service(config, &bus_, nullptr);
+  Announce(WriteBalancingCheckpoint(100), 100);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  for (int64_t update : {200, 300}) {
+    Announce(WriteCheckpoint(update), update);
+    ASSERT_TRUE(PollUntil(&service,
+                          [&] { return service.checkpoints_screened_out() == update / 100 - 1; }));
+  }
+  // Two failures in a row: the third always-left checkpoint is evaluated in full, unscreened.
+  Announce(WriteCheckpoint(400), 400);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 2; }));
+  EXPECT_EQ(results_.back().update, 400);
+  EXPECT_EQ(results_.back().episodes, 5);
+  EXPECT_LT(results_.back().mean, 20.0);
+  EXPECT_EQ(service.checkpoints_screened_out(), 2);
+  // And the count starts again: the next poor one is screened out.
+  Announce(WriteCheckpoint(500), 500);
+  ASSERT_TRUE(PollUntil(&service, [&] { return service.checkpoints_screened_out() == 3; }));
+  EXPECT_EQ(results_.size(), 2U);
+}
+
 TEST_F(EvaluatorServiceTest, AnnouncementsAfterTheServiceIsGoneAreHarmless) {
   { EvaluatorService service(Config(), &bus_, nullptr); }
   Announce(WriteCheckpoint(3), 3);
   EXPECT_GE(bus_.Handle(50), 1);
   EXPECT_TRUE(results_.empty());
   EXPECT_EQ(bus_.counters().invalid, 0);
+}
+
+TEST(EvaluatorConfigTest, RejectsBadScreenSettings) {
+  EvaluatorConfig c;
+  c.screen_episodes = 10;
+  EXPECT_NO_THROW(c.Validate());
+  c.screen_episodes = c.episodes;  // a screen as long as the evaluation saves nothing
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.screen_episodes = -1;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.screen_episodes = 10;
+  c.screen_margin = -1;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.screen_margin = 0;
+  c.screen_max_rejects = 0;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
 }
 
 TEST(EvaluatorConfigTest, RejectsBadSettings) {
