@@ -255,7 +255,7 @@ TEST(ScorerTest, ScoresAContinuousActorWithItsDeterministicAction) {
     env->Reset(40 + static_cast<uint64_t>(i));
     double total = 0;
     for (;;) {
-      const envs::StepResult r = env->StepContinuous(action);
+      const envs::StepResult r = env->Step(action);
       total += r.reward;
       if (r.terminated || r.truncated) break;
     }
