@@ -7,6 +7,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -18,7 +19,7 @@ namespace {
 // Its steps record the action and the step count; a step with index 1 throws.
 class TwoToneEnv : public Env {
  public:
-  TwoToneEnv() : Env(EnvSpec{"TwoTone", 1, 2, 10, 0}) {}
+  explicit TwoToneEnv(EnvSpec spec = EnvSpec{"TwoTone", 1, 2, 10, 0}) : Env(std::move(spec)) {}
   std::span<const float> observation() const override { return observation_; }
   void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override {
     *width = 4;
@@ -47,32 +48,27 @@ class TwoToneEnv : public Env {
   std::array<float, 1> observation_{};
 };
 
-// A continuous env of two dimensions in [-1, 1]; its steps record the action.
-class BoxEnv : public Env {
- public:
-  BoxEnv()
-      : Env(EnvSpec{.id = "Box",
-                    .observation_size = 1,
-                    .action_dim = 2,
-                    .action_low = {-1, -1},
-                    .action_high = {1, 1}}) {}
-  std::span<const float> observation() const override { return observation_; }
-  void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override {
-    rgb->assign(3, 0);
-    *width = 1;
-    *height = 1;
-  }
+// A continuous env of two dimensions in [-1, 1] with TwoToneEnv's picture; its steps record the
+// action.
+EnvSpec BoxSpec() {
+  EnvSpec spec{"Box", 1, 0, 10, 0};
+  spec.action_dim = 2;
+  spec.action_low = {-1, -1};
+  spec.action_high = {1, 1};
+  return spec;
+}
 
-  std::vector<float> last_action;
+class BoxEnv : public TwoToneEnv {
+ public:
+  BoxEnv() : TwoToneEnv(BoxSpec()) {}
+
+  std::vector<float> last_box_action;
 
  private:
-  void OnReset(std::optional<uint64_t> /*seed*/) override {}
   StepResult OnStep(std::span<const float> action) override {
-    last_action.assign(action.begin(), action.end());
+    last_box_action.assign(action.begin(), action.end());
     return {};
   }
-
-  std::array<float, 1> observation_{};
 };
 
 TEST(EnvTest, DefaultRenderSizedAveragesTheNativeImage) {
@@ -154,7 +150,7 @@ TEST(EnvTest, ContinuousStepsPassValuesOutOfBoundsAndRefuseNaN) {
   env.Reset(0);
   // The env clips: out-of-bounds and infinite values reach it unchanged.
   env.Step(std::array<float, 2>{3, -INFINITY});
-  EXPECT_EQ(env.last_action, (std::vector<float>{3, -INFINITY}));
+  EXPECT_EQ(env.last_box_action, (std::vector<float>{3, -INFINITY}));
   EXPECT_THROW(env.Step(std::array<float, 2>{0, NAN}), std::invalid_argument);
   EXPECT_THROW(env.Step(DiscreteAction(0)), std::invalid_argument);
   EXPECT_EQ(env.elapsed_steps(), 1);
