@@ -226,7 +226,7 @@ void Actor::StartStack(EnvSlot* s) {
 int Actor::StepEnvs() {
   for (EnvSlot& s : slots_) {
     policy_->Act(s.obs, env_steps_, s.action);
-    const envs::StepResult r = s.env->Act(s.action);
+    const envs::StepResult r = s.env->Step(s.action);
     const std::span<const float> next = s.env->observation();
     s.episode_return += r.reward;
     const double reward = config_.clip_rewards ? std::clamp(r.reward, -1.0, 1.0) : r.reward;

@@ -23,7 +23,7 @@ double CarRacingRate(rl::envs::Env& env, int frames_per_step, bool draw, double 
       [&] {
         for (int i = 0; i < chunk; ++i) {
           const std::array<float, 3> action = {2 * unit(rng) - 1, unit(rng), 0.2f * unit(rng)};
-          const auto r = env.StepContinuous(action);
+          const auto r = env.Step(action);
           if (draw) (void)env.observation()[0];
           if (r.terminated || r.truncated) env.Reset();
         }
@@ -61,7 +61,7 @@ void BenchCarRacing(int repeats, double seconds) {
     car.Reset(seed);
     double total = 0;
     for (int frame = 0; frame < 1000; ++frame) {
-      const auto r = car.StepContinuous(pilot.Act(car));
+      const auto r = car.Step(pilot.Act(car));
       total += r.reward;
       if (r.terminated) break;
     }
@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
       return rl::bench::Rate(
           [&] {
             for (int i = 0; i < chunk; ++i) {
-              const auto r = env->Step(static_cast<int>(rng() % actions));
+              const auto r = env->Step(rl::envs::DiscreteAction(static_cast<int>(rng() % actions)));
               if (r.terminated || r.truncated) env->Reset();
             }
           },

@@ -39,36 +39,20 @@ void CartPoleConfig::Validate() const {
   }
 }
 
-CartPole::CartPole(const CartPoleConfig& config) : spec_(CartPoleSpec()), config_(config) {
+CartPole::CartPole(const CartPoleConfig& config) : SeededEnv(CartPoleSpec()), config_(config) {
   config_.Validate();
 }
 
-void CartPole::Reset(uint64_t seed) {
-  rng_.Seed(seed);
-  SampleInitialState();
-}
-
-void CartPole::Reset() {
-  rng_.SeedIfUnseeded();
-  SampleInitialState();
-}
-
-void CartPole::SampleInitialState() {
-  for (double& v : state_) v = UniformDouble(rng_, config_.reset_low, config_.reset_high);
+void CartPole::NewEpisode() {
+  for (double& v : state_) v = UniformDouble(rng(), config_.reset_low, config_.reset_high);
   steps_beyond_terminated_.reset();
-  has_state_ = true;
   UpdateObservation();
 }
 
-StepResult CartPole::Step(int action) {
-  if (action != 0 && action != 1) {
-    throw std::invalid_argument("CartPole: action must be 0 or 1, got " + std::to_string(action));
-  }
-  if (!has_state_) throw std::logic_error("CartPole: call Reset() before Step()");
-
+StepResult CartPole::OnStep(std::span<const float> action) {
   // Accelerations from the equations of motion (same operation order as the reference).
   auto& [x, x_dot, theta, theta_dot] = state_;
-  const double force = action == 1 ? kForceMag : -kForceMag;
+  const double force = ActionIndex(action) == 1 ? kForceMag : -kForceMag;
   const double cos_theta = std::cos(theta);
   const double sin_theta = std::sin(theta);
   const double temp = (force + kPoleMassLength * (theta_dot * theta_dot) * sin_theta) / kTotalMass;
@@ -116,7 +100,7 @@ StepResult CartPole::Step(int action) {
 
 void CartPole::set_state(const std::array<double, 4>& state) {
   state_ = state;
-  has_state_ = true;
+  MarkStarted();
   UpdateObservation();
 }
 
@@ -137,7 +121,7 @@ void CartPole::RenderSized(int width, int height, std::vector<uint8_t>* rgb) con
     throw std::invalid_argument("CartPole: render size must be positive, got " +
                                 std::to_string(width) + "x" + std::to_string(height));
   }
-  if (!has_state_) throw std::logic_error("CartPole: call Reset() before Render()");
+  if (!started()) throw std::logic_error("CartPole: call Reset() before Render()");
 
   // The reference draws on a y-up 600x400 surface and flips it; map that surface to the output
   // image (y down), scaling each axis.

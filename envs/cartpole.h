@@ -40,7 +40,7 @@ struct CartPoleConfig {
 /// CartPole-v1. State and observation are [x, x_dot, theta, theta_dot] (m, m/s, rad, rad/s); theta
 /// is 0 upright and positive when the pole leans towards +x. Action 0 pushes the cart left, 1
 /// right. Copyable (the copy continues the same RNG stream). Not thread-safe.
-class CartPole : public Env {
+class CartPole : public SeededEnv {
  public:
   // Physical constants (SI units), as in the reference.
   static constexpr double kGravity = 9.8;
@@ -61,21 +61,12 @@ class CartPole : public Env {
   /// Throws std::invalid_argument if config.Validate() fails.
   explicit CartPole(const CartPoleConfig& config = {});
 
-  const EnvSpec& spec() const override { return spec_; }
   const CartPoleConfig& config() const { return config_; }
 
-  /// Seeds the RNG (std::mt19937_64 via std::seed_seq over the seed's two 32-bit halves) and draws
-  /// x, x_dot, theta, theta_dot in that order, each uniform in [reset_low, reset_high).
-  void Reset(uint64_t seed) override;
-  /// Draws a new initial state from the continuing RNG stream (seeded from std::random_device if no
-  /// seeded Reset came before).
-  void Reset() override;
-
-  /// One step of the dynamics. Reward is 1 while not terminated and on the step that terminates;
-  /// stepping again after termination keeps integrating, returns 0 and prints a warning to stderr
-  /// once per episode. truncated is always false (see TimeLimit). Throws std::invalid_argument for
-  /// an action other than 0 or 1 (state unchanged) and std::logic_error before the first Reset.
-  StepResult Step(int action) override;
+  // Reset draws x, x_dot, theta, theta_dot in that order, each uniform in [reset_low,
+  // reset_high). Step: one step of the dynamics. Reward is 1 while not terminated and on the
+  // step that terminates; stepping again after termination keeps integrating, returns 0 and
+  // prints a warning to stderr once per episode. truncated is always false (see TimeLimit).
 
   std::span<const float> observation() const override { return observation_; }
 
@@ -92,15 +83,12 @@ class CartPole : public Env {
   void set_state(const std::array<double, 4>& state);
 
  private:
-  // Draws a new initial state from rng_ and starts a new episode.
-  void SampleInitialState();
+  void NewEpisode() override;
+  StepResult OnStep(std::span<const float> action) override;
   // Refreshes observation_ from state_.
   void UpdateObservation();
 
-  EnvSpec spec_;
   CartPoleConfig config_;
-  EnvRng rng_;
-  bool has_state_ = false;  // Reset or set_state has been called.
   std::array<double, 4> state_{};
   std::array<float, 4> observation_{};
   // Steps taken since the episode first reported terminated; empty until then (as in the

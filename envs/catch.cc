@@ -31,42 +31,27 @@ void PaintCell(Canvas& canvas, int row, int column) {
 
 }  // namespace
 
-Catch::Catch() : spec_(CatchSpec()) {
-  RL_CHECK(spec_.observation_size == kRows * kColumns && spec_.max_episode_steps == kRows - 1 &&
-           spec_.render_width == kScreenWidth && spec_.render_height == kScreenHeight)
+Catch::Catch() : SeededEnv(CatchSpec()) {
+  RL_CHECK(spec().observation_size == kRows * kColumns && spec().max_episode_steps == kRows - 1 &&
+           spec().render_width == kScreenWidth && spec().render_height == kScreenHeight)
       << "CatchSpec() disagrees with the Catch constants";
 }
 
-void Catch::Reset(uint64_t seed) {
-  rng_.Seed(seed);
-  SampleInitialState();
-}
-
-void Catch::Reset() {
-  rng_.SeedIfUnseeded();
-  SampleInitialState();
-}
-
-void Catch::SampleInitialState() {
-  ball_column_ = static_cast<int>(UniformInt(rng_, 0, kColumns));
+void Catch::NewEpisode() {
+  ball_column_ = static_cast<int>(UniformInt(rng(), 0, kColumns));
   ball_row_ = 0;
   paddle_column_ = kPaddleStartColumn;
-  has_state_ = true;
   UpdateObservation();
 }
 
-StepResult Catch::Step(int action) {
-  if (action < 0 || action >= spec_.num_actions) {
-    throw std::invalid_argument("Catch: action must be 0, 1 or 2, got " + std::to_string(action));
-  }
-  if (!has_state_) throw std::logic_error("Catch: call Reset() before Step()");
-  if (episode_over()) {
+StepResult Catch::OnStep(std::span<const float> action) {
+  if (ball_row_ == kRows - 1) {
     throw std::logic_error(
         "Catch: the episode is over (the ball is in the bottom row); call Reset()");
   }
 
   // Move the paddle (action 0, 1, 2 -> -1, 0, +1 columns), then drop the ball one row.
-  paddle_column_ = std::clamp(paddle_column_ + action - 1, 0, kColumns - 1);
+  paddle_column_ = std::clamp(paddle_column_ + ActionIndex(action) - 1, 0, kColumns - 1);
   ++ball_row_;
   UpdateObservation();
 
@@ -98,7 +83,7 @@ void Catch::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const 
     throw std::invalid_argument("Catch: render size must be positive, got " +
                                 std::to_string(width) + "x" + std::to_string(height));
   }
-  if (!has_state_) throw std::logic_error("Catch: call Reset() before Render()");
+  if (!started()) throw std::logic_error("Catch: call Reset() before Render()");
 
   // Black board with the ball's and the paddle's cells in white.
   Canvas canvas(width, height, rgb);

@@ -28,7 +28,7 @@ namespace rl::envs {
 /// row; when the ball reaches the bottom row the episode terminates with reward +1 if the paddle is
 /// in the ball's column and -1 otherwise. All other steps give 0, so every episode has exactly
 /// kRows - 1 = 9 steps. Copyable (the copy continues the same RNG stream). Not thread-safe.
-class Catch : public Env {
+class Catch : public SeededEnv {
  public:
   static constexpr int kRows = 10;
   static constexpr int kColumns = 5;
@@ -40,19 +40,11 @@ class Catch : public Env {
 
   Catch();
 
-  /// id "Catch-v0", observation_size 50, num_actions 3, max_episode_steps 9, reward_threshold 0.9.
-  const EnvSpec& spec() const override { return spec_; }
-
-  /// Seeds the RNG (SeedRng in rng.h) and draws the ball's column with one UniformInt(0, 5).
-  void Reset(uint64_t seed) override;
-  /// Draws the ball's column from the continuing RNG stream (seeded from std::random_device if no
-  /// seeded Reset came before).
-  void Reset() override;
-
-  /// Moves the paddle, then the ball (see the class comment). Throws std::invalid_argument for an
-  /// action outside [0, 3) and std::logic_error before the first Reset or after the episode's last
-  /// step; in both cases the state is unchanged. truncated is always false (see TimeLimit).
-  StepResult Step(int action) override;
+  // Spec: id "Catch-v0", observation_size 50, num_actions 3, max_episode_steps 9,
+  // reward_threshold 0.9. Reset draws the ball's column with one UniformInt(0, 5). Step moves the
+  // paddle, then the ball (see the class comment); besides Env::Step's errors it throws
+  // std::logic_error after the episode's last step (state unchanged). truncated is always false
+  // (see TimeLimit).
 
   /// kRows * kColumns floats, row-major: 1.0 in the ball's cell and in the paddle's cell, 0
   /// elsewhere (a single 1.0 when they share the bottom-row cell).
@@ -74,17 +66,14 @@ class Catch : public Env {
   int ball_column() const { return ball_column_; }
   int paddle_column() const { return paddle_column_; }
   /// True once the episode's last step has been taken.
-  bool episode_over() const { return has_state_ && ball_row_ == kRows - 1; }
+  bool episode_over() const { return started() && ball_row_ == kRows - 1; }
 
  private:
-  // Draws a new ball column from rng_ and starts a new episode.
-  void SampleInitialState();
+  void NewEpisode() override;
+  StepResult OnStep(std::span<const float> action) override;
   // Refreshes observation_ from the positions.
   void UpdateObservation();
 
-  EnvSpec spec_;
-  EnvRng rng_;
-  bool has_state_ = false;  // Reset has been called.
   int ball_row_ = 0;
   int ball_column_ = 0;
   int paddle_column_ = kPaddleStartColumn;

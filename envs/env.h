@@ -1,12 +1,17 @@
 // The environment interface shared by the actor and the evaluator: a static spec, Reset, Step, the
-// current observation and an RGB rendering. Episode bookkeeping (time limits) lives in wrappers
-// such as TimeLimit, as in Gymnasium.
+// current observation and an RGB rendering. The episode's state (started, steps since Reset) is
+// kept by Env itself; time limits live in wrappers such as TimeLimit, as in Gymnasium.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "envs/rng.h"
 
 namespace rl::envs {
 
@@ -20,9 +25,9 @@ struct StepResult {
 
 /// Static description of an environment (shapes and registration data), known without building
 /// the env (LookupSpec in envs/specs.h). An env is either discrete (num_actions > 0, action_dim
-/// == 0; use Step) or continuous (num_actions == 0, action_dim > 0; use StepContinuous). Either
-/// way an action travels and is stored as action_width() floats: a discrete action is one value
-/// holding the index (Act() and CheckAction() accept only an integer in range).
+/// == 0) or continuous (num_actions == 0, action_dim > 0). Either way an action is stepped,
+/// travels and is stored as action_width() floats: a discrete action is one value holding the
+/// index (Env::Step and CheckAction() accept only an integer in range).
 struct EnvSpec {
   std::string id;               // Registered id, e.g. "CartPole-v1".
   int observation_size = 0;     // Number of float32 values in observation().
@@ -58,36 +63,40 @@ struct EnvSpec {
 /// O(width); no allocation.
 const char* CheckAction(const EnvSpec& spec, std::span<const float> action, float tolerance = 0);
 
-/// One environment instance. Not thread-safe: an instance is used by one thread at a time. Each
-/// instance owns its RNG, so instances never share random state.
+/// A discrete action as Step takes it: one float holding the index.
+inline std::array<float, 1> DiscreteAction(int index) { return {static_cast<float>(index)}; }
+
+/// One environment instance, and the state of its episode (started or not, steps since Reset),
+/// kept here once for every env and wrapper. Reset and Step are not virtual: they check the
+/// action and the episode, keep the step count, and call the env's OnReset and OnStep. Not
+/// thread-safe: an instance is used by one thread at a time.
 class Env {
  public:
   virtual ~Env() = default;
 
   /// Static spec; the reference stays valid for the lifetime of the env.
-  virtual const EnvSpec& spec() const = 0;
+  const EnvSpec& spec() const { return spec_; }
 
-  /// Seeds the env's own RNG from `seed` and samples an initial state.
-  virtual void Reset(uint64_t seed) = 0;
+  /// Starts an episode with the env's own RNG seeded from `seed` (each instance owns its RNG, so
+  /// instances never share random state).
+  void Reset(uint64_t seed) { StartEpisode(seed); }
 
-  /// Samples an initial state, continuing the env's RNG stream (like Gymnasium's reset() without a
-  /// seed after a seeded one). Before any seeded Reset, the RNG is seeded from std::random_device.
-  virtual void Reset() = 0;
+  /// Starts an episode continuing the env's RNG stream (like Gymnasium's reset() without a seed
+  /// after a seeded one). Before any seeded Reset, the RNG is seeded from std::random_device.
+  void Reset() { StartEpisode(std::nullopt); }
 
-  /// Advances one step of a discrete env. Throws std::invalid_argument for an action outside
-  /// [0, num_actions), and std::logic_error if Reset was never called or the env is continuous.
-  virtual StepResult Step(int action) = 0;
+  /// Advances one step with an action of spec().action_width() floats: a discrete action is one
+  /// value holding the index (DiscreteAction), a continuous one action_dim values that the env
+  /// clips to [action_low, action_high] (infinities included). Throws std::invalid_argument with
+  /// CheckAction()'s reason for a bad width, a NaN, or a discrete value that is not an integer in
+  /// [0, num_actions); then std::logic_error if Reset was never called. A step that throws is not
+  /// counted. O(action width) on top of the env's own step.
+  StepResult Step(std::span<const float> action);
 
-  /// Advances one step of a continuous env with an action of spec().action_dim floats. Throws
-  /// std::invalid_argument for an action of the wrong size, std::logic_error if Reset was never
-  /// called. The default (for discrete envs) throws std::logic_error("discrete env").
-  virtual StepResult StepContinuous(std::span<const float> action);
-
-  /// Steps with an action in the one representation (EnvSpec::action_width() floats): Step() with
-  /// the index for a discrete env, StepContinuous() for a continuous one. Throws
-  /// std::invalid_argument with CheckAction()'s reason for a bad action (bounds are not checked
-  /// here: a continuous env clips).
-  StepResult Act(std::span<const float> action);
+  /// Steps taken since the last Reset (during OnStep: including the step being taken).
+  int64_t elapsed_steps() const { return elapsed_steps_; }
+  /// Whether an episode has started (Reset, or a state set by a test hook).
+  bool started() const { return started_; }
 
   /// Current observation (observation_size float32 values). Valid until the next Reset or Step.
   virtual std::span<const float> observation() const = 0;
@@ -107,12 +116,49 @@ class Env {
   virtual void RenderSized(int width, int height, std::vector<uint8_t>* rgb) const;
 
  protected:
+  explicit Env(EnvSpec spec) : spec_(std::move(spec)) {}
   // Copying and moving are for derived classes only, so that an Env is never sliced.
-  Env() = default;
   Env(const Env&) = default;
   Env& operator=(const Env&) = default;
   Env(Env&&) = default;
   Env& operator=(Env&&) = default;
+
+  /// Starts an episode: `seed` is Reset(seed)'s, or empty for Reset().
+  virtual void OnReset(std::optional<uint64_t> seed) = 0;
+  /// One step with an action Step has checked (width, finite, a discrete index in range); runs
+  /// after an episode started, with elapsed_steps() already counting this step.
+  virtual StepResult OnStep(std::span<const float> action) = 0;
+
+  /// For wrappers that change their inner env's spec, in their constructor.
+  EnvSpec& mutable_spec() { return spec_; }
+  /// For test hooks that set a state: counts as a Reset for Step's precondition (the step count
+  /// is left alone).
+  void MarkStarted() { started_ = true; }
+  /// The index held by a checked discrete action.
+  static int ActionIndex(std::span<const float> action) { return static_cast<int>(action[0]); }
+
+ private:
+  void StartEpisode(std::optional<uint64_t> seed);
+
+  EnvSpec spec_;
+  bool started_ = false;
+  int64_t elapsed_steps_ = 0;
+};
+
+/// An env that draws its episodes from an RNG of its own (std::mt19937_64 seeded as envs/rng.h
+/// says): Reset(seed) seeds it, Reset() continues its stream (seeded from std::random_device if
+/// it never was), and both then call NewEpisode. Copies continue the same stream.
+class SeededEnv : public Env {
+ protected:
+  using Env::Env;
+  /// Draws a new initial state from rng().
+  virtual void NewEpisode() = 0;
+  EnvRng& rng() { return rng_; }
+
+ private:
+  void OnReset(std::optional<uint64_t> seed) final;
+
+  EnvRng rng_;
 };
 
 }  // namespace rl::envs

@@ -49,7 +49,7 @@ void PendulumConfig::Validate() const {
   }
 }
 
-Pendulum::Pendulum(const PendulumConfig& config) : spec_(PendulumSpec()), config_(config) {
+Pendulum::Pendulum(const PendulumConfig& config) : SeededEnv(PendulumSpec()), config_(config) {
   config_.Validate();
 }
 
@@ -61,29 +61,18 @@ double Pendulum::AngleNormalize(double x) {
   return m - std::numbers::pi;
 }
 
-void Pendulum::Reset(uint64_t seed) {
-  rng_.Seed(seed);
-  SampleInitialState();
-}
-
-void Pendulum::Reset() {
-  rng_.SeedIfUnseeded();
-  SampleInitialState();
-}
-
-void Pendulum::SampleInitialState() {
+void Pendulum::NewEpisode() {
   // The reference draws both with one uniform(low=-high, high=high): theta first.
-  theta_ = UniformDouble(rng_, -config_.x_init, config_.x_init);
-  theta_dot_ = UniformDouble(rng_, -config_.y_init, config_.y_init);
+  theta_ = UniformDouble(rng(), -config_.x_init, config_.x_init);
+  theta_dot_ = UniformDouble(rng(), -config_.y_init, config_.y_init);
   last_u_.reset();
-  has_state_ = true;
   UpdateObservation();
 }
 
 void Pendulum::SetState(double theta, double theta_dot) {
   theta_ = theta;
   theta_dot_ = theta_dot;
-  has_state_ = true;
+  MarkStarted();
   UpdateObservation();
 }
 
@@ -92,16 +81,7 @@ void Pendulum::UpdateObservation() {
                   static_cast<float>(theta_dot_)};
 }
 
-StepResult Pendulum::Step(int /*action*/) { throw std::logic_error("continuous env"); }
-
-StepResult Pendulum::StepContinuous(std::span<const float> action) {
-  if (action.size() != 1) {
-    throw std::invalid_argument("Pendulum: action must have 1 value, got " +
-                                std::to_string(action.size()));
-  }
-  if (std::isnan(action[0])) throw std::invalid_argument("Pendulum: action must not be NaN");
-  if (!has_state_) throw std::logic_error("Pendulum: call Reset() before StepContinuous()");
-
+StepResult Pendulum::OnStep(std::span<const float> action) {
   // Clip the torque, then the cost of the state before the step.
   const double u = std::clamp(static_cast<double>(action[0]), -kMaxTorque, kMaxTorque);
   const double th = theta_;
@@ -135,7 +115,7 @@ void Pendulum::RenderSized(int width, int height, std::vector<uint8_t>* rgb) con
     throw std::invalid_argument("Pendulum: render size must be positive, got " +
                                 std::to_string(width) + "x" + std::to_string(height));
   }
-  if (!has_state_) throw std::logic_error("Pendulum: call Reset() before Render()");
+  if (!started()) throw std::logic_error("Pendulum: call Reset() before Render()");
 
   // The reference draws on a 500 x 500 surface and flips it vertically; map that surface (taken
   // as y up) to the output image (y down), scaling each axis. Its shapes have integer pixel

@@ -37,7 +37,7 @@ struct PendulumConfig {
 /// theta_dot dt with the new velocity (semi-implicit), and returns reward -cost, which lies in
 /// [-16.2736044, 0]. theta itself is never wrapped. The episode never terminates or truncates.
 /// Copyable (the copy continues the same RNG stream). Not thread-safe.
-class Pendulum : public Env {
+class Pendulum : public SeededEnv {
  public:
   // Physical constants (SI units), as in the reference.
   static constexpr double kMaxSpeed = 8.0;   // rad/s
@@ -51,23 +51,12 @@ class Pendulum : public Env {
   /// Throws std::invalid_argument if config.Validate() fails.
   explicit Pendulum(const PendulumConfig& config = {});
 
-  /// PendulumSpec() (envs/specs.h): id "Pendulum-v1", observation_size 3, action_dim 1 in [-2, 2].
-  const EnvSpec& spec() const override { return spec_; }
   const PendulumConfig& config() const { return config_; }
 
-  /// Seeds the RNG (SeedRng in rng.h) and draws theta, then theta_dot, each with one
-  /// UniformDouble. Forgets the last torque.
-  void Reset(uint64_t seed) override;
-  /// Draws a new initial state from the continuing RNG stream (seeded from std::random_device if
-  /// no seeded Reset came before). Forgets the last torque.
-  void Reset() override;
-
-  /// Pendulum is continuous: always throws std::logic_error("continuous env").
-  StepResult Step(int action) override;
-  /// One step with the torque action[0], clipped to [-2, 2] (so an infinite torque is the bound).
-  /// Throws std::invalid_argument for an action of another size or a NaN torque, and
-  /// std::logic_error before the first Reset (or SetState); the state is then unchanged.
-  StepResult StepContinuous(std::span<const float> action) override;
+  // Spec: PendulumSpec() (envs/specs.h): id "Pendulum-v1", observation_size 3, action_dim 1 in
+  // [-2, 2]. Reset draws theta, then theta_dot, each with one UniformDouble, and forgets the last
+  // torque. Step takes the torque action[0], clipped to [-2, 2] (so an infinite torque is the
+  // bound); SetState also counts as a Reset for its precondition.
 
   std::span<const float> observation() const override { return observation_; }
 
@@ -96,15 +85,12 @@ class Pendulum : public Env {
   static double AngleNormalize(double x);
 
  private:
-  // Draws a new initial state from rng_ and starts a new episode.
-  void SampleInitialState();
+  void NewEpisode() override;
+  StepResult OnStep(std::span<const float> action) override;
   // Refreshes observation_ from theta_ and theta_dot_.
   void UpdateObservation();
 
-  EnvSpec spec_;
   PendulumConfig config_;
-  EnvRng rng_;
-  bool has_state_ = false;  // Reset or SetState has been called.
   double theta_ = 0;
   double theta_dot_ = 0;
   std::optional<double> last_u_;

@@ -66,7 +66,9 @@ EnvIdParts ParseEnvId(const std::string& id) {
     if (key == "max-pool" || key == "off-track" || key == "lap-ends") {
       const int v = ParseInt(id, key, value);
       if (v != 0 && v != 1) throw std::invalid_argument("env '" + id + "': " + key + " is 0 or 1");
-      (key == "max-pool" ? c.max_pool : key == "off-track" ? c.off_track : c.lap_ends) = v == 1;
+      (key == "max-pool"    ? c.max_pool
+       : key == "off-track" ? parts.off_track
+                            : parts.lap_ends) = v == 1;
     } else if (auto it = ints.find(key); it != ints.end()) {
       *it->second = ParseInt(id, key, value);
     } else {
@@ -82,8 +84,10 @@ EnvIdParts ParseEnvId(const std::string& id) {
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("env '" + id + "': " + e.what());
   }
-  if (!c.lap_ends && !parts.base.starts_with("CarRacing")) {
-    throw std::invalid_argument("env '" + id + "': lap-ends applies to CarRacing only");
+  if ((parts.off_track || !parts.lap_ends) && !parts.base.starts_with("CarRacing")) {
+    throw std::invalid_argument("env '" + id +
+                                "': " + (parts.off_track ? "off-track" : "lap-ends") +
+                                " applies to CarRacing only");
   }
   return parts;
 }

@@ -19,10 +19,19 @@
 namespace rl::envs {
 namespace {
 
-// What an id's image pipeline changes in the env under it (ImagePipelineConfig).
+// What an id's pixels keys change in the env under the pipeline: CarRacing's rules.
 struct BaseOptions {
-  bool lap_ends = true;  // CarRacing only
+  bool lap_ends = true;
+  bool off_track = false;
+  int off_track_after = 0;  // The no-op frames after every reset, which the rule skips.
 };
+
+CarRacingConfig CarRacingRules(bool continuous, const BaseOptions& o) {
+  return CarRacingConfig{.continuous = continuous,
+                         .lap_ends = o.lap_ends,
+                         .off_track = o.off_track,
+                         .off_track_after = o.off_track_after};
+}
 
 // One registered id and how to build the env under its TimeLimit (MakeBase), whose default
 // limit is the id's spec's (envs/specs.h: one table of the limits).
@@ -43,15 +52,14 @@ constexpr std::array kRegistrations = {
                    return std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true});
                  }},
     // CarRacing: 1,000 frames; an episode also ends when every tile is visited (unless lap_ends
-    // is off) or the car leaves the playfield.
+    // is off), the car leaves the playfield, or (off_track) the track.
     Registration{"CarRacing-v3",
                  [](const BaseOptions& o) -> std::unique_ptr<Env> {
-                   return std::make_unique<CarRacing>(CarRacingConfig{.lap_ends = o.lap_ends});
+                   return std::make_unique<CarRacing>(CarRacingRules(true, o));
                  }},
     Registration{"CarRacingDiscrete-v3",
                  [](const BaseOptions& o) -> std::unique_ptr<Env> {
-                   return std::make_unique<CarRacing>(
-                       CarRacingConfig{.continuous = false, .lap_ends = o.lap_ends});
+                   return std::make_unique<CarRacing>(CarRacingRules(false, o));
                  }},
     Registration{
         "Pendulum-v1",
@@ -95,9 +103,10 @@ std::unique_ptr<Env> MakeBase(const std::string& id, int time_limit, const BaseO
 std::unique_ptr<Env> MakeEnv(const std::string& id) {
   const EnvIdParts parts = ParseEnvId(id);
   if (!parts.pixels) return MakeBase(id, 0, {});
-  return MakePixelEnv(
-      MakeBase(parts.base, parts.image.time_limit, {.lap_ends = parts.image.lap_ends}),
-      parts.image);
+  const BaseOptions options{.lap_ends = parts.lap_ends,
+                            .off_track = parts.off_track,
+                            .off_track_after = parts.image.noop_start};
+  return MakePixelEnv(MakeBase(parts.base, parts.image.time_limit, options), parts.image);
 }
 
 std::vector<std::string> RegisteredEnvs() {

@@ -88,7 +88,7 @@ FrameGridResult WriteFrameGrid(nn::Sequential* net, const std::string& env_id, u
     for (int t = 1;; ++t) {
       const auto obs = env->observation();
       policy->Act(obs, 0, action);
-      const envs::StepResult r = env->Act(action);
+      const envs::StepResult r = env->Step(action);
       episode_return += r.reward;
       const bool done = r.terminated || r.truncated;
       char label[64];

@@ -144,7 +144,7 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
       policy->Act(env->observation(), 0, action);
       // The value of the action taken, random ones included (a Q-network's estimate).
       const std::optional<double> value = policy->last_value();
-      const envs::StepResult step = env->Act(action);
+      const envs::StepResult step = env->Step(action);
       episode_return += step.reward;
       if (value) {
         has_values = true;

@@ -106,7 +106,7 @@ StateSamples CollectStates(nn::Sequential* net, const std::string& env_id, int s
                                    hidden.data() + features);
         episode_frames.insert(episode_frames.end(), frame.begin(), frame.end());
       }
-      const envs::StepResult step = env->Act(action);
+      const envs::StepResult step = env->Step(action);
       episode_rewards.push_back(step.reward);
       const bool done = step.terminated || step.truncated;
       if (s.value_is_return && done) {

@@ -49,7 +49,7 @@ VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, ui
   while (true) {
     const auto obs = env->observation();
     policy->Act(obs, 0, action);
-    const envs::StepResult r = env->Act(action);
+    const envs::StepResult r = env->Step(action);
     result.episode_return += r.reward;
     write_frame();
     if (r.terminated || r.truncated) break;

@@ -172,37 +172,31 @@ void CarRacingConfig::Validate() const {
     throw std::invalid_argument("CarRacingConfig: supersample must be in [1, 8], got " +
                                 std::to_string(supersample));
   }
+  if (off_track_after < 0) {
+    throw std::invalid_argument("CarRacingConfig: off_track_after must be >= 0, got " +
+                                std::to_string(off_track_after));
+  }
 }
 
 double CarRacingCar::speed() const { return std::hypot(velocity.x, velocity.y); }
 
-CarRacing::CarRacing(const CarRacingConfig& config) : config_(config) {
+CarRacing::CarRacing(const CarRacingConfig& config)
+    : SeededEnv(CarRacingSpec(config.continuous)), config_(config) {
   config_.Validate();
-  spec_ = CarRacingSpec(config_.continuous);
 }
 
 CarRacing::~CarRacing() = default;
 CarRacing::CarRacing(CarRacing&&) noexcept = default;
 CarRacing& CarRacing::operator=(CarRacing&&) noexcept = default;
 
-void CarRacing::Reset(uint64_t seed) {
-  rng_.Seed(seed);
-  StartEpisode();
-}
-
-void CarRacing::Reset() {
-  rng_.SeedIfUnseeded();
-  StartEpisode();
-}
-
-void CarRacing::StartEpisode() {
+void CarRacing::NewEpisode() {
   if (config_.domain_randomize) {
-    for (double& c : road_color_) c = UniformDouble(rng_, 0, 210);
-    for (double& c : background_color_) c = UniformDouble(rng_, 0, 210);
+    for (double& c : road_color_) c = UniformDouble(rng(), 0, 210);
+    for (double& c : background_color_) c = UniformDouble(rng(), 0, 210);
     grass_color_ = background_color_;
-    grass_color_[UniformInt(rng_, 0, 3)] += 20;
+    grass_color_[UniformInt(rng(), 0, 3)] += 20;
   }
-  GenerateCarRacingTrack(rng_, &track_);
+  GenerateCarRacingTrack(rng(), &track_);
   const int n = track_.size();
 
   physics_ = std::make_unique<Physics>(config_.lap_complete_percent);
@@ -360,6 +354,7 @@ void CarRacing::Advance() {
   p.world.Step(static_cast<float>(kDt), kVelocityIterations, kPositionIterations);
   t_ += kDt;
   scene_stale_ = true;
+  pixels_stale_ = true;
   observation_stale_ = true;
 }
 
@@ -384,35 +379,32 @@ StepResult CarRacing::Finish() {
   return result;
 }
 
-StepResult CarRacing::Step(int action) {
-  RequireReset("Step");
-  if (config_.continuous) throw std::logic_error("CarRacing: Step(int) on the continuous variant");
-  if (action < 0 || action >= 5) {
-    throw std::invalid_argument("CarRacing: action must be in [0, 5), got " +
-                                std::to_string(action));
+StepResult CarRacing::OnStep(std::span<const float> action) {
+  if (config_.continuous) {
+    const double steer = std::clamp(double{action[0]}, -1.0, 1.0);
+    const double brake = std::clamp(double{action[2]}, 0.0, 1.0);
+    Control(-steer, action[1], brake);
+  } else {
+    const int a = ActionIndex(action);
+    Control(-0.6 * (a == 1) + 0.6 * (a == 2), 0.2 * (a == 3), 0.8 * (a == 4));
   }
-  Control(-0.6 * (action == 1) + 0.6 * (action == 2), 0.2 * (action == 3), 0.8 * (action == 4));
   Advance();
-  return Finish();
+  StepResult result = Finish();
+  if (config_.off_track && elapsed_steps() > config_.off_track_after && OffTrack()) {
+    result.reward = -10.0;
+    result.terminated = true;
+  }
+  return result;
 }
 
-StepResult CarRacing::StepContinuous(std::span<const float> action) {
-  RequireReset("StepContinuous");
-  if (!config_.continuous) {
-    throw std::logic_error("CarRacing: StepContinuous on the discrete variant");
+bool CarRacing::OffTrack() const {
+  // Row 75 and columns 41, 42, 52, 53 of the 96 x 96 picture: green above 200 on both sides.
+  const std::vector<uint8_t>& picture = Picture();
+  constexpr std::size_t kRow = 75;
+  for (std::size_t column : {41, 42, 52, 53}) {
+    if (picture[(kRow * kStateSize + column) * 3 + 1] <= 200) return false;
   }
-  if (action.size() != 3) {
-    throw std::invalid_argument("CarRacing: action must have 3 values, got " +
-                                std::to_string(action.size()));
-  }
-  for (float a : action) {
-    if (std::isnan(a)) throw std::invalid_argument("CarRacing: action value is NaN");
-  }
-  const double steer = std::clamp(double{action[0]}, -1.0, 1.0);
-  const double brake = std::clamp(double{action[2]}, 0.0, 1.0);
-  Control(-steer, action[1], brake);
-  Advance();
-  return Finish();
+  return true;
 }
 
 const CarRacingTrack& CarRacing::track() const {
@@ -544,18 +536,28 @@ void CarRacing::RenderSized(int width, int height, std::vector<uint8_t>* rgb) co
 }
 
 void CarRacing::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
-  RL_CHECK(width != nullptr && height != nullptr) << "Render needs width and height outputs";
-  RenderSized(kStateSize, kStateSize, rgb);
+  RL_CHECK(rgb != nullptr && width != nullptr && height != nullptr)
+      << "Render needs an output buffer and width and height outputs";
+  *rgb = Picture();
   *width = kStateSize;
   *height = kStateSize;
+}
+
+const std::vector<uint8_t>& CarRacing::Picture() const {
+  RequireReset("Render");
+  if (pixels_stale_) {
+    RenderSized(kStateSize, kStateSize, &pixels_);
+    pixels_stale_ = false;
+  }
+  return pixels_;
 }
 
 std::span<const float> CarRacing::observation() const {
   RequireReset("observation");
   if (observation_stale_) {
-    RenderSized(kStateSize, kStateSize, &pixels_);
-    observation_.resize(pixels_.size());
-    for (std::size_t k = 0; k < pixels_.size(); ++k) observation_[k] = pixels_[k] / 255.0f;
+    const std::vector<uint8_t>& pixels = Picture();
+    observation_.resize(pixels.size());
+    for (std::size_t k = 0; k < pixels.size(); ++k) observation_[k] = pixels[k] / 255.0f;
     observation_stale_ = false;
   }
   return observation_;

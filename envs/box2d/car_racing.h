@@ -31,14 +31,22 @@ struct CarRacingConfig {
   bool domain_randomize = false;       // Random road, background and grass colours every Reset.
   double lap_complete_percent = 0.95;  // See CarRacing's class comment on the lap rule.
   // Whether finishing the lap ends the episode (v3); false: the car drives on, as in the TD3
-  // article's code (ImagePipelineConfig::lap_ends).
+  // article's code (its Gymnasium reported the lap as a truncation, which it ignored), earning
+  // -0.1 a frame until the time limit, the off-track rule or the playfield's edge ends it.
   bool lap_ends = true;
+  // The TD3 CarRacing article's off-track rule: after every step past the first off_track_after
+  // of the episode, the 96 x 96 observation picture is drawn and tested; green above 200 at row
+  // 75 and columns 41, 42, 52 and 53 (grass or white kerb on both sides of the car) replaces the
+  // step's reward by -10 and ends the episode (terminated). The article starts testing after its
+  // 45 no-op frames of zoom-in (MakeEnv sets off_track_after to the id's noop-start).
+  bool off_track = false;
+  int off_track_after = 0;
   // Point samples per pixel side of the 96 x 96 observation (4: 16 samples per pixel, see
   // car_racing_render.h). Larger renders use fewer, never more than one per surface pixel.
   int supersample = 4;
 
-  /// Throws std::invalid_argument unless lap_complete_percent is in [0, 1] and supersample in
-  /// [1, 8].
+  /// Throws std::invalid_argument unless lap_complete_percent is in [0, 1], supersample in
+  /// [1, 8] and off_track_after >= 0.
   void Validate() const;
 };
 
@@ -75,8 +83,9 @@ struct CarRacingCar {
 ///
 /// Reward: -0.1 per step, +1000/N for each of the N tiles the first time a wheel touches it;
 /// exactly -100 on the step the hull leaves the playfield (|x| or |y| above 333.3), which ends the
-/// episode (terminated). Visiting every tile ends it too (terminated, lap_finished()). Tiles
-/// touched during the reset's own physics step count in the first step's reward, as in the
+/// episode (terminated). Visiting every tile ends it too (terminated, lap_finished()) unless
+/// config.lap_ends is off; config.off_track adds the TD3 article's rule (see CarRacingConfig).
+/// Tiles touched during the reset's own physics step count in the first step's reward, as in the
 /// reference.
 ///
 /// Lap rule (Gymnasium issue #1269): the reference ends a lap when tile 0 is touched for the first
@@ -87,11 +96,12 @@ struct CarRacingCar {
 ///
 /// Observation: the 96 x 96 RGB picture (environments.md 3.10), 27,648 floats in [0, 1]
 /// (rows top first, channels interleaved, each byte / 255). It is drawn when observation() or
-/// Render() is called, not on every Step, so a pipeline that skips frames skips their drawing.
+/// Render() is called, not on every Step (unless the off-track rule tests it), so a pipeline that
+/// skips frames skips their drawing; both share one drawing per state.
 ///
 /// Deterministic: the same seed and actions give the same trajectory and pictures on the same
 /// build (each Reset builds a new Box2D world). Not copyable, movable, not thread-safe.
-class CarRacing : public Env {
+class CarRacing : public SeededEnv {
  public:
   static constexpr int kStateSize = 96;  // STATE_W = STATE_H
   static constexpr int kVideoWidth = 600;
@@ -109,28 +119,16 @@ class CarRacing : public Env {
   CarRacing(CarRacing&&) noexcept;
   CarRacing& operator=(CarRacing&&) noexcept;
 
-  const EnvSpec& spec() const override { return spec_; }
   const CarRacingConfig& config() const { return config_; }
 
-  /// Seeds the RNG (envs/rng.h) and starts an episode: with domain randomisation 7 colour draws,
-  /// then track attempts of 24 draws each until one succeeds; builds a new world, the track's
-  /// tiles and the car at node 0, and takes the reference's reset step (physics without an
-  /// action, t = 0.02).
-  void Reset(uint64_t seed) override;
-  /// The same, continuing the RNG stream (seeded from std::random_device if never seeded).
-  void Reset() override;
-
-  /// Discrete variant: one step with action in [0, 5). Throws std::invalid_argument outside that
-  /// range (state unchanged), std::logic_error before the first Reset or on the continuous one.
-  StepResult Step(int action) override;
-  /// Continuous variant: one step with [steer, gas, brake] (clipped). Throws
-  /// std::invalid_argument unless the action has 3 values, none NaN (state unchanged),
-  /// std::logic_error before the first Reset or on the discrete variant.
-  StepResult StepContinuous(std::span<const float> action) override;
+  // Reset: with domain randomisation 7 colour draws, then track attempts of 24 draws each until
+  // one succeeds; builds a new world, the track's tiles and the car at node 0, and takes the
+  // reference's reset step (physics without an action, t = 0.02). Step: the index (discrete) or
+  // [steer, gas, brake] (continuous, clipped).
 
   /// The 96 x 96 picture as floats (drawn on first use after each Reset or Step).
   std::span<const float> observation() const override;
-  /// The 96 x 96 observation picture as bytes (the native size).
+  /// The 96 x 96 observation picture as bytes (the native size), drawn once per state.
   void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override;
   /// The same picture at any size (600 x 400 for videos), drawn at that size.
   void RenderSized(int width, int height, std::vector<uint8_t>* rgb) const override;
@@ -159,20 +157,23 @@ class CarRacing : public Env {
  private:
   struct Physics;  // The Box2D world, the car's bodies and joints, the tile contact listener.
 
-  void StartEpisode();
+  void NewEpisode() override;
+  StepResult OnStep(std::span<const float> action) override;
   // Sets the controls as the reference's Car.steer, Car.gas and Car.brake do.
   void Control(double steer, double gas, double brake);
   // The tyre model, one world step and the clock: what every step does, the reset's included.
   void Advance();
   // The reward and end-of-episode rules of a step taken with an action.
   StepResult Finish();
+  // The off-track rule's test on the observation picture (CarRacingConfig::off_track).
+  bool OffTrack() const;
+  // The 96 x 96 picture of the current state, drawn on first use after each Reset or Step.
+  const std::vector<uint8_t>& Picture() const;
   void RequireReset(const char* what) const;
   // Refreshes scene_'s car polygons and indicators from the bodies.
   void UpdateScene() const;
 
-  EnvSpec spec_;
   CarRacingConfig config_;
-  EnvRng rng_;
   CarRacingTrack track_;
   std::unique_ptr<Physics> physics_;  // Null until the first Reset.
   // The reference's colours, as floats (domain randomisation draws them); drawing truncates them.
@@ -186,6 +187,7 @@ class CarRacing : public Env {
   mutable CarRacingScene scene_;
   mutable bool scene_stale_ = true;
   mutable std::vector<uint8_t> pixels_;
+  mutable bool pixels_stale_ = true;
   mutable std::vector<float> observation_;
   mutable bool observation_stale_ = true;
 };

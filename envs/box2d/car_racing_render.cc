@@ -159,6 +159,8 @@ class SampleGrid {
  public:
   SampleGrid(uint8_t* data, int width, int height) : data_(data), width_(width), height_(height) {}
 
+  int width() const { return width_; }
+
   void FillRows(int row_begin, int row_end, uint8_t index) {
     row_begin = std::clamp(row_begin, 0, height_);
     row_end = std::clamp(row_end, row_begin, height_);
@@ -273,6 +275,149 @@ WorldToGrid MakeWorldToGrid(const CarRacingScene& scene, double kx, double ky) {
                      -ky * zoom * s, -ky * zoom * c, ky * (600 + zoom * (s * hx + c * hy))};
 }
 
+// Paints the playfield: the surface starts black and the playfield square is drawn on it. When
+// the square holds the whole visible grid (it is convex, so holding its corners is enough) a clear
+// does it. Only rows above bar_row (the indicator bar covers the rest).
+void DrawPlayfield(const CarRacingScene& scene, const WorldToGrid& to_grid, int bar_row,
+                   Palette& palette, SampleGrid& grid) {
+  const int grid_width = grid.width();
+  const uint8_t background = palette.Index(scene.background);
+  const std::array<GridPoint, 4> square = {
+      to_grid({-kPlayfield, -kPlayfield}), to_grid({kPlayfield, -kPlayfield}),
+      to_grid({kPlayfield, kPlayfield}), to_grid({-kPlayfield, kPlayfield})};
+  bool holds_view = false;
+  const double det = to_grid.m00 * to_grid.m11 - to_grid.m01 * to_grid.m10;
+  if (std::isfinite(det) && det != 0) {
+    holds_view = true;
+    for (const GridPoint g :
+         {GridPoint{0, 0}, GridPoint{1.0 * grid_width, 0}, GridPoint{0, 1.0 * bar_row},
+          GridPoint{1.0 * grid_width, 1.0 * bar_row}}) {
+      const double dx = g.x - to_grid.m02;
+      const double dy = g.y - to_grid.m12;
+      const double wx = (to_grid.m11 * dx - to_grid.m01 * dy) / det;
+      const double wy = (-to_grid.m10 * dx + to_grid.m00 * dy) / det;
+      if (!(std::abs(wx) < kPlayfield && std::abs(wy) < kPlayfield)) holds_view = false;
+    }
+  }
+  if (holds_view) {
+    grid.FillRows(0, bar_row, background);
+  } else {
+    grid.FillRows(0, bar_row, 0);
+    grid.FillPolygon(square.data(), 4, bar_row, [&] { return background; });
+  }
+}
+
+// Paints the grass lattice: only the cells within reach of the view. Every visible surface point
+// is within |(1000, 700) - (500, 600)| < 782 surface pixels of the hull, i.e. 782 / zoom world
+// units.
+void DrawGrass(const CarRacingScene& scene, const WorldToGrid& to_grid, int bar_row,
+               Palette& palette, SampleGrid& grid) {
+  const double zoom = CarRacingZoom(scene.t);
+  const double reach = 782 / std::abs(zoom);
+  int first = -20;
+  int last_x = 18;
+  int first_y = -20;
+  int last_y = 18;
+  if (std::isfinite(reach) && std::isfinite(scene.hull_position.x) &&
+      std::isfinite(scene.hull_position.y)) {
+    const auto cell_at = [](double w) {
+      return static_cast<int>(std::clamp(std::floor(w / kGrassDim), -30.0, 30.0));
+    };
+    first = cell_at(scene.hull_position.x - reach);
+    last_x = cell_at(scene.hull_position.x + reach);
+    first_y = cell_at(scene.hull_position.y - reach);
+    last_y = cell_at(scene.hull_position.y + reach);
+  }
+  const auto even_at_or_after = [](int k) { return k % 2 == 0 ? k : k + 1; };
+  const int x_begin = std::max(-20, even_at_or_after(first));
+  const int y_begin = std::max(-20, even_at_or_after(first_y));
+  const int x_end = std::min(18, last_x);
+  const int y_end = std::min(18, last_y);
+  auto grass_index = [&] { return palette.Index(scene.grass); };
+  for (int gx = x_begin; gx <= x_end; gx += 2) {
+    for (int gy = y_begin; gy <= y_end; gy += 2) {
+      const double x0 = kGrassDim * gx;
+      const double x1 = kGrassDim * (gx + 1);
+      const double y0 = kGrassDim * gy;
+      const double y1 = kGrassDim * (gy + 1);
+      const std::array<GridPoint, 4> cell = {to_grid({x0, y0}), to_grid({x1, y0}),
+                                             to_grid({x1, y1}), to_grid({x0, y1})};
+      grid.FillPolygon(cell.data(), 4, bar_row, grass_index);
+    }
+  }
+}
+
+// Paints axis-aligned rectangles given in surface pixels (y down) on the grid.
+struct BarPainter {
+  SampleGrid& grid;
+  Palette& palette;
+  double kx;
+  double ky;
+
+  void Rect(double x0, double y0, double x1, double y1, Rgb color) const {
+    grid.FillRect(x0 * kx, y0 * ky, x1 * kx, y1 * ky, palette.Index(color));
+  }
+};
+
+// The indicators of the bar: speed, the four wheel speeds, steering and gyro. The reference tests
+// the raw quantity against 1e-4, not the bar length.
+void DrawIndicators(const CarRacingScene& scene, const BarPainter& bar) {
+  const auto vertical = [&](int slot, double quantity, double value, Rgb color) {
+    if (!(std::abs(quantity) > kIndicatorMin)) return;
+    bar.Rect(slot * kSlot, kSurfaceH - kUnit - kUnit * value, (slot + 1) * kSlot, kSurfaceH - kUnit,
+             color);
+  };
+  const auto horizontal = [&](int slot, double quantity, double value, Rgb color) {
+    if (!(std::abs(quantity) > kIndicatorMin)) return;
+    bar.Rect(slot * kSlot, kSurfaceH - 4 * kUnit, (slot + value) * kSlot, kSurfaceH - 2 * kUnit,
+             color);
+  };
+  vertical(5, scene.true_speed, 0.02 * scene.true_speed, kSpeedColor);
+  vertical(7, scene.wheel_omega[0], 0.01 * scene.wheel_omega[0], kFrontWheelColor);
+  vertical(8, scene.wheel_omega[1], 0.01 * scene.wheel_omega[1], kFrontWheelColor);
+  vertical(9, scene.wheel_omega[2], 0.01 * scene.wheel_omega[2], kRearWheelColor);
+  vertical(10, scene.wheel_omega[3], 0.01 * scene.wheel_omega[3], kRearWheelColor);
+  horizontal(20, scene.front_joint_angle, -10.0 * scene.front_joint_angle, kSteeringColor);
+  horizontal(30, scene.hull_angular_velocity, -0.8 * scene.hull_angular_velocity, kGyroColor);
+}
+
+// The score: its black box (which hides an indicator reaching that far left), then the glyphs.
+void DrawScore(double score, const BarPainter& bar) {
+  char text[64];
+  const int length = FormatScore(score, text);
+  double text_width = 0;
+  for (int k = 0; k < length; ++k) text_width += text[k] == '-' ? kMinusAdvance : kDigitAdvance;
+  double x = kTextCentreX - text_width / 2;
+  bar.Rect(x, kTextCentreY - kTextBoxHalfHeight, x + text_width, kTextCentreY + kTextBoxHalfHeight,
+           kBlack);
+  const double top = kBaseline - kDigitInkHeight;
+  const double mid = top + (kDigitInkHeight - kStroke) / 2;
+  for (int k = 0; k < length; ++k) {
+    const char ch = text[k];
+    if (ch == '-') {
+      bar.Rect(x + kMinusLeft, kMinusTop, x + kMinusLeft + kMinusWidth, kMinusTop + kMinusHeight,
+               kWhite);
+      x += kMinusAdvance;
+      continue;
+    }
+    if (ch >= '0' && ch <= '9') {
+      const uint8_t lit = kDigitSegments[ch - '0'];
+      const double l = x + kDigitInkLeft;
+      const double r = l + kDigitInkWidth;
+      const double yb = kBaseline;
+      const double ym = top + kDigitInkHeight / 2;
+      if (lit & 0x01) bar.Rect(l, top, r, top + kStroke, kWhite);  // a
+      if (lit & 0x02) bar.Rect(r - kStroke, top, r, ym, kWhite);   // b
+      if (lit & 0x04) bar.Rect(r - kStroke, ym, r, yb, kWhite);    // c
+      if (lit & 0x08) bar.Rect(l, yb - kStroke, r, yb, kWhite);    // d
+      if (lit & 0x10) bar.Rect(l, ym, l + kStroke, yb, kWhite);    // e
+      if (lit & 0x20) bar.Rect(l, top, l + kStroke, ym, kWhite);   // f
+      if (lit & 0x40) bar.Rect(l, mid, r, mid + kStroke, kWhite);  // g
+    }
+    x += kDigitAdvance;  // Other characters ("nan", "inf") are not drawn.
+  }
+}
+
 // Output pixel (i, j) = rounded mean of the colours of its SS x SS samples.
 template <int SS>
 void Resolve(const uint8_t* grid, int grid_width, int width, int height,
@@ -365,72 +510,8 @@ void DrawCarRacing(const CarRacingScene& scene, int width, int height, int super
   // The world layers only show above the bar, which covers every sample from bar_row on.
   const int bar_row = CentreAtOrAfter(kBarTop * ky, 0, grid_height);
 
-  // Playfield: the surface starts black and the playfield square is drawn on it. When the square
-  // holds the whole visible grid (it is convex, so holding its corners is enough) a clear does it.
-  {
-    const uint8_t background = palette.Index(scene.background);
-    const std::array<GridPoint, 4> square = {
-        to_grid({-kPlayfield, -kPlayfield}), to_grid({kPlayfield, -kPlayfield}),
-        to_grid({kPlayfield, kPlayfield}), to_grid({-kPlayfield, kPlayfield})};
-    bool holds_view = false;
-    const double det = to_grid.m00 * to_grid.m11 - to_grid.m01 * to_grid.m10;
-    if (std::isfinite(det) && det != 0) {
-      holds_view = true;
-      for (const GridPoint g :
-           {GridPoint{0, 0}, GridPoint{1.0 * grid_width, 0}, GridPoint{0, 1.0 * bar_row},
-            GridPoint{1.0 * grid_width, 1.0 * bar_row}}) {
-        const double dx = g.x - to_grid.m02;
-        const double dy = g.y - to_grid.m12;
-        const double wx = (to_grid.m11 * dx - to_grid.m01 * dy) / det;
-        const double wy = (-to_grid.m10 * dx + to_grid.m00 * dy) / det;
-        if (!(std::abs(wx) < kPlayfield && std::abs(wy) < kPlayfield)) holds_view = false;
-      }
-    }
-    if (holds_view) {
-      grid.FillRows(0, bar_row, background);
-    } else {
-      grid.FillRows(0, bar_row, 0);
-      grid.FillPolygon(square.data(), 4, bar_row, [&] { return background; });
-    }
-  }
-
-  // Grass lattice: only the cells within reach of the view. Every visible surface point is within
-  // |(1000, 700) - (500, 600)| < 782 surface pixels of the hull, i.e. 782 / zoom world units.
-  {
-    const double zoom = CarRacingZoom(scene.t);
-    const double reach = 782 / std::abs(zoom);
-    int first = -20;
-    int last_x = 18;
-    int first_y = -20;
-    int last_y = 18;
-    if (std::isfinite(reach) && std::isfinite(scene.hull_position.x) &&
-        std::isfinite(scene.hull_position.y)) {
-      const auto cell_at = [](double w) {
-        return static_cast<int>(std::clamp(std::floor(w / kGrassDim), -30.0, 30.0));
-      };
-      first = cell_at(scene.hull_position.x - reach);
-      last_x = cell_at(scene.hull_position.x + reach);
-      first_y = cell_at(scene.hull_position.y - reach);
-      last_y = cell_at(scene.hull_position.y + reach);
-    }
-    const auto even_at_or_after = [](int k) { return k % 2 == 0 ? k : k + 1; };
-    const int x_begin = std::max(-20, even_at_or_after(first));
-    const int y_begin = std::max(-20, even_at_or_after(first_y));
-    const int x_end = std::min(18, last_x);
-    const int y_end = std::min(18, last_y);
-    auto grass_index = [&] { return palette.Index(scene.grass); };
-    for (int gx = x_begin; gx <= x_end; gx += 2) {
-      for (int gy = y_begin; gy <= y_end; gy += 2) {
-        const double x0 = kGrassDim * gx;
-        const double x1 = kGrassDim * (gx + 1);
-        const double y0 = kGrassDim * gy;
-        const double y1 = kGrassDim * (gy + 1);
-        const std::array<GridPoint, 4> cell = {to_grid({x0, y0}), to_grid({x1, y0}),
-                                               to_grid({x1, y1}), to_grid({x0, y1})};
-        grid.FillPolygon(cell.data(), 4, bar_row, grass_index);
-      }
-    }
-  }
+  DrawPlayfield(scene, to_grid, bar_row, palette, grid);
+  DrawGrass(scene, to_grid, bar_row, palette, grid);
 
   // Road tiles and kerbs, then the car, each culled when it covers no sample.
   std::array<GridPoint, 8> points;
@@ -444,63 +525,9 @@ void DrawCarRacing(const CarRacingScene& scene, int width, int height, int super
 
   // Indicator bar, in surface pixels (y down) scaled to the grid.
   grid.FillRows(bar_row, grid_height, 0);
-  const auto rect = [&](double x0, double y0, double x1, double y1, Rgb color) {
-    grid.FillRect(x0 * kx, y0 * ky, x1 * kx, y1 * ky, palette.Index(color));
-  };
-  // The reference tests the raw quantity against 1e-4, not the bar length.
-  const auto vertical = [&](int slot, double quantity, double value, Rgb color) {
-    if (!(std::abs(quantity) > kIndicatorMin)) return;
-    rect(slot * kSlot, kSurfaceH - kUnit - kUnit * value, (slot + 1) * kSlot, kSurfaceH - kUnit,
-         color);
-  };
-  const auto horizontal = [&](int slot, double quantity, double value, Rgb color) {
-    if (!(std::abs(quantity) > kIndicatorMin)) return;
-    rect(slot * kSlot, kSurfaceH - 4 * kUnit, (slot + value) * kSlot, kSurfaceH - 2 * kUnit, color);
-  };
-  vertical(5, scene.true_speed, 0.02 * scene.true_speed, kSpeedColor);
-  vertical(7, scene.wheel_omega[0], 0.01 * scene.wheel_omega[0], kFrontWheelColor);
-  vertical(8, scene.wheel_omega[1], 0.01 * scene.wheel_omega[1], kFrontWheelColor);
-  vertical(9, scene.wheel_omega[2], 0.01 * scene.wheel_omega[2], kRearWheelColor);
-  vertical(10, scene.wheel_omega[3], 0.01 * scene.wheel_omega[3], kRearWheelColor);
-  horizontal(20, scene.front_joint_angle, -10.0 * scene.front_joint_angle, kSteeringColor);
-  horizontal(30, scene.hull_angular_velocity, -0.8 * scene.hull_angular_velocity, kGyroColor);
-
-  // Score: its black box (which hides an indicator reaching that far left), then the glyphs.
-  {
-    char text[64];
-    const int length = FormatScore(scene.score, text);
-    double text_width = 0;
-    for (int k = 0; k < length; ++k) text_width += text[k] == '-' ? kMinusAdvance : kDigitAdvance;
-    double x = kTextCentreX - text_width / 2;
-    rect(x, kTextCentreY - kTextBoxHalfHeight, x + text_width, kTextCentreY + kTextBoxHalfHeight,
-         kBlack);
-    const double top = kBaseline - kDigitInkHeight;
-    const double mid = top + (kDigitInkHeight - kStroke) / 2;
-    for (int k = 0; k < length; ++k) {
-      const char ch = text[k];
-      if (ch == '-') {
-        rect(x + kMinusLeft, kMinusTop, x + kMinusLeft + kMinusWidth, kMinusTop + kMinusHeight,
-             kWhite);
-        x += kMinusAdvance;
-        continue;
-      }
-      if (ch >= '0' && ch <= '9') {
-        const uint8_t lit = kDigitSegments[ch - '0'];
-        const double l = x + kDigitInkLeft;
-        const double r = l + kDigitInkWidth;
-        const double yb = kBaseline;
-        const double ym = top + kDigitInkHeight / 2;
-        if (lit & 0x01) rect(l, top, r, top + kStroke, kWhite);  // a
-        if (lit & 0x02) rect(r - kStroke, top, r, ym, kWhite);   // b
-        if (lit & 0x04) rect(r - kStroke, ym, r, yb, kWhite);    // c
-        if (lit & 0x08) rect(l, yb - kStroke, r, yb, kWhite);    // d
-        if (lit & 0x10) rect(l, ym, l + kStroke, yb, kWhite);    // e
-        if (lit & 0x20) rect(l, top, l + kStroke, ym, kWhite);   // f
-        if (lit & 0x40) rect(l, mid, r, mid + kStroke, kWhite);  // g
-      }
-      x += kDigitAdvance;  // Other characters ("nan", "inf") are not drawn.
-    }
-  }
+  const BarPainter bar{grid, palette, kx, ky};
+  DrawIndicators(scene, bar);
+  DrawScore(scene.score, bar);
 
   // Resolve the samples into output pixels.
   std::array<uint64_t, 256> packed{};

@@ -114,9 +114,9 @@ void LunarLanderConfig::Validate() const {
   }
 }
 
-LunarLander::LunarLander(const LunarLanderConfig& config) : config_(config) {
+LunarLander::LunarLander(const LunarLanderConfig& config)
+    : SeededEnv(LunarLanderSpec(config.continuous)), config_(config) {
   config_.Validate();
-  spec_ = LunarLanderSpec(config_.continuous);
   // The reference warns about, but accepts, values outside the recommended ranges.
   if (config_.wind_power < 0.0 || config_.wind_power > 20.0) {
     std::fprintf(stderr, "WARN: LunarLander: wind_power %g is outside the recommended [0, 20]\n",
@@ -133,17 +133,7 @@ LunarLander::~LunarLander() = default;
 LunarLander::LunarLander(LunarLander&&) noexcept = default;
 LunarLander& LunarLander::operator=(LunarLander&&) noexcept = default;
 
-void LunarLander::Reset(uint64_t seed) {
-  rng_.Seed(seed);
-  StartEpisode();
-}
-
-void LunarLander::Reset() {
-  rng_.SeedIfUnseeded();
-  StartEpisode();
-}
-
-void LunarLander::StartEpisode() {
+void LunarLander::NewEpisode() {
   // A new world every episode (v3), so that nothing carries over between episodes.
   physics_.reset();
   physics_ = std::make_unique<Physics>(config_.gravity);
@@ -154,7 +144,7 @@ void LunarLander::StartEpisode() {
   // reference's factor 0.33 (not 1/3, so the pad sits at 0.99 * helipad_y). Point 0 wraps around
   // to the last height, as Python's height[-1] does.
   std::array<double, kChunks + 1> height{};
-  for (double& h : height) h = UniformDouble(rng_, 0.0, kH / 2);
+  for (double& h : height) h = UniformDouble(rng(), 0.0, kH / 2);
   for (int i = 0; i < kChunks; ++i) chunk_x_[i] = kW / (kChunks - 1) * i;
   for (int i = kChunks / 2 - 2; i <= kChunks / 2 + 2; ++i) height[i] = kHelipadY;
   for (int i = 0; i < kChunks; ++i) {
@@ -203,16 +193,16 @@ void LunarLander::StartEpisode() {
   p.lander->CreateFixture(&lander_fixture);
 
   // The initial random push: a force, so it acts during the first world step only.
-  const double force_x = UniformDouble(rng_, -kInitialRandom, kInitialRandom);
-  const double force_y = UniformDouble(rng_, -kInitialRandom, kInitialRandom);
+  const double force_x = UniformDouble(rng(), -kInitialRandom, kInitialRandom);
+  const double force_y = UniformDouble(rng(), -kInitialRandom, kInitialRandom);
   p.lander->ApplyForceToCenter(ToVec2(force_x, force_y), true);
 
   // Wind phases (v3 draws them from the env's RNG at every reset).
   wind_idx_ = 0;
   torque_idx_ = 0;
   if (config_.enable_wind) {
-    wind_idx_ = UniformInt(rng_, -9999, 9999);
-    torque_idx_ = UniformInt(rng_, -9999, 9999);
+    wind_idx_ = UniformInt(rng(), -9999, 9999);
+    torque_idx_ = UniformInt(rng(), -9999, 9999);
   }
 
   // Legs i = -1 (the +x side) then i = +1, each followed by its joint to the lander's origin. The
@@ -260,30 +250,13 @@ void LunarLander::StartEpisode() {
   StepPhysics(0.0, 0.0, 0.0);
 }
 
-StepResult LunarLander::Step(int action) {
-  if (config_.continuous) {
-    throw std::logic_error("LunarLander: the continuous variant takes StepContinuous()");
+StepResult LunarLander::OnStep(std::span<const float> action) {
+  if (!config_.continuous) {
+    // Action 2 is the main engine; 1 and 3 are the side engines with direction -1 and +1.
+    const int a = ActionIndex(action);
+    const bool side = a == 1 || a == 3;
+    return StepPhysics(a == 2 ? 1.0 : 0.0, side ? 1.0 : 0.0, side ? a - 2.0 : 0.0);
   }
-  if (action < 0 || action > 3) {
-    throw std::invalid_argument("LunarLander: action must be in [0, 4), got " +
-                                std::to_string(action));
-  }
-  RequireReset("Step()");
-  // Action 2 is the main engine; 1 and 3 are the side engines with direction -1 and +1.
-  const bool side = action == 1 || action == 3;
-  return StepPhysics(action == 2 ? 1.0 : 0.0, side ? 1.0 : 0.0, side ? action - 2.0 : 0.0);
-}
-
-StepResult LunarLander::StepContinuous(std::span<const float> action) {
-  if (!config_.continuous) throw std::logic_error("discrete env");
-  if (action.size() != 2) {
-    throw std::invalid_argument("LunarLanderContinuous: action must have 2 values, got " +
-                                std::to_string(action.size()));
-  }
-  if (std::isnan(action[0]) || std::isnan(action[1])) {
-    throw std::invalid_argument("LunarLanderContinuous: action must not be NaN");
-  }
-  RequireReset("StepContinuous()");
 
   // Clip to [-1, 1] and widen to double (v3). The main engine fires above 0 with throttle in
   // [0.5, 1]; a side engine fires when |lateral| > 0.5, with throttle in (0.5, 1].
@@ -317,8 +290,8 @@ StepResult LunarLander::StepPhysics(double m_power, double s_power, double direc
   const double angle = p.lander->GetAngle();
   const std::array<double, 2> tip = {std::sin(angle), std::cos(angle)};
   const std::array<double, 2> side = {-tip[1], tip[0]};
-  const std::array<double, 2> dispersion = {UniformDouble(rng_, -1.0, 1.0) / kScale,
-                                            UniformDouble(rng_, -1.0, 1.0) / kScale};
+  const std::array<double, 2> dispersion = {UniformDouble(rng(), -1.0, 1.0) / kScale,
+                                            UniformDouble(rng(), -1.0, 1.0) / kScale};
 
   // Main engine: an impulse along -tip through a point below the body origin.
   if (m_power > 0.0) {

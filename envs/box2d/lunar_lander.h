@@ -65,7 +65,7 @@ struct LanderKinematics {
 /// Deterministic: the same seed and the same actions give bit-identical trajectories on the same
 /// build (each Reset builds a new Box2D world). Not copyable (it owns a Box2D world), movable. Not
 /// thread-safe.
-class LunarLander : public Env {
+class LunarLander : public SeededEnv {
  public:
   // Constants of the reference. Lengths in "pixels" are divided by kScale to get metres.
   static constexpr int kFps = 50;  // Steps per second: the world advances 1/50 s per step.
@@ -101,26 +101,13 @@ class LunarLander : public Env {
   LunarLander(LunarLander&&) noexcept;
   LunarLander& operator=(LunarLander&&) noexcept;
 
-  const EnvSpec& spec() const override { return spec_; }
   const LunarLanderConfig& config() const { return config_; }
 
-  /// Seeds the RNG (see envs/rng.h) and starts an episode. Draws, in this order: 12 terrain
-  /// heights, the 2 components of the initial force, with wind the 2 wind offsets, then the 2
-  /// dispersion values of one real physics step with no engine firing (as the reference's reset
-  /// does). Builds a new Box2D world.
-  void Reset(uint64_t seed) override;
-  /// The same, continuing the RNG stream (seeded from std::random_device if never seeded).
-  void Reset() override;
-
-  /// One step of the discrete variant (action in [0, 4)). Draws 2 dispersion values from the RNG
-  /// every step. Stepping after termination keeps simulating. Throws std::invalid_argument for an
-  /// action outside [0, 4) (state unchanged), std::logic_error before the first Reset or on the
-  /// continuous variant.
-  StepResult Step(int action) override;
-  /// One step of the continuous variant with [main, lateral]. Throws std::invalid_argument unless
-  /// the action has 2 values and neither is NaN (state unchanged), std::logic_error before the
-  /// first Reset or on the discrete variant.
-  StepResult StepContinuous(std::span<const float> action) override;
+  // Reset draws, in this order: 12 terrain heights, the 2 components of the initial force, with
+  // wind the 2 wind offsets, then the 2 dispersion values of one real physics step with no engine
+  // firing (as the reference's reset does); it builds a new Box2D world. Step takes the index
+  // (discrete) or [main, lateral] (continuous), draws 2 dispersion values from the RNG every step,
+  // and keeps simulating after termination.
 
   std::span<const float> observation() const override { return observation_; }
 
@@ -184,8 +171,10 @@ class LunarLander : public Env {
  private:
   struct Physics;  // The Box2D world, its bodies and the contact listener.
 
-  // Builds a new world and terrain from rng_ and takes the reference's initial step.
-  void StartEpisode();
+  // Builds a new world and terrain from rng() and takes the reference's initial step.
+  void NewEpisode() override;
+  // The engines an action fires (discrete or continuous), then StepPhysics.
+  StepResult OnStep(std::span<const float> action) override;
   // One step with the sanitised action: the engine throttles and the side direction.
   StepResult StepPhysics(double m_power, double s_power, double direction);
   // Recomputes state_ and observation_ from the bodies and contact flags.
@@ -193,9 +182,7 @@ class LunarLander : public Env {
   // Throws std::logic_error unless an episode has started.
   void RequireReset(const char* what) const;
 
-  EnvSpec spec_;
   LunarLanderConfig config_;
-  EnvRng rng_;
   std::unique_ptr<Physics> physics_;  // Null until the first Reset.
   std::array<double, kChunks> chunk_x_{};
   std::array<double, kChunks> smooth_y_{};

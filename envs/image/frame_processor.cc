@@ -13,10 +13,9 @@
 namespace rl::envs {
 
 FrameProcessor::FrameProcessor(std::unique_ptr<ImageSource> env, const ImagePipelineConfig& config)
-    : env_(std::move(env)), crop_left_(config.crop_left), crop_top_(config.crop_top) {
-  if (env_ == nullptr) {
-    throw std::invalid_argument("FrameProcessor: the wrapped env must not be null");
-  }
+    : EnvWrapper(std::move(env), "FrameProcessor"),
+      crop_left_(config.crop_left),
+      crop_top_(config.crop_top) {
   config.Validate();
   const ImageShape in = env_->image_shape();
   if (in.channels != 3) {
@@ -47,24 +46,13 @@ FrameProcessor::FrameProcessor(std::unique_ptr<ImageSource> env, const ImagePipe
   if (resize_) resized_.resize(shape_.bytes());
 }
 
-void FrameProcessor::Reset(uint64_t seed) {
-  env_->Reset(seed);
+void FrameProcessor::OnReset(std::optional<uint64_t> seed) {
+  EnvWrapper::OnReset(seed);
   Process();
 }
 
-void FrameProcessor::Reset() {
-  env_->Reset();
-  Process();
-}
-
-StepResult FrameProcessor::Step(int action) {
+StepResult FrameProcessor::OnStep(std::span<const float> action) {
   const StepResult result = env_->Step(action);
-  Process();
-  return result;
-}
-
-StepResult FrameProcessor::StepContinuous(std::span<const float> action) {
-  const StepResult result = env_->StepContinuous(action);
   Process();
   return result;
 }
@@ -92,20 +80,11 @@ void FrameProcessor::Process() {
     cv::resize(gray, resized, resized.size(), 0, 0, cv::INTER_AREA);
     RL_CHECK(resized.data == resized_.data()) << "resize reallocated its output";
   }
-  has_image_ = true;
 }
 
 std::span<const uint8_t> FrameProcessor::image() const {
-  if (!has_image_) throw std::logic_error("FrameProcessor: call Reset() before image()");
+  if (!started()) throw std::logic_error("FrameProcessor: call Reset() before image()");
   return resize_ ? resized_ : gray_;
-}
-
-void FrameProcessor::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
-  env_->Render(rgb, width, height);
-}
-
-void FrameProcessor::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
-  env_->RenderSized(width, height, rgb);
 }
 
 }  // namespace rl::envs

@@ -11,29 +11,20 @@
 #include "envs/env.h"
 #include "envs/image/image_source.h"
 #include "envs/image/pixel_env.h"
+#include "envs/wrapper.h"
 
 namespace rl::envs {
 
 /// Wraps an RGB ImageSource; its image() is the processed grayscale frame of the current state.
 /// spec() and observation() are the wrapped env's. Not thread-safe.
-class FrameProcessor : public ImageSource {
+class FrameProcessor : public EnvWrapper<ImageSource, ImageSource> {
  public:
   /// Takes ownership of `env` and reads config's crop_top, crop_bottom, crop_left, crop_right,
   /// width and height. Allocates all frame buffers. Throws std::invalid_argument if env is null,
   /// its images are not RGB, config.Validate() fails, or the crop leaves no pixel of its images.
   FrameProcessor(std::unique_ptr<ImageSource> env, const ImagePipelineConfig& config);
 
-  const EnvSpec& spec() const override { return env_->spec(); }
-
-  /// Reset or step the wrapped env, then process its image.
-  void Reset(uint64_t seed) override;
-  void Reset() override;
-  StepResult Step(int action) override;
-  StepResult StepContinuous(std::span<const float> action) override;
-
-  std::span<const float> observation() const override { return env_->observation(); }
-  void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override;
-  void RenderSized(int width, int height, std::vector<uint8_t>* rgb) const override;
+  // Reset and Step reset or step the wrapped env, then process its image.
 
   /// Grayscale frames of width x height, or of the cropped size when both are 0.
   ImageShape image_shape() const override { return shape_; }
@@ -42,10 +33,11 @@ class FrameProcessor : public ImageSource {
   std::span<const uint8_t> image() const override;
 
  private:
+  void OnReset(std::optional<uint64_t> seed) override;
+  StepResult OnStep(std::span<const float> action) override;
   // Computes image() from the wrapped env's current image.
   void Process();
 
-  std::unique_ptr<ImageSource> env_;
   int crop_left_;
   int crop_top_;
   ImageShape cropped_;            // Grayscale shape after the crop.
@@ -53,7 +45,6 @@ class FrameProcessor : public ImageSource {
   bool resize_;                   // Whether shape_ differs from cropped_.
   std::vector<uint8_t> gray_;     // The cropped grayscale frame.
   std::vector<uint8_t> resized_;  // The output when resize_.
-  bool has_image_ = false;
 };
 
 }  // namespace rl::envs

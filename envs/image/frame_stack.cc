@@ -12,8 +12,7 @@
 namespace rl::envs {
 
 FrameStack::FrameStack(std::unique_ptr<ImageSource> env, const ImagePipelineConfig& config)
-    : env_(std::move(env)) {
-  if (env_ == nullptr) throw std::invalid_argument("FrameStack: the wrapped env must not be null");
+    : EnvWrapper(std::move(env), "FrameStack") {
   config.Validate();
   const ImageShape shape = env_->image_shape();
   if (shape.channels != 1) {
@@ -26,41 +25,25 @@ FrameStack::FrameStack(std::unique_ptr<ImageSource> env, const ImagePipelineConf
     throw std::invalid_argument("FrameStack: stack * height * width must fit in an int, got " +
                                 std::to_string(total));
   }
-  spec_ = env_->spec();
-  spec_.observation_size = static_cast<int>(total);
-  spec_.frame_height = shape.height;
-  spec_.frame_width = shape.width;
-  spec_.frame_stack = config.stack;
+  EnvSpec& spec = mutable_spec();
+  spec.observation_size = static_cast<int>(total);
+  spec.frame_height = shape.height;
+  spec.frame_width = shape.width;
+  spec.frame_stack = config.stack;
   stacked_.resize(total);
 }
 
-void FrameStack::Reset(uint64_t seed) {
-  env_->Reset(seed);
-  for (int slot = 0; slot < spec_.frame_stack; ++slot) Store(slot);
-  has_frames_ = true;
+void FrameStack::OnReset(std::optional<uint64_t> seed) {
+  EnvWrapper::OnReset(seed);
+  for (int slot = 0; slot < spec().frame_stack; ++slot) Store(slot);
 }
 
-void FrameStack::Reset() {
-  env_->Reset();
-  for (int slot = 0; slot < spec_.frame_stack; ++slot) Store(slot);
-  has_frames_ = true;
-}
-
-StepResult FrameStack::Step(int action) {
-  if (!has_frames_) throw std::logic_error("FrameStack: call Reset() before Step()");
-  return Push(env_->Step(action));
-}
-
-StepResult FrameStack::StepContinuous(std::span<const float> action) {
-  if (!has_frames_) throw std::logic_error("FrameStack: call Reset() before Step()");
-  return Push(env_->StepContinuous(action));
-}
-
-StepResult FrameStack::Push(StepResult result) {
+StepResult FrameStack::OnStep(std::span<const float> action) {
+  const StepResult result = env_->Step(action);
   // Shift the stack one frame towards the front and append the new frame.
   std::copy(stacked_.begin() + static_cast<std::ptrdiff_t>(frame_size_), stacked_.end(),
             stacked_.begin());
-  Store(spec_.frame_stack - 1);
+  Store(spec().frame_stack - 1);
   return result;
 }
 
@@ -75,16 +58,8 @@ void FrameStack::Store(int slot) {
 }
 
 std::span<const uint8_t> FrameStack::frame() const {
-  if (!has_frames_) throw std::logic_error("FrameStack: call Reset() before frame()");
+  if (!started()) throw std::logic_error("FrameStack: call Reset() before frame()");
   return env_->image();
-}
-
-void FrameStack::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
-  env_->Render(rgb, width, height);
-}
-
-void FrameStack::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
-  env_->RenderSized(width, height, rgb);
 }
 
 }  // namespace rl::envs

@@ -13,6 +13,7 @@
 #include "envs/env.h"
 #include "envs/image/image_source.h"
 #include "envs/image/pixel_env.h"
+#include "envs/wrapper.h"
 
 namespace rl::envs {
 
@@ -20,44 +21,31 @@ namespace rl::envs {
 /// last `stack` frames, oldest first, each byte / 255.0f; frame() is the newest frame. After any
 /// Reset every slot holds the first frame, so no frame of an earlier episode is ever visible.
 /// Not thread-safe.
-class FrameStack : public Env {
+class FrameStack : public EnvWrapper<Env, ImageSource> {
  public:
   /// Takes ownership of `env` and reads config's stack. Allocates the observation. Throws
   /// std::invalid_argument if env is null, its images are not grayscale, config.Validate() fails,
   /// or the observation would exceed INT_MAX floats.
   FrameStack(std::unique_ptr<ImageSource> env, const ImagePipelineConfig& config);
 
-  /// The wrapped env's spec with frame_height, frame_width and frame_stack set and
-  /// observation_size = frame_stack * frame_height * frame_width.
-  const EnvSpec& spec() const override { return spec_; }
-
-  /// Reset the wrapped env and fill every slot of the stack with its first frame.
-  void Reset(uint64_t seed) override;
-  void Reset() override;
-  /// Steps the wrapped env, drops the oldest frame and appends the new one. O(observation_size).
-  /// Throws std::logic_error before the first Reset.
-  StepResult Step(int action) override;
-  /// The same for a continuous env.
-  StepResult StepContinuous(std::span<const float> action) override;
+  // Its spec is the wrapped env's with frame_height, frame_width and frame_stack set and
+  // observation_size = frame_stack * frame_height * frame_width. Reset resets the wrapped env and
+  // fills every slot of the stack with its first frame; Step steps it, drops the oldest frame and
+  // appends the new one, O(observation_size).
 
   /// The stacked frames (all 0 before the first Reset).
   std::span<const float> observation() const override { return stacked_; }
   /// The newest frame, the wrapped env's image(). Throws std::logic_error before the first Reset.
   std::span<const uint8_t> frame() const override;
-  void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override;
-  void RenderSized(int width, int height, std::vector<uint8_t>* rgb) const override;
 
  private:
+  void OnReset(std::optional<uint64_t> seed) override;
+  StepResult OnStep(std::span<const float> action) override;
   // Writes the wrapped env's current image, divided by 255, into slot `slot` of the stack.
   void Store(int slot);
-  // After a step of the wrapped env: shifts the stack and appends the new frame.
-  StepResult Push(StepResult result);
 
-  std::unique_ptr<ImageSource> env_;
-  EnvSpec spec_;
   std::size_t frame_size_;      // Pixels in one frame.
-  std::vector<float> stacked_;  // spec_.frame_stack frames of frame_size_ floats, oldest first.
-  bool has_frames_ = false;
+  std::vector<float> stacked_;  // frame_stack frames of frame_size_ floats, oldest first.
 };
 
 }  // namespace rl::envs

@@ -38,19 +38,9 @@ struct ImagePipelineConfig {
   // CarRacing article plays 45 while the camera zooms in). An episode that ends during them is
   // reset again.
   int noop_start = 0;
-  // The TD3 CarRacing article's off-track rule, tested on the raw frame of every inner step (so
-  // every inner step is rendered): green above 200 at row 75 and columns 41, 42, 52 and 53 of a
-  // 96 x 96 frame (scaled to the render size), i.e. grass or white kerb on both sides of the car.
-  // That inner step's reward is replaced by -10 and the Step ends, terminated.
-  bool off_track = false;
   // Inner steps after which an episode is truncated, replacing the env's own time limit
   // (EnvSpec::max_episode_steps); 0 keeps it. The TD3 CarRacing article tests for 18,000.
   int time_limit = 0;
-  // Whether finishing the lap ends a CarRacing episode (Gymnasium v3: terminated). The TD3
-  // article's code ignores it (its Gymnasium reported the lap as a truncation), so there a car that
-  // finished drives on, earning -0.1 a frame, until the time limit, the off-track rule or the
-  // playfield's edge ends the episode. CarRacing only (ParseEnvId refuses it for other envs).
-  bool lap_ends = true;
 
   /// Throws std::invalid_argument naming the field unless: render_width and render_height are
   /// both 0 or both positive, frame_skip >= 1, the crops are >= 0 (and, with an explicit render

@@ -34,6 +34,9 @@ class ImageSource : public Env {
   /// The current image, image_shape().bytes() bytes. Valid until the next Reset or Step. Throws
   /// std::logic_error before the first Reset.
   virtual std::span<const uint8_t> image() const = 0;
+
+ protected:
+  using Env::Env;
 };
 
 }  // namespace rl::envs

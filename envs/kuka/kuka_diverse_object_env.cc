@@ -66,11 +66,12 @@ void KukaDiverseObjectConfig::Validate() const {
 }
 
 KukaDiverseObjectEnv::KukaDiverseObjectEnv(const KukaDiverseObjectConfig& config)
-    : config_(config) {
+    : SeededEnv(
+          KukaDiverseObjectSpec(config.is_test, config.max_steps, config.width, config.height)),
+      config_(config) {
   config_.Validate();
-  spec_ = KukaDiverseObjectSpec(config_.is_test, config_.max_steps, config_.width, config_.height);
-  RL_CHECK(spec_.observation_size == static_cast<int>(observation_.size()) &&
-           spec_.num_actions == kNumActions)
+  RL_CHECK(spec().observation_size == static_cast<int>(observation_.size()) &&
+           spec().num_actions == kNumActions)
       << "KukaDiverseObjectSpec() disagrees with the env";
   pool_ = kuka::ObjectIds(config_.is_test);
   shapes_.resize(kuka::kNumObjectIds);
@@ -79,41 +80,31 @@ KukaDiverseObjectEnv::KukaDiverseObjectEnv(const KukaDiverseObjectConfig& config
 
 KukaDiverseObjectEnv::~KukaDiverseObjectEnv() = default;
 
-void KukaDiverseObjectEnv::Reset(uint64_t seed) {
-  rng_.Seed(seed);
-  StartEpisode();
-}
-
-void KukaDiverseObjectEnv::Reset() {
-  rng_.SeedIfUnseeded();
-  StartEpisode();
-}
-
 const kuka::ObjectShape& KukaDiverseObjectEnv::Shape(int id) {
   if (!shapes_[id]) shapes_[id] = std::make_unique<kuka::ObjectShape>(kuka::GenerateObject(id));
   return *shapes_[id];
 }
 
-void KukaDiverseObjectEnv::StartEpisode() {
+void KukaDiverseObjectEnv::NewEpisode() {
   // Camera: pitch, yaw, fov, in this order (spec 4.6).
   const double r = config_.camera_random;
   camera_ = kuka::CameraParams{};
-  camera_.pitch = -56 + r * UniformDouble(rng_, -3, 3);
-  camera_.yaw = 245 + r * UniformDouble(rng_, -3, 3);
-  camera_.fov = 20 + r * UniformDouble(rng_, -2, 2);
+  camera_.pitch = -56 + r * UniformDouble(rng(), -3, 3);
+  camera_.yaw = 245 + r * UniformDouble(rng(), -3, 3);
+  camera_.fov = 20 + r * UniformDouble(rng(), -2, 2);
 
   // Objects, with replacement, then their drop poses (spec 4.7).
   object_ids_.clear();
   for (int i = 0; i < config_.num_objects; ++i) {
-    object_ids_.push_back(pool_[UniformInt(rng_, 0, static_cast<int64_t>(pool_.size()))]);
+    object_ids_.push_back(pool_[UniformInt(rng(), 0, static_cast<int64_t>(pool_.size()))]);
   }
   std::vector<Eigen::Vector3d> positions;
   std::vector<double> yaws;
   const double b = config_.block_random;
   for (int i = 0; i < config_.num_objects; ++i) {
-    const double x = 0.4 + b * UniformDouble(rng_, 0, 1);
-    const double y = b * (UniformDouble(rng_, 0, 1) - 0.5);
-    yaws.push_back(std::numbers::pi / 2 + b * std::numbers::pi * UniformDouble(rng_, 0, 1));
+    const double x = 0.4 + b * UniformDouble(rng(), 0, 1);
+    const double y = b * (UniformDouble(rng(), 0, 1) - 0.5);
+    yaws.push_back(std::numbers::pi / 2 + b * std::numbers::pi * UniformDouble(rng(), 0, 1));
     positions.emplace_back(x, y, kDropHeight);
   }
 
@@ -138,9 +129,7 @@ void KukaDiverseObjectEnv::StartEpisode() {
 
   end_effector_target_ = kInitialTarget;
   gripper_angle_target_ = 0;
-  env_step_ = 0;
   attempted_grasp_ = false;
-  has_state_ = true;
   UpdateObservation();
 }
 
@@ -174,21 +163,15 @@ void KukaDiverseObjectEnv::ApplyArmAction(double dx, double dy, double dz, doubl
   }
 }
 
-StepResult KukaDiverseObjectEnv::Step(int action) {
-  if (action < 0 || action >= kNumActions) {
-    throw std::invalid_argument("KukaDiverseObjectEnv::Step: action must be in [0, 7), got " +
-                                std::to_string(action));
-  }
-  if (!has_state_) throw std::logic_error("KukaDiverseObjectEnv::Step before Reset");
-
+StepResult KukaDiverseObjectEnv::OnStep(std::span<const float> action_floats) {
   // Move: every action also descends by dv (the reference's height hack).
+  const int action = ActionIndex(action_floats);
   const double dv = config_.dv;
-  ++env_step_;
   ApplyArmAction(dv * kActionTable[action][0], dv * kActionTable[action][1], -dv,
                  kGraspAngle * kActionTable[action][2], kFingerOpen);
   for (int i = 0; i < config_.action_repeat; ++i) {
     scene_->StepSimulation();
-    if (attempted_grasp_ || env_step_ >= config_.max_steps) break;
+    if (attempted_grasp_ || elapsed_steps() >= config_.max_steps) break;
   }
 
   // Grasp once lbr_iiwa_link_7's centre of mass is low enough: close for 500 steps, then lift
@@ -210,7 +193,7 @@ StepResult KukaDiverseObjectEnv::Step(int action) {
 
   StepResult result;
   result.reward = ObjectLifted() ? 1.0 : 0.0;
-  result.terminated = attempted_grasp_ || env_step_ >= config_.max_steps;
+  result.terminated = attempted_grasp_ || elapsed_steps() >= config_.max_steps;
   UpdateObservation();
   return result;
 }
@@ -232,8 +215,10 @@ Eigen::Vector3d KukaDiverseObjectEnv::GraspPoint() const {
 }
 
 void KukaDiverseObjectEnv::UpdateObservation() {
-  observation_[0] = static_cast<float>(env_step_);
-  observation_[1] = static_cast<float>(static_cast<double>(env_step_) / config_.max_steps);
+  // The step index: Steps since Reset (0 while the episode starts).
+  const int64_t step = elapsed_steps();
+  observation_[0] = static_cast<float>(step);
+  observation_[1] = static_cast<float>(static_cast<double>(step) / config_.max_steps);
 }
 
 void KukaDiverseObjectEnv::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
@@ -249,7 +234,7 @@ void KukaDiverseObjectEnv::RenderSized(int width, int height, std::vector<uint8_
     throw std::invalid_argument("RenderSized: width and height must be positive, got " +
                                 std::to_string(width) + "x" + std::to_string(height));
   }
-  if (!has_state_) throw std::logic_error("KukaDiverseObjectEnv::Render before Reset");
+  if (!started()) throw std::logic_error("KukaDiverseObjectEnv::Render before Reset");
   if (!renderer_) renderer_ = std::make_unique<kuka::KukaRenderer>();
   scene_->CollectDrawItems(&draw_items_);
   renderer_->Render(camera_, draw_items_, width, height, rgb);

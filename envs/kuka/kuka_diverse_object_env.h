@@ -87,7 +87,7 @@ struct KukaDiverseObjectConfig {
 /// registers 5.0, which a return of at most 1 never reaches).
 ///
 /// Not copyable (it owns a Bullet world and an OpenGL context). Not thread-safe.
-class KukaDiverseObjectEnv : public Env {
+class KukaDiverseObjectEnv : public SeededEnv {
  public:
   static constexpr int kNumActions = 7;
   static constexpr double kGraspAngle = 0.25;         // rad per turning action.
@@ -105,21 +105,13 @@ class KukaDiverseObjectEnv : public Env {
   KukaDiverseObjectEnv(const KukaDiverseObjectEnv&) = delete;
   KukaDiverseObjectEnv& operator=(const KukaDiverseObjectEnv&) = delete;
 
-  const EnvSpec& spec() const override { return spec_; }
   const KukaDiverseObjectConfig& config() const { return config_; }
 
-  /// Seeds the RNG (SeedRng) and starts an episode: draws the camera (pitch, yaw, fov), the
-  /// object ids (with replacement) and each object's drop pose in that order, builds the world
-  /// and settles the objects. About 30..100 ms.
-  void Reset(uint64_t seed) override;
-  /// The same, continuing the RNG stream.
-  void Reset() override;
-
-  /// One env step: moves the IK target, runs action_repeat physics steps (just 1 on the last
-  /// step, as the reference does), then the grasp routine if the gripper is low enough. Stepping
-  /// on after termination keeps simulating, as the reference does. Throws
-  /// std::invalid_argument for an action outside [0, 7), std::logic_error before the first Reset.
-  StepResult Step(int action) override;
+  // Reset draws the camera (pitch, yaw, fov), the object ids (with replacement) and each object's
+  // drop pose in that order, builds the world and settles the objects: about 30..100 ms. Step:
+  // moves the IK target, runs action_repeat physics steps (just 1 on the last step, as the
+  // reference does), then the grasp routine if the gripper is low enough. Stepping on after
+  // termination keeps simulating, as the reference does. The step index is elapsed_steps().
 
   std::span<const float> observation() const override { return observation_; }
 
@@ -138,7 +130,6 @@ class KukaDiverseObjectEnv : public Env {
   /// The IK target of lbr_iiwa_link_7's frame (Kuka.endEffectorPos) and the gripper yaw target.
   const Eigen::Vector3d& end_effector_target() const { return end_effector_target_; }
   double gripper_angle_target() const { return gripper_angle_target_; }
-  int env_step() const { return env_step_; }
   bool attempted_grasp() const { return attempted_grasp_; }
   /// Whether some object is above kSuccessHeight now (the reward rule).
   bool ObjectLifted() const;
@@ -148,8 +139,9 @@ class KukaDiverseObjectEnv : public Env {
   int64_t physics_steps() const { return scene_->num_steps(); }
 
  private:
-  // Draws the episode's camera, objects and drop poses from rng_ and builds the world.
-  void StartEpisode();
+  // Draws the episode's camera, objects and drop poses from rng() and builds the world.
+  void NewEpisode() override;
+  StepResult OnStep(std::span<const float> action) override;
   // Kuka.applyAction: moves the IK target by (dx, dy, dz) within the workspace clamps, turns the
   // gripper target by da, solves IK and sets all motors; finger_angle 0.3 is open, 0 closed.
   void ApplyArmAction(double dx, double dy, double dz, double da, double finger_angle);
@@ -157,20 +149,16 @@ class KukaDiverseObjectEnv : public Env {
   const kuka::ObjectShape& Shape(int id);
   void UpdateObservation();
 
-  EnvSpec spec_;
   KukaDiverseObjectConfig config_;
   std::vector<int> pool_;                                   // Object ids this env draws from.
   std::vector<std::unique_ptr<kuka::ObjectShape>> shapes_;  // By id; null until used.
   std::unique_ptr<kuka::KukaScene> scene_;
   mutable std::unique_ptr<kuka::KukaRenderer> renderer_;  // Created by the first Render.
   mutable std::vector<kuka::DrawItem> draw_items_;
-  EnvRng rng_;
-  bool has_state_ = false;
   kuka::CameraParams camera_;
   std::vector<int> object_ids_;
   Eigen::Vector3d end_effector_target_ = Eigen::Vector3d::Zero();
   double gripper_angle_target_ = 0;
-  int env_step_ = 0;
   bool attempted_grasp_ = false;
   std::array<float, 2> observation_{};
 };

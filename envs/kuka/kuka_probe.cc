@@ -67,7 +67,7 @@ Rates Run(rl::envs::KukaDiverseObjectEnv& env, int episodes, uint64_t seed, bool
     while (!done) {
       const int action = oracle ? rl::envs::kuka::OracleAction(env)
                                 : static_cast<int>(rl::envs::UniformInt(rng, 0, 7));
-      const rl::envs::StepResult s = env.Step(action);
+      const rl::envs::StepResult s = env.Step(rl::envs::DiscreteAction(action));
       if (render) env.Render(&rgb, &w, &h);
       reward += s.reward;
       done = s.terminated || s.truncated;
@@ -177,8 +177,8 @@ int main(int argc, char** argv) {
   // Physics alone: the arm moving over resting (sleeping) objects.
   c0 = CpuSeconds();
   const int64_t before = env.physics_steps();
-  env.Step(0);
-  env.Step(0);
+  env.Step(rl::envs::DiscreteAction(0));
+  env.Step(rl::envs::DiscreteAction(0));
   const double physics = (env.physics_steps() - before) / (CpuSeconds() - c0);
   if (!json)
     std::printf("physics (arm moving, objects asleep) steps per CPU second %.0f\n", physics);

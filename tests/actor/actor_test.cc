@@ -455,7 +455,7 @@ TEST(ActorPixelsTest, SendsEveryFrameOnceAndStacksThatRebuildTheEnvsObservations
     const int64_t* ids = &obs_ids[3 * i];
     if (ids[0] == ids[2]) ++episode_starts;  // the first frame, repeated
     EXPECT_EQ(stack_bytes(ids), env_bytes(*replica)) << "transition " << i;
-    const envs::StepResult r = replica->Act(std::span<const float>(&actions[i], 1));
+    const envs::StepResult r = replica->Step(std::span<const float>(&actions[i], 1));
     EXPECT_EQ(stack_bytes(&next_ids[3 * i]), env_bytes(*replica)) << "transition " << i;
     EXPECT_EQ(discounts[i] == 0.0f, r.terminated) << "transition " << i;
     if (r.terminated || r.truncated) replica->Reset();

@@ -70,7 +70,7 @@ TEST(CartPoleTest, EulerStepFromRestMatchesHandComputedFractions) {
   // -600/41 and x_acc = 100/11 + 0.05 * (600/41) / 1.1 = 400/41. Euler moves only the velocities.
   CartPole env;
   env.set_state({0, 0, 0, 0});
-  const StepResult right = env.Step(1);
+  const StepResult right = env.Step(DiscreteAction(1));
   EXPECT_DOUBLE_EQ(env.state()[0], 0.0);
   EXPECT_DOUBLE_EQ(env.state()[1], 0.02 * 400.0 / 41.0);
   EXPECT_DOUBLE_EQ(env.state()[2], 0.0);
@@ -84,7 +84,7 @@ TEST(CartPoleTest, EulerStepFromRestMatchesHandComputedFractions) {
 
   // Pushing left mirrors everything.
   env.set_state({0, 0, 0, 0});
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   EXPECT_DOUBLE_EQ(env.state()[1], -0.02 * 400.0 / 41.0);
   EXPECT_DOUBLE_EQ(env.state()[3], 0.02 * 600.0 / 41.0);
 }
@@ -92,7 +92,7 @@ TEST(CartPoleTest, EulerStepFromRestMatchesHandComputedFractions) {
 TEST(CartPoleTest, SemiImplicitStepFromRestMovesPositionsWithTheNewVelocities) {
   CartPole env = SemiImplicitCartPole();
   env.set_state({0, 0, 0, 0});
-  env.Step(1);
+  env.Step(DiscreteAction(1));
   EXPECT_DOUBLE_EQ(env.state()[1], 0.02 * 400.0 / 41.0);
   EXPECT_DOUBLE_EQ(env.state()[0], 0.02 * 0.02 * 400.0 / 41.0);
   EXPECT_DOUBLE_EQ(env.state()[3], -0.02 * 600.0 / 41.0);
@@ -107,7 +107,7 @@ TEST(CartPoleTest, EulerStepFromAGeneralStateMatchesTheEquationsForBothActions) 
   for (int action : {0, 1}) {
     CartPole env;
     env.set_state(start);
-    const StepResult r = env.Step(action);
+    const StepResult r = env.Step(DiscreteAction(action));
     const State reference = ReferenceStep(start, action, /*semi_implicit=*/false);
     const State& literal = action == 0 ? expected_left : expected_right;
     for (int i = 0; i < 4; ++i) {
@@ -129,7 +129,7 @@ TEST(CartPoleTest, SemiImplicitStepFromAGeneralStateMatchesTheEquationsForBothAc
   for (int action : {0, 1}) {
     CartPole env = SemiImplicitCartPole();
     env.set_state(start);
-    env.Step(action);
+    env.Step(DiscreteAction(action));
     const State reference = ReferenceStep(start, action, /*semi_implicit=*/true);
     const State& literal = action == 0 ? expected_left : expected_right;
     for (int i = 0; i < 4; ++i) {
@@ -147,7 +147,7 @@ TEST(CartPoleTest, ManyStepsFollowTheReferenceEquations) {
   std::mt19937_64 policy(11);
   for (int t = 0; t < 200; ++t) {
     const int action = static_cast<int>(policy() >> 63);
-    env.Step(action);
+    env.Step(DiscreteAction(action));
     reference = ReferenceStep(reference, action, /*semi_implicit=*/false);
     for (int i = 0; i < 4; ++i) ASSERT_NEAR(env.state()[i], reference[i], 1e-9) << "step " << t;
   }
@@ -158,7 +158,7 @@ TEST(CartPoleTest, CartExactlyAtTheBoundaryDoesNotTerminate) {
   for (double x : {2.4, -2.4}) {
     CartPole env;
     env.set_state({x, 0, 0, 0});
-    const StepResult r = env.Step(1);
+    const StepResult r = env.Step(DiscreteAction(1));
     EXPECT_EQ(env.state()[0], x);
     EXPECT_FALSE(r.terminated) << "x = " << x;
     EXPECT_EQ(r.reward, 1.0);
@@ -169,7 +169,7 @@ TEST(CartPoleTest, CartPastTheBoundaryTerminates) {
   for (double x : {std::nextafter(2.4, 3.0), std::nextafter(-2.4, -3.0), 2.41, -2.5}) {
     CartPole env;
     env.set_state({x, 0, 0, 0});
-    const StepResult r = env.Step(0);
+    const StepResult r = env.Step(DiscreteAction(0));
     EXPECT_TRUE(r.terminated) << "x = " << x;
     EXPECT_EQ(r.reward, 1.0) << "the terminating step is still rewarded";
     EXPECT_FALSE(r.truncated);
@@ -181,7 +181,7 @@ TEST(CartPoleTest, PoleExactlyAtTwelveDegreesDoesNotTerminate) {
   for (double theta : {threshold, -threshold}) {
     CartPole env;
     env.set_state({0, 0, theta, 0});
-    const StepResult r = env.Step(theta > 0 ? 1 : 0);
+    const StepResult r = env.Step(DiscreteAction(theta > 0 ? 1 : 0));
     EXPECT_EQ(env.state()[2], theta);
     EXPECT_FALSE(r.terminated) << "theta = " << theta;
   }
@@ -192,7 +192,7 @@ TEST(CartPoleTest, PolePastTwelveDegreesTerminates) {
   for (double theta : {std::nextafter(threshold, 1.0), std::nextafter(-threshold, -1.0), 0.25}) {
     CartPole env;
     env.set_state({0, 0, theta, 0});
-    const StepResult r = env.Step(1);
+    const StepResult r = env.Step(DiscreteAction(1));
     EXPECT_TRUE(r.terminated) << "theta = " << theta;
     EXPECT_EQ(r.reward, 1.0);
   }
@@ -205,7 +205,7 @@ TEST(CartPoleTest, PoleFallsOverUnderAConstantPush) {
   int steps = 0;
   StepResult r;
   do {
-    r = env.Step(1);
+    r = env.Step(DiscreteAction(1));
     ++steps;
   } while (!r.terminated && steps < 100);
   EXPECT_TRUE(r.terminated);
@@ -216,40 +216,40 @@ TEST(CartPoleTest, PoleFallsOverUnderAConstantPush) {
 TEST(CartPoleTest, StepsAfterTerminationGiveZeroRewardAndWarnOnce) {
   CartPole env;
   env.set_state({2.5, 0, 0, 0});
-  EXPECT_EQ(env.Step(0).reward, 1.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, 1.0);
 
   testing::internal::CaptureStderr();
-  const StepResult first_after = env.Step(0);
+  const StepResult first_after = env.Step(DiscreteAction(0));
   const std::string first_warning = testing::internal::GetCapturedStderr();
   EXPECT_TRUE(first_after.terminated);
   EXPECT_EQ(first_after.reward, 0.0);
   EXPECT_NE(first_warning.find("terminated"), std::string::npos) << first_warning;
 
   testing::internal::CaptureStderr();
-  const StepResult second_after = env.Step(0);
+  const StepResult second_after = env.Step(DiscreteAction(0));
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
   EXPECT_EQ(second_after.reward, 0.0);
 
   // A new episode gets a fresh terminating reward and a fresh warning.
   env.Reset(1);
   env.set_state({2.5, 0, 0, 0});
-  EXPECT_EQ(env.Step(0).reward, 1.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, 1.0);
   testing::internal::CaptureStderr();
-  EXPECT_EQ(env.Step(0).reward, 0.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, 0.0);
   EXPECT_NE(testing::internal::GetCapturedStderr(), "");
 }
 
 TEST(CartPoleTest, ReenteringTheBoundsAfterTerminationRewardsAgainButNotASecondFall) {
   CartPole env;
   env.set_state({2.5, 0, 0, 0});
-  EXPECT_EQ(env.Step(0).reward, 1.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, 1.0);
   env.set_state({0, 0, 0, 0});
-  const StepResult inside = env.Step(0);
+  const StepResult inside = env.Step(DiscreteAction(0));
   EXPECT_FALSE(inside.terminated);
   EXPECT_EQ(inside.reward, 1.0);
   env.set_state({2.5, 0, 0, 0});
   testing::internal::CaptureStderr();
-  const StepResult fell_again = env.Step(0);
+  const StepResult fell_again = env.Step(DiscreteAction(0));
   testing::internal::GetCapturedStderr();
   EXPECT_TRUE(fell_again.terminated);
   EXPECT_EQ(fell_again.reward, 0.0);
@@ -260,11 +260,11 @@ TEST(CartPoleTest, SuttonBartoRewardIsZeroAliveAndMinusOneFromTermination) {
   config.sutton_barto_reward = true;
   CartPole env(config);
   env.set_state({0, 0, 0, 0});
-  EXPECT_EQ(env.Step(0).reward, 0.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, 0.0);
   env.set_state({2.5, 0, 0, 0});
-  EXPECT_EQ(env.Step(0).reward, -1.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, -1.0);
   testing::internal::CaptureStderr();
-  EXPECT_EQ(env.Step(0).reward, -1.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, -1.0);
   testing::internal::GetCapturedStderr();
 }
 
@@ -331,7 +331,7 @@ uint64_t RandomTrajectoryHash(uint64_t seed, int episodes) {
     for (float v : env->observation()) hash.Add(v);
     StepResult r;
     do {
-      r = env->Step(static_cast<int>(policy() >> 63));
+      r = env->Step(DiscreteAction(static_cast<int>(policy() >> 63)));
       for (float v : env->observation()) hash.Add(v);
       hash.Add(r.reward);
       hash.Add(r.terminated);
@@ -348,8 +348,8 @@ TEST(CartPoleTest, SameSeedGivesIdenticalObservationsAndTrajectories) {
   b.Reset(42);
   EXPECT_EQ(a.state(), b.state());
   for (int t = 0; t < 50; ++t) {
-    a.Step(t % 3 == 0 ? 1 : 0);
-    b.Step(t % 3 == 0 ? 1 : 0);
+    a.Step(DiscreteAction(t % 3 == 0 ? 1 : 0));
+    b.Step(DiscreteAction(t % 3 == 0 ? 1 : 0));
     ASSERT_EQ(a.state(), b.state()) << "step " << t;
   }
   EXPECT_EQ(RandomTrajectoryHash(42, 20), RandomTrajectoryHash(42, 20));
@@ -379,7 +379,7 @@ TEST(CartPoleTest, ResetWithoutSeedContinuesTheSeededStream) {
   CartPole b;
   b.Reset(7);
   EXPECT_EQ(b.state(), first);
-  for (int t = 0; t < 10; ++t) b.Step(t % 2);
+  for (int t = 0; t < 10; ++t) b.Step(DiscreteAction(t % 2));
   b.Reset();
   EXPECT_EQ(b.state(), second);
 
@@ -395,7 +395,7 @@ TEST(CartPoleTest, UnseededResetStillDrawsAValidState) {
     EXPECT_GE(v, -0.05);
     EXPECT_LE(v, 0.05);
   }
-  EXPECT_NO_THROW(env.Step(0));
+  EXPECT_NO_THROW(env.Step(DiscreteAction(0)));
 }
 
 TEST(CartPoleTest, RandomPolicyLastsAboutTwentyTwoStepsPerEpisode) {
@@ -409,7 +409,7 @@ TEST(CartPoleTest, RandomPolicyLastsAboutTwentyTwoStepsPerEpisode) {
     if (e > 0) env->Reset();
     StepResult r;
     do {
-      r = env->Step(static_cast<int>(policy() >> 63));
+      r = env->Step(DiscreteAction(static_cast<int>(policy() >> 63)));
       ++total_steps;
       total_reward += r.reward;
     } while (!r.terminated && !r.truncated);
@@ -425,11 +425,11 @@ TEST(CartPoleTest, InvalidActionThrowsAndLeavesTheStateUnchanged) {
   CartPole env;
   env.Reset(0);
   const State before = env.state();
-  EXPECT_THROW(env.Step(2), std::invalid_argument);
-  EXPECT_THROW(env.Step(-1), std::invalid_argument);
+  EXPECT_THROW(env.Step(DiscreteAction(2)), std::invalid_argument);
+  EXPECT_THROW(env.Step(DiscreteAction(-1)), std::invalid_argument);
   EXPECT_EQ(env.state(), before);
   try {
-    env.Step(5);
+    env.Step(DiscreteAction(5));
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find('5'), std::string::npos) << e.what();
@@ -438,7 +438,7 @@ TEST(CartPoleTest, InvalidActionThrowsAndLeavesTheStateUnchanged) {
 
 TEST(CartPoleTest, StepBeforeResetThrows) {
   CartPole env;
-  EXPECT_THROW(env.Step(0), std::logic_error);
+  EXPECT_THROW(env.Step(DiscreteAction(0)), std::logic_error);
 }
 
 }  // namespace

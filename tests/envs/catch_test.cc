@@ -75,18 +75,18 @@ TEST(CatchTest, StepMovesThePaddleThenDropsTheBallOneRow) {
   env.Reset(1);
   const int ball = env.ball_column();
   // Left from column 2.
-  EXPECT_EQ(env.Step(0).reward, 0.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, 0.0);
   EXPECT_EQ(env.paddle_column(), 1);
   EXPECT_EQ(env.ball_row(), 1);
   EXPECT_EQ(env.ball_column(), ball);
   EXPECT_EQ(Ones(env), (std::vector<int>{Cell(1, ball), Cell(9, 1)}));
   // Stay.
-  env.Step(1);
+  env.Step(DiscreteAction(1));
   EXPECT_EQ(env.paddle_column(), 1);
   EXPECT_EQ(env.ball_row(), 2);
   // Right twice.
-  env.Step(2);
-  env.Step(2);
+  env.Step(DiscreteAction(2));
+  env.Step(DiscreteAction(2));
   EXPECT_EQ(env.paddle_column(), 3);
   EXPECT_EQ(env.ball_row(), 4);
   EXPECT_EQ(Ones(env), (std::vector<int>{Cell(4, ball), Cell(9, 3)}));
@@ -95,10 +95,10 @@ TEST(CatchTest, StepMovesThePaddleThenDropsTheBallOneRow) {
 TEST(CatchTest, PaddleIsClampedToTheGrid) {
   Catch env;
   env.Reset(2);
-  for (int t = 0; t < 4; ++t) env.Step(0);
+  for (int t = 0; t < 4; ++t) env.Step(DiscreteAction(0));
   EXPECT_EQ(env.paddle_column(), 0);
   env.Reset(2);
-  for (int t = 0; t < 4; ++t) env.Step(2);
+  for (int t = 0; t < 4; ++t) env.Step(DiscreteAction(2));
   EXPECT_EQ(env.paddle_column(), 4);
 }
 
@@ -108,7 +108,7 @@ TEST(CatchTest, EveryEpisodeLastsNineStepsAndEndsWithPlusOneForACatch) {
     env.Reset(seed);
     const int ball = env.ball_column();
     for (int t = 1; t <= 9; ++t) {
-      const StepResult r = env.Step(Towards(env.paddle_column(), ball));
+      const StepResult r = env.Step(DiscreteAction(Towards(env.paddle_column(), ball)));
       EXPECT_FALSE(r.truncated);
       EXPECT_EQ(r.terminated, t == 9) << "seed " << seed << " step " << t;
       EXPECT_EQ(r.reward, t == 9 ? 1.0 : 0.0) << "seed " << seed << " step " << t;
@@ -128,7 +128,7 @@ TEST(CatchTest, MissingTheBallEndsWithMinusOne) {
     // Move to the far side from the ball: column 0 if the ball is right of the middle, else 4.
     const int away = ball >= 2 ? 0 : 4;
     StepResult r;
-    for (int t = 1; t <= 9; ++t) r = env.Step(Towards(env.paddle_column(), away));
+    for (int t = 1; t <= 9; ++t) r = env.Step(DiscreteAction(Towards(env.paddle_column(), away)));
     EXPECT_TRUE(r.terminated);
     EXPECT_EQ(r.reward, -1.0) << "seed " << seed;
     EXPECT_EQ(env.paddle_column(), away);
@@ -151,8 +151,8 @@ TEST(CatchTest, SameSeedGivesTheSameEpisodes) {
       EXPECT_EQ(a.ball_column(), b.ball_column());
       for (int t = 0; t < 9; ++t) {
         const int action = (t + episode) % 3;
-        const StepResult ra = a.Step(action);
-        const StepResult rb = b.Step(action);
+        const StepResult ra = a.Step(DiscreteAction(action));
+        const StepResult rb = b.Step(DiscreteAction(action));
         EXPECT_EQ(ra.reward, rb.reward);
         EXPECT_EQ(ra.terminated, rb.terminated);
         ASSERT_TRUE(
@@ -171,18 +171,18 @@ TEST(CatchTest, SameSeedGivesTheSameEpisodes) {
 
 TEST(CatchTest, BadActionsAndStepsOutsideAnEpisodeThrowWithoutChangingTheState) {
   Catch env;
-  EXPECT_THROW(env.Step(1), std::logic_error);
+  EXPECT_THROW(env.Step(DiscreteAction(1)), std::logic_error);
   env.Reset(4);
-  EXPECT_THROW(env.Step(-1), std::invalid_argument);
-  EXPECT_THROW(env.Step(3), std::invalid_argument);
+  EXPECT_THROW(env.Step(DiscreteAction(-1)), std::invalid_argument);
+  EXPECT_THROW(env.Step(DiscreteAction(3)), std::invalid_argument);
   EXPECT_EQ(env.ball_row(), 0);
   EXPECT_EQ(env.paddle_column(), 2);
-  for (int t = 0; t < 9; ++t) env.Step(1);
-  EXPECT_THROW(env.Step(1), std::logic_error);
+  for (int t = 0; t < 9; ++t) env.Step(DiscreteAction(1));
+  EXPECT_THROW(env.Step(DiscreteAction(1)), std::logic_error);
   EXPECT_EQ(env.ball_row(), 9);
   env.Reset();
   EXPECT_EQ(env.ball_row(), 0);
-  EXPECT_NO_THROW(env.Step(1));
+  EXPECT_NO_THROW(env.Step(DiscreteAction(1)));
 }
 
 TEST(CatchTest, RenderIs40By80WithWhiteBallAndPaddleCellsOnBlack) {
@@ -192,7 +192,7 @@ TEST(CatchTest, RenderIs40By80WithWhiteBallAndPaddleCellsOnBlack) {
   int height = 0;
   EXPECT_THROW(env.Render(&rgb, &width, &height), std::logic_error);
   env.Reset(5);
-  env.Step(0);  // Paddle to column 1, ball to row 1.
+  env.Step(DiscreteAction(0));  // Paddle to column 1, ball to row 1.
   Image image;
   env.Render(&image.rgb, &image.width, &image.height);
   ASSERT_EQ(image.width, 40);
@@ -250,10 +250,10 @@ TEST(CatchTest, RegistryWrapsCatchInANineStepTimeLimit) {
   // The limit coincides with the natural end of the episode.
   env->Reset(0);
   for (int t = 1; t < 9; ++t) {
-    const StepResult r = env->Step(1);
+    const StepResult r = env->Step(DiscreteAction(1));
     EXPECT_FALSE(r.terminated || r.truncated) << "step " << t;
   }
-  const StepResult last = env->Step(1);
+  const StepResult last = env->Step(DiscreteAction(1));
   EXPECT_TRUE(last.terminated);
   EXPECT_TRUE(last.truncated);
 }

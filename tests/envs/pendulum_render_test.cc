@@ -34,7 +34,7 @@ Image RenderAfterTorque(double theta, float u) {
   Pendulum env;
   env.SetState(theta, 0);
   const float action[] = {u};
-  env.StepContinuous(action);
+  env.Step(action);
   Image image;
   env.Render(&image.rgb, &image.width, &image.height);
   return image;
@@ -159,7 +159,7 @@ TEST(PendulumRenderTest, TorqueArrowScalesWithTheClippedTorque) {
   Pendulum env;
   env.Reset(4);
   const float action[] = {2.0f};
-  env.StepContinuous(action);
+  env.Step(action);
   Image image;
   env.Render(&image.rgb, &image.width, &image.height);
   EXPECT_GT(FindColor(image, kArrow).count, 0);

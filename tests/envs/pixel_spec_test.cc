@@ -20,8 +20,7 @@ TEST(PixelSpecTest, AnIdWithoutPixelsIsJustTheRegisteredId) {
 TEST(PixelSpecTest, ReadsEveryKey) {
   const EnvIdParts p = ParseEnvId(
       "Catch-v0+pixels(width=6,height=12,stack=3,skip=2,max-pool=0,crop-top=1,crop-bottom=2,"
-      "crop-left=3,crop-right=4,render-width=40,render-height=80,noop-start=45,off-track=1,"
-      "time-limit=7)");
+      "crop-left=3,crop-right=4,render-width=40,render-height=80,noop-start=45,time-limit=7)");
   EXPECT_EQ(p.base, "Catch-v0");
   ASSERT_TRUE(p.pixels);
   EXPECT_EQ(p.image.width, 6);
@@ -36,11 +35,14 @@ TEST(PixelSpecTest, ReadsEveryKey) {
   EXPECT_EQ(p.image.render_width, 40);
   EXPECT_EQ(p.image.render_height, 80);
   EXPECT_EQ(p.image.noop_start, 45);
-  EXPECT_TRUE(p.image.off_track);
   EXPECT_EQ(p.image.time_limit, 7);
-  EXPECT_TRUE(p.image.lap_ends);
+  EXPECT_FALSE(p.off_track);
+  EXPECT_TRUE(p.lap_ends);
   EXPECT_FALSE(p.image.clip_rewards);
-  EXPECT_FALSE(ParseEnvId("CarRacing-v3+pixels(lap-ends=0)").image.lap_ends);
+  // CarRacing's own rules.
+  const EnvIdParts car = ParseEnvId("CarRacing-v3+pixels(off-track=1,lap-ends=0)");
+  EXPECT_TRUE(car.off_track);
+  EXPECT_FALSE(car.lap_ends);
 }
 
 TEST(PixelSpecTest, KeepsTheDefaultsOfKeysNotGiven) {
@@ -75,6 +77,8 @@ TEST(PixelSpecTest, RefusesBadSpecsWithTheReason) {
   EXPECT_NE(message("Catch-v0+pixels(time-limit=-1)").find("time_limit"), std::string::npos);
   EXPECT_NE(message("Catch-v0+pixels(lap-ends=0)").find("lap-ends applies to CarRacing only"),
             std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(off-track=1)").find("off-track applies to CarRacing only"),
+            std::string::npos);
   EXPECT_NE(message("CarRacing-v3+pixels(lap-ends=2)").find("lap-ends is 0 or 1"),
             std::string::npos);
 }
@@ -87,9 +91,9 @@ TEST(PixelSpecTest, TimeLimitReplacesTheEnvsOwn) {
   EXPECT_EQ(LookupSpec(id).max_episode_steps, 2);
   EXPECT_EQ(env->spec().max_episode_steps, 2);
   env->Reset(1);
-  const StepResult first = env->Step(1);
+  const StepResult first = env->Step(DiscreteAction(1));
   EXPECT_FALSE(first.terminated || first.truncated);
-  const StepResult second = env->Step(1);
+  const StepResult second = env->Step(DiscreteAction(1));
   EXPECT_TRUE(second.truncated);
   EXPECT_FALSE(second.terminated);
   EXPECT_EQ(LookupSpec("CarRacing-v3+pixels(skip=5,time-limit=18000)").max_episode_steps, 3600);

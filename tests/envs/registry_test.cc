@@ -55,7 +55,7 @@ TEST(RegistryTest, EachCallBuildsAnIndependentEnv) {
   EXPECT_NE(a.get(), b.get());
   a->Reset(1);
   b->Reset(1);
-  a->Step(1);
+  a->Step(DiscreteAction(1));
   EXPECT_NE(a->observation()[1], b->observation()[1]);
 }
 

@@ -146,16 +146,16 @@ TEST(EnvActTest, DispatchesByActionKindAndRefusesBadActions) {
   auto cartpole = MakeEnv("CartPole-v1");
   cartpole->Reset(3);
   const float right[] = {1.0f};
-  EXPECT_NO_THROW(cartpole->Act(right));
+  EXPECT_NO_THROW(cartpole->Step(right));
   const float fraction[] = {0.5f};
-  EXPECT_THROW(cartpole->Act(fraction), std::invalid_argument);
+  EXPECT_THROW(cartpole->Step(fraction), std::invalid_argument);
   auto lander = MakeEnv("LunarLanderContinuous-v3");
   lander->Reset(3);
   // Out of bounds is the env's to clip, not an error.
   const float strong[] = {5.0f, -5.0f};
-  EXPECT_NO_THROW(lander->Act(strong));
+  EXPECT_NO_THROW(lander->Step(strong));
   const float one[] = {0.0f};
-  EXPECT_THROW(lander->Act(one), std::invalid_argument);
+  EXPECT_THROW(lander->Step(one), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,8 +1,10 @@
 #include "envs/time_limit.h"
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <utility>
@@ -19,22 +21,8 @@ namespace {
 // A scripted env: terminates on step `terminate_at` of an episode (never if 0) and records calls.
 class ScriptedEnv : public Env {
  public:
-  explicit ScriptedEnv(int terminate_at) : terminate_at_(terminate_at) {}
-  const EnvSpec& spec() const override { return spec_; }
-  void Reset(uint64_t seed) override {
-    last_seed = seed;
-    steps = 0;
-    ++resets;
-  }
-  void Reset() override {
-    steps = 0;
-    ++resets;
-  }
-  StepResult Step(int action) override {
-    if (action != 0) throw std::invalid_argument("ScriptedEnv: action must be 0");
-    ++steps;
-    return StepResult{.reward = 2.0, .terminated = steps == terminate_at_, .truncated = false};
-  }
+  explicit ScriptedEnv(int terminate_at)
+      : Env(EnvSpec{"Scripted-v0", 1, 1, 1000, 5.0}), terminate_at_(terminate_at) {}
   std::span<const float> observation() const override { return observation_; }
   void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override {
     rgb->assign(3, 7);
@@ -47,7 +35,16 @@ class ScriptedEnv : public Env {
   uint64_t last_seed = 0;
 
  private:
-  EnvSpec spec_{"Scripted-v0", 1, 1, 1000, 5.0};
+  void OnReset(std::optional<uint64_t> seed) override {
+    if (seed.has_value()) last_seed = *seed;
+    steps = 0;
+    ++resets;
+  }
+  StepResult OnStep(std::span<const float> /*action*/) override {
+    ++steps;
+    return StepResult{.reward = 2.0, .terminated = steps == terminate_at_, .truncated = false};
+  }
+
   std::array<float, 1> observation_{};
   int terminate_at_;
 };
@@ -63,15 +60,15 @@ TEST(TimeLimitTest, TruncatesOnTheStepThatReachesTheLimitAndNotBefore) {
   TimeLimit env(std::move(inner), 3);
   env.Reset(5);
   EXPECT_EQ(env.elapsed_steps(), 0);
-  EXPECT_FALSE(env.Step(0).truncated);
-  EXPECT_FALSE(env.Step(0).truncated);
-  const StepResult third = env.Step(0);
+  EXPECT_FALSE(env.Step(DiscreteAction(0)).truncated);
+  EXPECT_FALSE(env.Step(DiscreteAction(0)).truncated);
+  const StepResult third = env.Step(DiscreteAction(0));
   EXPECT_TRUE(third.truncated);
   EXPECT_FALSE(third.terminated);
   EXPECT_EQ(third.reward, 2.0);
   EXPECT_EQ(env.elapsed_steps(), 3);
   // Stepping on keeps counting and keeps truncating, as Gymnasium does.
-  EXPECT_TRUE(env.Step(0).truncated);
+  EXPECT_TRUE(env.Step(DiscreteAction(0)).truncated);
   EXPECT_EQ(env.elapsed_steps(), 4);
 }
 
@@ -81,27 +78,27 @@ TEST(TimeLimitTest, ResetRestartsTheCountAndForwardsTheSeed) {
   TimeLimit env(std::move(inner), 2);
   env.Reset(99);
   EXPECT_EQ(scripted->last_seed, 99u);
-  env.Step(0);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
+  env.Step(DiscreteAction(0));
   env.Reset();
   EXPECT_EQ(scripted->resets, 2);
   EXPECT_EQ(env.elapsed_steps(), 0);
-  EXPECT_FALSE(env.Step(0).truncated);
-  EXPECT_TRUE(env.Step(0).truncated);
+  EXPECT_FALSE(env.Step(DiscreteAction(0)).truncated);
+  EXPECT_TRUE(env.Step(DiscreteAction(0)).truncated);
 }
 
 TEST(TimeLimitTest, TerminatedPassesThroughAndCanCoincideWithTruncated) {
   TimeLimit early(std::make_unique<ScriptedEnv>(2), 5);
   early.Reset(0);
-  early.Step(0);
-  const StepResult ended = early.Step(0);
+  early.Step(DiscreteAction(0));
+  const StepResult ended = early.Step(DiscreteAction(0));
   EXPECT_TRUE(ended.terminated);
   EXPECT_FALSE(ended.truncated);
 
   TimeLimit both(std::make_unique<ScriptedEnv>(4), 4);
   both.Reset(0);
-  for (int t = 0; t < 3; ++t) both.Step(0);
-  const StepResult last = both.Step(0);
+  for (int t = 0; t < 3; ++t) both.Step(DiscreteAction(0));
+  const StepResult last = both.Step(DiscreteAction(0));
   EXPECT_TRUE(last.terminated);
   EXPECT_TRUE(last.truncated);
 }
@@ -125,22 +122,22 @@ TEST(TimeLimitTest, SpecCarriesTheLimitAndForwardsEverythingElse) {
 TEST(TimeLimitTest, InvalidActionThrowsWithoutCountingAStep) {
   TimeLimit env(std::make_unique<ScriptedEnv>(0), 3);
   env.Reset(0);
-  EXPECT_THROW(env.Step(1), std::invalid_argument);
+  EXPECT_THROW(env.Step(DiscreteAction(1)), std::invalid_argument);
   EXPECT_EQ(env.elapsed_steps(), 0);
 }
 
 // A continuous scripted env: one float action, which must be finite; never terminates.
 class ScriptedContinuousEnv : public Env {
  public:
-  const EnvSpec& spec() const override { return spec_; }
-  void Reset(uint64_t) override {}
-  void Reset() override {}
-  StepResult Step(int) override { throw std::logic_error("continuous env"); }
-  StepResult StepContinuous(std::span<const float> action) override {
-    if (action.size() != 1) throw std::invalid_argument("ScriptedContinuousEnv: one value");
-    last_action = action[0];
-    return StepResult{.reward = action[0]};
-  }
+  ScriptedContinuousEnv()
+      : Env(EnvSpec{.id = "ScriptedContinuous-v0",
+                    .observation_size = 1,
+                    .num_actions = 0,
+                    .max_episode_steps = 1000,
+                    .reward_threshold = 0,
+                    .action_dim = 1,
+                    .action_low = {-2},
+                    .action_high = {2}}) {}
   std::span<const float> observation() const override { return observation_; }
   void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override {
     rgb->assign(3, 0);
@@ -151,14 +148,12 @@ class ScriptedContinuousEnv : public Env {
   float last_action = 0;
 
  private:
-  EnvSpec spec_{.id = "ScriptedContinuous-v0",
-                .observation_size = 1,
-                .num_actions = 0,
-                .max_episode_steps = 1000,
-                .reward_threshold = 0,
-                .action_dim = 1,
-                .action_low = {-2},
-                .action_high = {2}};
+  void OnReset(std::optional<uint64_t> /*seed*/) override {}
+  StepResult OnStep(std::span<const float> action) override {
+    last_action = action[0];
+    return StepResult{.reward = action[0]};
+  }
+
   std::array<float, 1> observation_{};
 };
 
@@ -170,22 +165,23 @@ TEST(TimeLimitTest, ForwardsContinuousStepsAndCountsThem) {
   EXPECT_EQ(env.spec().action_low, std::vector<float>{-2.0f});
   EXPECT_EQ(env.spec().action_high, std::vector<float>{2.0f});
   env.Reset(0);
-  const StepResult first = env.StepContinuous(std::array<float, 1>{1.5f});
+  const StepResult first = env.Step(std::array<float, 1>{1.5f});
   EXPECT_EQ(first.reward, 1.5);
   EXPECT_EQ(scripted->last_action, 1.5f);
   EXPECT_FALSE(first.truncated);
   // A rejected action is not counted.
-  EXPECT_THROW(env.StepContinuous(std::array<float, 2>{0, 0}), std::invalid_argument);
-  EXPECT_THROW(env.Step(0), std::logic_error);
+  EXPECT_THROW(env.Step(std::array<float, 2>{0, 0}), std::invalid_argument);
+  EXPECT_THROW(env.Step(std::array<float, 1>{NAN}), std::invalid_argument);
   EXPECT_EQ(env.elapsed_steps(), 1);
-  EXPECT_TRUE(env.StepContinuous(std::array<float, 1>{0}).truncated);
+  EXPECT_TRUE(env.Step(std::array<float, 1>{0}).truncated);
   EXPECT_EQ(env.elapsed_steps(), 2);
 }
 
-TEST(TimeLimitTest, ContinuousStepOnADiscreteEnvThrowsWithoutCounting) {
+TEST(TimeLimitTest, AContinuousActionOnADiscreteEnvThrowsWithoutCounting) {
   TimeLimit env(std::make_unique<ScriptedEnv>(0), 3);
   env.Reset(0);
-  EXPECT_THROW(env.StepContinuous(std::array<float, 1>{0}), std::logic_error);
+  EXPECT_THROW(env.Step(std::array<float, 2>{0, 0}), std::invalid_argument);
+  EXPECT_THROW(env.Step(std::array<float, 1>{0.5f}), std::invalid_argument);
   EXPECT_EQ(env.elapsed_steps(), 0);
 }
 
@@ -201,12 +197,12 @@ TEST(TimeLimitTest, BalancedCartPoleIsTruncatedAtExactlyStep500) {
     env->Reset(seed);
     double episode_return = 0;
     for (int t = 1; t <= 499; ++t) {
-      const StepResult r = env->Step(BalancingAction(env->observation()));
+      const StepResult r = env->Step(DiscreteAction(BalancingAction(env->observation())));
       episode_return += r.reward;
       ASSERT_FALSE(r.terminated) << "seed " << seed << " step " << t;
       ASSERT_FALSE(r.truncated) << "seed " << seed << " step " << t;
     }
-    const StepResult last = env->Step(BalancingAction(env->observation()));
+    const StepResult last = env->Step(DiscreteAction(BalancingAction(env->observation())));
     episode_return += last.reward;
     EXPECT_TRUE(last.truncated) << "seed " << seed;
     EXPECT_FALSE(last.terminated) << "seed " << seed;
@@ -222,11 +218,11 @@ TEST(TimeLimitTest, CartPoleFallingOnStep500IsTerminatedAndTruncated) {
   auto& cartpole = dynamic_cast<CartPole&>(limit.wrapped_env());
   env->Reset(3);
   for (int t = 1; t <= 499; ++t) {
-    ASSERT_FALSE(env->Step(BalancingAction(env->observation())).truncated);
+    ASSERT_FALSE(env->Step(DiscreteAction(BalancingAction(env->observation()))).truncated);
   }
   // Put the cart past the edge with zero velocity so the 500th step ends the episode.
   cartpole.set_state({2.5, 0, 0, 0});
-  const StepResult last = env->Step(0);
+  const StepResult last = env->Step(DiscreteAction(0));
   EXPECT_TRUE(last.terminated);
   EXPECT_TRUE(last.truncated);
   EXPECT_EQ(last.reward, 1.0);

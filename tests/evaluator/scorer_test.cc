@@ -64,7 +64,7 @@ std::vector<double> PlayByHand(int action, int episodes, uint64_t first_seed) {
     env->Reset(first_seed + static_cast<uint64_t>(i));
     double total = 0;
     for (;;) {
-      const envs::StepResult r = env->Step(action);
+      const envs::StepResult r = env->Step(rl::envs::DiscreteAction(action));
       total += r.reward;
       if (r.terminated || r.truncated) break;
     }
@@ -255,7 +255,7 @@ TEST(ScorerTest, ScoresAContinuousActorWithItsDeterministicAction) {
     env->Reset(40 + static_cast<uint64_t>(i));
     double total = 0;
     for (;;) {
-      const envs::StepResult r = env->StepContinuous(action);
+      const envs::StepResult r = env->Step(action);
       total += r.reward;
       if (r.terminated || r.truncated) break;
     }

@@ -71,7 +71,7 @@ TEST(TsneMapTest, CollectsTheHiddenLayerTheGreedyValueAndTheFrameOfEveryState) {
     const auto frame = env->frame();
     EXPECT_TRUE(std::equal(frame.begin(), frame.end(), s.frames.begin() + 50 * t));
     const float action = static_cast<float>(best);
-    env->Act(std::span<const float>(&action, 1));
+    env->Step(std::span<const float>(&action, 1));
   }
   // The next episode starts from the next seed.
   env->Reset(seed + 1);
@@ -97,7 +97,7 @@ TEST(TsneMapTest, ANetworkWithoutValuesIsColouredByTheDiscountedReturnThatFollow
     const auto obs = env->observation();
     const float a =
         std::clamp(net.Predict(obs.data(), static_cast<int>(obs.size()))(0, 0), -2.0f, 2.0f);
-    const envs::StepResult r = env->Act(std::span<const float>(&a, 1));
+    const envs::StepResult r = env->Step(std::span<const float>(&a, 1));
     rewards.push_back(r.reward);
     if (r.terminated || r.truncated) break;
   }

@@ -13,7 +13,10 @@
 #include <vector>
 
 #include "envs/box2d/car_racing_pilot.h"
+#include "envs/image/image_source.h"
+#include "envs/pixel_spec.h"
 #include "envs/registry.h"
+#include "envs/wrapper.h"
 
 namespace rl::envs {
 namespace {
@@ -22,7 +25,7 @@ constexpr double kDt = 0.02;
 
 StepResult Drive(CarRacing& env, float steer, float gas, float brake) {
   const std::array<float, 3> action = {steer, gas, brake};
-  return env.StepContinuous(action);
+  return env.Step(action);
 }
 
 // Mean summed reward of a fixed action held for 100 steps, over 100 tracks.
@@ -32,7 +35,7 @@ double FixedActionScore(std::array<float, 3> action) {
     CarRacing env;
     env.Reset(1000 + seed);
     for (int k = 0; k < 100; ++k) {
-      const StepResult r = env.StepContinuous(action);
+      const StepResult r = env.Step(action);
       sum += r.reward;
       if (r.terminated) break;
     }
@@ -133,20 +136,20 @@ TEST(CarRacingTest, SteeringTurnsTheFrontWheelsToTheirStopsAndTheCarRight) {
 TEST(CarRacingTest, DiscreteActionsSetAllThreeControls) {
   CarRacing env(CarRacingConfig{.continuous = false});
   env.Reset(2);
-  env.Step(3);
+  env.Step(DiscreteAction(3));
   EXPECT_NEAR(env.car().wheels[2].gas, 0.1, 1e-12);
-  env.Step(3);
-  env.Step(3);
+  env.Step(DiscreteAction(3));
+  env.Step(DiscreteAction(3));
   EXPECT_NEAR(env.car().wheels[3].gas, 0.2, 1e-12);  // Gas 0.2, reached in two steps.
-  env.Step(1);
+  env.Step(DiscreteAction(1));
   EXPECT_EQ(env.car().wheels[0].steer, -0.6);  // Right.
   EXPECT_EQ(env.car().wheels[2].gas, 0);       // Each action sets all three controls.
-  env.Step(2);
+  env.Step(DiscreteAction(2));
   EXPECT_EQ(env.car().wheels[1].steer, 0.6);
-  env.Step(4);
+  env.Step(DiscreteAction(4));
   EXPECT_EQ(env.car().wheels[0].brake, 0.8);
   EXPECT_EQ(env.car().wheels[0].steer, 0);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   EXPECT_EQ(env.car().wheels[0].brake, 0);
 }
 
@@ -176,7 +179,7 @@ TEST(CarRacingTest, ALapVisitingEveryTileScoresAThousandLessATenthPerFrame) {
   int frames = 0;
   bool finished = false;
   while (frames < 1000 && !finished) {
-    const StepResult r = env.StepContinuous(pilot.Act(env));
+    const StepResult r = env.Step(pilot.Act(env));
     sum += r.reward;
     ++frames;
     finished = r.terminated;
@@ -196,18 +199,94 @@ TEST(CarRacingTest, WithoutLapEndsTheCarDrivesOnPastAFinishedLap) {
   int frames = 0;
   while (env.tiles_visited() < env.track().size()) {
     ASSERT_LT(frames, 1000);
-    const StepResult r = env.StepContinuous(pilot.Act(env));
+    const StepResult r = env.Step(pilot.Act(env));
     ASSERT_FALSE(r.terminated);
     sum += r.reward;
     ++frames;
   }
   EXPECT_NEAR(sum, 1000 - 0.1 * frames, 1e-6);
   for (int k = 0; k < 50; ++k) {
-    const StepResult r = env.StepContinuous(pilot.Act(env));
+    const StepResult r = env.Step(pilot.Act(env));
     EXPECT_FALSE(r.terminated);
     EXPECT_FALSE(env.lap_finished());
     EXPECT_NEAR(r.reward, -0.1, 1e-9);
   }
+}
+
+// Whether the picture shows grass (green above 200) at row 75 and columns 41, 42, 52 and 53.
+bool ShowsGrassBesideTheCar(const CarRacing& env) {
+  std::vector<uint8_t> rgb;
+  int width = 0;
+  int height = 0;
+  env.Render(&rgb, &width, &height);
+  for (int column : {41, 42, 52, 53}) {
+    if (rgb[static_cast<std::size_t>((75 * width + column) * 3 + 1)] <= 200) return false;
+  }
+  return true;
+}
+
+// The off-track rule, against a twin without it on the same seed and actions: each step pays the
+// twin's reward until the first step past off_track_after whose picture shows grass on both sides
+// of the car, which pays -10 and ends the episode.
+void CheckOffTrackRule(int after) {
+  CarRacing env(CarRacingConfig{.off_track = true, .off_track_after = after});
+  CarRacing twin;
+  env.Reset(4);
+  twin.Reset(4);
+  const std::array<float, 3> swerve = {1.0f, 0.5f, 0.0f};  // Full right: off the road soon.
+  bool ended = false;
+  bool skipped_grass = false;
+  for (int t = 1; t <= 400 && !ended; ++t) {
+    const StepResult r = env.Step(swerve);
+    const StepResult plain = twin.Step(swerve);
+    const bool grass = ShowsGrassBesideTheCar(twin);
+    if (grass && t <= after) skipped_grass = true;
+    if (grass && t > after) {
+      EXPECT_EQ(r.reward, -10.0) << "step " << t;
+      EXPECT_TRUE(r.terminated) << "step " << t;
+      ended = true;
+    } else {
+      ASSERT_EQ(r.reward, plain.reward) << "step " << t;
+      ASSERT_EQ(r.terminated, plain.terminated) << "step " << t;
+    }
+  }
+  EXPECT_TRUE(ended) << "the car never left the road";
+  if (after > 0) {
+    EXPECT_TRUE(skipped_grass) << "nothing for off_track_after to skip";
+  }
+}
+
+TEST(CarRacingTest, OffTrackRuleEndsTheEpisodeOnTheFirstFrameOnGrass) { CheckOffTrackRule(0); }
+
+TEST(CarRacingTest, OffTrackRuleSkipsTheFirstFramesOfAnEpisode) {
+  // During the zoom-in the picture shows grass beside the car: the article's 45 no-op frames.
+  CheckOffTrackRule(45);
+}
+
+// The pixels keys off-track and lap-ends reach CarRacing's own options; the rule skips the
+// no-op frames of the id.
+TEST(CarRacingTest, EnvIdKeysSetTheRulesOfTheEnvUnderThePipeline) {
+  auto env = MakeEnv("CarRacing-v3+pixels(skip=5,noop-start=45,off-track=1,lap-ends=0)");
+  // ClipReward is off: the pipeline is FrameStack > FrameProcessor > ActionRepeat > TimeLimit.
+  const Env* inner = env.get();
+  const CarRacing* car = nullptr;
+  for (int depth = 0; depth < 6 && car == nullptr; ++depth) {
+    car = dynamic_cast<const CarRacing*>(inner);
+    if (const auto* w = dynamic_cast<const EnvWrapper<ImageSource, ImageSource>*>(inner)) {
+      inner = &w->wrapped_env();
+    } else if (const auto* e = dynamic_cast<const EnvWrapper<Env, ImageSource>*>(inner)) {
+      inner = &e->wrapped_env();
+    } else if (const auto* i = dynamic_cast<const EnvWrapper<ImageSource, Env>*>(inner)) {
+      inner = &i->wrapped_env();
+    } else if (const auto* p = dynamic_cast<const EnvWrapper<Env, Env>*>(inner)) {
+      inner = &p->wrapped_env();
+    }
+  }
+  ASSERT_NE(car, nullptr);
+  EXPECT_TRUE(car->config().off_track);
+  EXPECT_EQ(car->config().off_track_after, 45);
+  EXPECT_FALSE(car->config().lap_ends);
+  EXPECT_FALSE(ParseEnvId("CarRacing-v3+pixels(skip=5)").off_track);
 }
 
 TEST(CarRacingTest, ScriptedPilotCompletesLapsWithAHighScore) {
@@ -220,7 +299,7 @@ TEST(CarRacingTest, ScriptedPilotCompletesLapsWithAHighScore) {
     CarRacingPilot pilot;
     env.Reset(5000 + seed);
     for (int frame = 0; frame < 1000; ++frame) {
-      const StepResult r = env.StepContinuous(pilot.Act(env));
+      const StepResult r = env.Step(pilot.Act(env));
       total += r.reward;
       if (r.terminated) break;
     }
@@ -288,14 +367,14 @@ TEST(CarRacingTest, BadActionsAndCallsBeforeResetAreRefused) {
   EXPECT_THROW(continuous.observation(), std::logic_error);
   continuous.Reset(1);
   const std::array<float, 2> short_action = {0, 0};
-  EXPECT_THROW(continuous.StepContinuous(short_action), std::invalid_argument);
+  EXPECT_THROW(continuous.Step(short_action), std::invalid_argument);
   EXPECT_THROW(Drive(continuous, std::nanf(""), 0, 0), std::invalid_argument);
-  EXPECT_THROW(continuous.Step(0), std::logic_error);
+  EXPECT_THROW(continuous.Step(DiscreteAction(0)), std::invalid_argument);
   CarRacing discrete(CarRacingConfig{.continuous = false});
   discrete.Reset(1);
-  EXPECT_THROW(discrete.Step(5), std::invalid_argument);
-  EXPECT_THROW(discrete.Step(-1), std::invalid_argument);
-  EXPECT_THROW(Drive(discrete, 0, 0, 0), std::logic_error);
+  EXPECT_THROW(discrete.Step(DiscreteAction(5)), std::invalid_argument);
+  EXPECT_THROW(discrete.Step(DiscreteAction(-1)), std::invalid_argument);
+  EXPECT_THROW(Drive(discrete, 0, 0, 0), std::invalid_argument);
   EXPECT_THROW(CarRacing(CarRacingConfig{.supersample = 0}), std::invalid_argument);
   EXPECT_THROW(CarRacing(CarRacingConfig{.lap_complete_percent = 1.5}), std::invalid_argument);
 }
@@ -340,7 +419,7 @@ TEST(CarRacingTest, PictureShowsTheCarAtItsPlaceTurningWithIt) {
   double start_angle = env.car().angle;
   bool turned = false;
   for (int k = 0; k < 600 && !turned; ++k) {
-    env.StepContinuous(pilot.Act(env));
+    env.Step(pilot.Act(env));
     if (k < 60) continue;  // After the zoom-in (t >= 1 s).
     env.Render(&rgb, &width, &height);
     ASSERT_EQ(width, 96);

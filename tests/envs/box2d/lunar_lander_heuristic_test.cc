@@ -93,7 +93,7 @@ TEST(LunarLanderHeuristicTest, ContinuousActionsAreScaledAndClipped) {
 TEST(LunarLanderHeuristicTest, DiscreteHeuristicLandsMostEpisodesAndAveragesAbove200) {
   // The reference quotes 236.90 +- 105.83 over 1000 episodes.
   const Scores s = Evaluate("LunarLander-v3", 100, [](Env& env) {
-    return env.Step(LunarLanderHeuristicAction(env.observation()));
+    return env.Step(DiscreteAction(LunarLanderHeuristicAction(env.observation())));
   });
   EXPECT_GT(s.mean_return, 200.0);
   EXPECT_GE(s.landed, 80);
@@ -102,7 +102,7 @@ TEST(LunarLanderHeuristicTest, DiscreteHeuristicLandsMostEpisodesAndAveragesAbov
 TEST(LunarLanderHeuristicTest, ContinuousHeuristicLandsAlmostAlwaysAndAveragesAbove200) {
   // The reference quotes 283.87 +- 18.88 over 1000 episodes.
   const Scores s = Evaluate("LunarLanderContinuous-v3", 100, [](Env& env) {
-    return env.StepContinuous(LunarLanderHeuristicContinuousAction(env.observation()));
+    return env.Step(LunarLanderHeuristicContinuousAction(env.observation()));
   });
   EXPECT_GT(s.mean_return, 250.0);
   EXPECT_GE(s.landed, 95);
@@ -110,8 +110,9 @@ TEST(LunarLanderHeuristicTest, ContinuousHeuristicLandsAlmostAlwaysAndAveragesAb
 
 TEST(LunarLanderHeuristicTest, UniformRandomPolicyScoresBetweenMinus250AndMinus50) {
   std::mt19937_64 rng(2024);
-  const Scores s = Evaluate("LunarLander-v3", 100,
-                            [&rng](Env& env) { return env.Step(static_cast<int>(rng() >> 62)); });
+  const Scores s = Evaluate("LunarLander-v3", 100, [&rng](Env& env) {
+    return env.Step(DiscreteAction(static_cast<int>(rng() >> 62)));
+  });
   EXPECT_GT(s.mean_return, -250.0);
   EXPECT_LT(s.mean_return, -50.0);
   EXPECT_EQ(s.truncated, 0);  // A random lander never lasts 1000 steps.

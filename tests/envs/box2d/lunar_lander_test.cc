@@ -38,7 +38,7 @@ double PadHeight(const LunarLander& env) { return env.terrain_y()[5]; }
 // place and leaves them swinging), then puts the lander above the pad centre, upright and at rest,
 // with the legs about 1 cm above the pad (at rest on it, the origin is about 0.64 m above).
 void PlaceAbovePad(LunarLander& env) {
-  for (int t = 0; t < 30; ++t) env.Step(0);
+  for (int t = 0; t < 30; ++t) env.Step(DiscreteAction(0));
   env.SetLanderKinematics(LanderKinematics{.x = 10.0, .y = PadHeight(env) + 0.65});
 }
 
@@ -51,7 +51,7 @@ std::vector<float> RandomEpisode(uint64_t seed, uint64_t policy_seed) {
   std::vector<float> trace(env->observation().begin(), env->observation().end());
   StepResult r;
   do {
-    r = env->Step(static_cast<int>(policy() >> 62));
+    r = env->Step(DiscreteAction(static_cast<int>(policy() >> 62)));
     trace.insert(trace.end(), env->observation().begin(), env->observation().end());
     trace.push_back(static_cast<float>(r.reward));
   } while (!r.terminated && !r.truncated);
@@ -179,7 +179,7 @@ TEST(LunarLanderTest, RewardIsTheShapingDifferenceMinusFuelForEachDiscreteAction
   for (int t = 0; t < 120; ++t) {
     const int action = (t / 3) % 4;
     const double before = ReferenceShaping(env.state());
-    const StepResult r = env.Step(action);
+    const StepResult r = env.Step(DiscreteAction(action));
     if (r.terminated) break;
     const double after = ReferenceShaping(env.state());
     EXPECT_NEAR(r.reward, after - before - fuel[action], 1e-9)
@@ -211,7 +211,7 @@ TEST(LunarLanderTest, ContinuousThrottlesFollowTheClippingAndDeadZones) {
   for (const Case& c : cases) {
     env.SetLanderKinematics(LanderKinematics{.x = 10, .y = 9});
     const double before = ReferenceShaping(env.state());
-    const StepResult r = env.StepContinuous(c.action);
+    const StepResult r = env.Step(c.action);
     ASSERT_FALSE(r.terminated);
     const double fuel = ReferenceShaping(env.state()) - before - r.reward;
     EXPECT_NEAR(fuel, 0.3 * c.m_power + 0.03 * c.s_power, 1e-9)
@@ -231,8 +231,8 @@ EngineEffect DiscreteEngineEffect(int action) {
   LunarLander idle;
   fired.Reset(21);
   idle.Reset(21);
-  fired.Step(action);
-  idle.Step(0);
+  fired.Step(DiscreteAction(action));
+  idle.Step(DiscreteAction(0));
   return {fired.lander_kinematics().vy - idle.lander_kinematics().vy,
           fired.lander_kinematics().angular_velocity - idle.lander_kinematics().angular_velocity};
 }
@@ -241,8 +241,8 @@ EngineEffect ContinuousEngineEffect(std::array<float, 2> action) {
   LunarLander idle = ContinuousLander();
   fired.Reset(21);
   idle.Reset(21);
-  fired.StepContinuous(action);
-  idle.StepContinuous(std::array<float, 2>{0, 0});
+  fired.Step(action);
+  idle.Step(std::array<float, 2>{0, 0});
   return {fired.lander_kinematics().vy - idle.lander_kinematics().vy,
           fired.lander_kinematics().angular_velocity - idle.lander_kinematics().angular_velocity};
 }
@@ -277,7 +277,7 @@ TEST(LunarLanderTest, UpsideDownTouchdownIsACrash) {
   StepResult r;
   int steps = 0;
   do {
-    r = env.Step(0);
+    r = env.Step(DiscreteAction(0));
     ++steps;
   } while (!r.terminated && steps < 50);
   EXPECT_TRUE(r.terminated);
@@ -291,7 +291,7 @@ TEST(LunarLanderTest, LeavingTheViewportSidewaysEndsTheEpisode) {
     LunarLander env;
     env.Reset(2);
     env.SetLanderKinematics(LanderKinematics{.x = x, .y = 9});
-    const StepResult r = env.Step(0);
+    const StepResult r = env.Step(DiscreteAction(0));
     EXPECT_TRUE(r.terminated) << "x = " << x;
     EXPECT_EQ(r.reward, -100.0) << "x = " << x;
     EXPECT_FALSE(env.game_over());
@@ -300,7 +300,7 @@ TEST(LunarLanderTest, LeavingTheViewportSidewaysEndsTheEpisode) {
     LunarLander env;
     env.Reset(2);
     env.SetLanderKinematics(LanderKinematics{.x = x, .y = 9});
-    EXPECT_FALSE(env.Step(0).terminated) << "x = " << x;
+    EXPECT_FALSE(env.Step(DiscreteAction(0)).terminated) << "x = " << x;
   }
 }
 
@@ -314,7 +314,7 @@ TEST(LunarLanderTest, LandingOnThePadEarnsTheLegBonusesAndRestingEndsWithPlus100
   do {
     const double before = ReferenceShaping(env.state());
     const bool had_contact = env.state()[6] != 0 || env.state()[7] != 0;
-    r = env.Step(0);
+    r = env.Step(DiscreteAction(0));
     ++steps;
     if (r.terminated) break;
     // The step's reward includes +10 for each leg that came into contact.
@@ -386,7 +386,7 @@ TEST(LunarLanderTest, InitialForceIsRandomInBothDirections) {
 TEST(LunarLanderTest, LegsHangOnTheirSidesAtTheInnerJointLimitsInFlight) {
   LunarLander env;
   env.Reset(9);
-  for (int t = 0; t < 25; ++t) env.Step(0);
+  for (int t = 0; t < 25; ++t) env.Step(DiscreteAction(0));
   ASSERT_GT(env.lander_kinematics().y, 8.0);  // Still falling freely.
   // Limits: leg 0 in [0.4, 0.9], leg 1 in [-0.9, -0.4]; the motors push to the inner ends.
   EXPECT_NEAR(env.leg_joint_angle(0), 0.4, 0.05);
@@ -426,7 +426,7 @@ TEST(LunarLanderTest, SameSeedAndActionsGiveBitIdenticalEpisodes) {
   for (TrajectoryHash* hash : {&first, &second}) {
     env.Reset(99);
     for (int t = 0; t < 300; ++t) {
-      const StepResult r = env.Step(t % 7 == 0 ? 2 : t % 4);
+      const StepResult r = env.Step(DiscreteAction(t % 7 == 0 ? 2 : t % 4));
       for (float v : env.observation()) hash->Add(v);
       hash->Add(r.reward);
       if (r.terminated) break;
@@ -458,7 +458,7 @@ TEST(LunarLanderTest, EveryStepDrawsTwoDispersionValuesWhetherOrNotAnEngineFires
   const auto terrain_after = [](const std::vector<int>& actions) {
     LunarLander env;
     env.Reset(31);
-    for (int a : actions) env.Step(a);
+    for (int a : actions) env.Step(DiscreteAction(a));
     env.Reset();
     return env.terrain_y();
   };
@@ -494,8 +494,8 @@ TEST(LunarLanderTest, WindPushesTheLanderAndAdvancesOncePerStepInFlight) {
     impulse += LunarLander::WindMagnitude(windy.wind_index(), 20.0) / LunarLander::kFps;
     const int64_t index = windy.wind_index();
     const int64_t torque_index = windy.torque_index();
-    calm.Step(0);
-    windy.Step(0);
+    calm.Step(DiscreteAction(0));
+    windy.Step(DiscreteAction(0));
     EXPECT_EQ(windy.wind_index(), index + 1);
     EXPECT_EQ(windy.torque_index(), torque_index + 1);
   }
@@ -507,7 +507,7 @@ TEST(LunarLanderTest, WindPushesTheLanderAndAdvancesOncePerStepInFlight) {
   // Without enable_wind the phases stay 0 and draw nothing.
   LunarLander plain;
   plain.Reset(6);
-  plain.Step(0);
+  plain.Step(DiscreteAction(0));
   EXPECT_EQ(plain.wind_index(), 0);
   EXPECT_EQ(plain.torque_index(), 0);
 }
@@ -520,7 +520,7 @@ TEST(LunarLanderTest, WindStopsOnceALegTouches) {
   bool touched = false;
   for (int t = 0; t < 60 && !touched; ++t) {
     const bool contact = env.leg_ground_contact(0) || env.leg_ground_contact(1);
-    env.Step(0);
+    env.Step(DiscreteAction(0));
     EXPECT_EQ(env.wind_index(), contact ? index : index + 1) << "step " << t;
     index = env.wind_index();
     touched = contact;
@@ -530,7 +530,7 @@ TEST(LunarLanderTest, WindStopsOnceALegTouches) {
 
 TEST(LunarLanderTest, InvalidCallsThrowAndLeaveTheEpisodeUnchanged) {
   LunarLander env;
-  EXPECT_THROW(env.Step(0), std::logic_error);
+  EXPECT_THROW(env.Step(DiscreteAction(0)), std::logic_error);
   std::vector<uint8_t> rgb;
   int width = 0;
   int height = 0;
@@ -541,34 +541,35 @@ TEST(LunarLanderTest, InvalidCallsThrowAndLeaveTheEpisodeUnchanged) {
   LunarLander twin;
   env.Reset(3);
   twin.Reset(3);
-  EXPECT_THROW(env.Step(4), std::invalid_argument);
-  EXPECT_THROW(env.Step(-1), std::invalid_argument);
+  EXPECT_THROW(env.Step(DiscreteAction(4)), std::invalid_argument);
+  EXPECT_THROW(env.Step(DiscreteAction(-1)), std::invalid_argument);
+  EXPECT_THROW(env.Step(std::array<float, 1>{1.5f}), std::invalid_argument);
   try {
-    env.Step(7);
+    env.Step(DiscreteAction(7));
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find('7'), std::string::npos) << e.what();
   }
-  env.Step(2);
-  twin.Step(2);
+  env.Step(DiscreteAction(2));
+  twin.Step(DiscreteAction(2));
   for (int i = 0; i < 8; ++i) EXPECT_EQ(env.observation()[i], twin.observation()[i]) << i;
 
-  // Each variant refuses the other's step.
+  // Each variant refuses the other's actions: a discrete action is one float, a continuous two.
   try {
-    env.StepContinuous(std::array<float, 2>{0, 0});
-    FAIL() << "expected std::logic_error";
-  } catch (const std::logic_error& e) {
-    EXPECT_EQ(std::string(e.what()), "discrete env");
+    env.Step(std::array<float, 2>{0, 0});
+    FAIL() << "expected std::invalid_argument";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string(e.what()), "LunarLander-v3: action of the wrong width (got [0, 0])");
   }
   LunarLander continuous = ContinuousLander();
-  EXPECT_THROW(continuous.StepContinuous(std::array<float, 2>{0, 0}), std::logic_error);
+  EXPECT_THROW(continuous.Step(std::array<float, 2>{0, 0}), std::logic_error);
   continuous.Reset(3);
-  EXPECT_THROW(continuous.Step(0), std::logic_error);
-  EXPECT_THROW(continuous.StepContinuous(std::array<float, 1>{0}), std::invalid_argument);
-  EXPECT_THROW(continuous.StepContinuous(std::array<float, 3>{0, 0, 0}), std::invalid_argument);
+  EXPECT_THROW(continuous.Step(DiscreteAction(0)), std::invalid_argument);
+  EXPECT_THROW(continuous.Step(std::array<float, 1>{0}), std::invalid_argument);
+  EXPECT_THROW(continuous.Step(std::array<float, 3>{0, 0, 0}), std::invalid_argument);
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  EXPECT_THROW(continuous.StepContinuous(std::array<float, 2>{nan, 0}), std::invalid_argument);
-  EXPECT_THROW(continuous.StepContinuous(std::array<float, 2>{0, nan}), std::invalid_argument);
+  EXPECT_THROW(continuous.Step(std::array<float, 2>{nan, 0}), std::invalid_argument);
+  EXPECT_THROW(continuous.Step(std::array<float, 2>{0, nan}), std::invalid_argument);
 }
 
 TEST(LunarLanderTest, TimeLimitTruncatesAHoveringLanderAtStep1000) {
@@ -579,12 +580,12 @@ TEST(LunarLanderTest, TimeLimitTruncatesAHoveringLanderAtStep1000) {
   // Hold the lander still in mid-air before every step, so that it neither lands nor sleeps.
   for (int t = 1; t <= 999; ++t) {
     lander.SetLanderKinematics(LanderKinematics{.x = 10, .y = 9});
-    const StepResult r = env->Step(t % 4);
+    const StepResult r = env->Step(DiscreteAction(t % 4));
     ASSERT_FALSE(r.terminated) << "step " << t;
     ASSERT_FALSE(r.truncated) << "step " << t;
   }
   lander.SetLanderKinematics(LanderKinematics{.x = 10, .y = 9});
-  const StepResult last = env->Step(0);
+  const StepResult last = env->Step(DiscreteAction(0));
   EXPECT_TRUE(last.truncated);
   EXPECT_FALSE(last.terminated);
   EXPECT_EQ(limit.elapsed_steps(), 1000);
@@ -593,15 +594,15 @@ TEST(LunarLanderTest, TimeLimitTruncatesAHoveringLanderAtStep1000) {
 TEST(LunarLanderTest, TimeLimitCountsContinuousStepsAndRejectsThemOnTheDiscreteVariant) {
   auto continuous = MakeEnv("LunarLanderContinuous-v3");
   continuous->Reset(1);
-  continuous->StepContinuous(std::array<float, 2>{0.5f, 0.0f});
-  continuous->StepContinuous(std::array<float, 2>{0.0f, -1.0f});
+  continuous->Step(std::array<float, 2>{0.5f, 0.0f});
+  continuous->Step(std::array<float, 2>{0.0f, -1.0f});
   EXPECT_EQ(dynamic_cast<TimeLimit&>(*continuous).elapsed_steps(), 2);
-  EXPECT_THROW(continuous->StepContinuous(std::array<float, 1>{0}), std::invalid_argument);
+  EXPECT_THROW(continuous->Step(std::array<float, 1>{0}), std::invalid_argument);
   EXPECT_EQ(dynamic_cast<TimeLimit&>(*continuous).elapsed_steps(), 2);
 
   auto discrete = MakeEnv("LunarLander-v3");
   discrete->Reset(1);
-  EXPECT_THROW(discrete->StepContinuous(std::array<float, 2>{0, 0}), std::logic_error);
+  EXPECT_THROW(discrete->Step(std::array<float, 2>{0, 0}), std::invalid_argument);
   EXPECT_EQ(dynamic_cast<TimeLimit&>(*discrete).elapsed_steps(), 0);
 }
 
@@ -614,7 +615,7 @@ TEST(LunarLanderTest, MovedLanderKeepsItsLegsAttached) {
   // The joints are where they were: same joint angles, same anchors.
   EXPECT_NEAR(env.leg_joint_angle(0), angle0, 1e-5);
   EXPECT_NEAR(env.leg_joint_angle(1), angle1, 1e-5);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   EXPECT_NEAR(env.leg_joint_angle(0), angle0, 0.05);
   EXPECT_NEAR(env.lander_kinematics().x, 4.0, 0.01);
 }

@@ -52,9 +52,9 @@ TEST(ActionRepeatTest, SumsTheRewardsOverTheSkip) {
   ActionRepeat env(std::move(inner), Skip(2));
   env.Reset(7);
   // Inner steps 1 + 2, then 3 + 4.
-  EXPECT_EQ(env.Step(1).reward, 1.0 + 2.0);
+  EXPECT_EQ(env.Step(DiscreteAction(1)).reward, 1.0 + 2.0);
   EXPECT_EQ(scripted->steps_taken, 2);
-  const StepResult second = env.Step(1);
+  const StepResult second = env.Step(DiscreteAction(1));
   EXPECT_EQ(second.reward, 4.0 + 8.0);
   EXPECT_FALSE(second.terminated);
   EXPECT_FALSE(second.truncated);
@@ -68,7 +68,7 @@ TEST(ActionRepeatTest, StopsEarlyOnTermination) {
   ScriptedImageEnv* scripted = inner.get();
   ActionRepeat env(std::move(inner), Skip(4));
   env.Reset(0);
-  const StepResult r = env.Step(0);
+  const StepResult r = env.Step(DiscreteAction(0));
   EXPECT_EQ(r.reward, 1.0 + 2.0);
   EXPECT_TRUE(r.terminated);
   EXPECT_FALSE(r.truncated);
@@ -80,7 +80,7 @@ TEST(ActionRepeatTest, StopsEarlyOnTruncation) {
   ScriptedImageEnv* scripted = inner.get();
   ActionRepeat env(std::move(inner), Skip(4));
   env.Reset(0);
-  const StepResult r = env.Step(0);
+  const StepResult r = env.Step(DiscreteAction(0));
   EXPECT_EQ(r.reward, 1.0 + 2.0 + 4.0);
   EXPECT_FALSE(r.terminated);
   EXPECT_TRUE(r.truncated);
@@ -91,12 +91,12 @@ TEST(ActionRepeatTest, ImageIsTheMaxOfTheLastTwoRawFrames) {
   ActionRepeat env(MakeScripted(), Skip(2));
   env.Reset(0);
   EXPECT_EQ(Bytes(env.image()), kF0);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   // Pixelwise max of kF1 and kF2.
   const std::vector<uint8_t> max12 = {20, 200, 30, 7,   0,   0,  255, 3, 2,  //
                                       6,  5,   5,  100, 100, 25, 9,   9, 10};
   EXPECT_EQ(Bytes(env.image()), max12);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   // Pixelwise max of kF3 (all 1) and kF4.
   const std::vector<uint8_t> max34 = {3, 3, 3, 1, 1, 1, 2, 2, 2,  //
                                       1, 1, 1, 4, 4, 4, 1, 1, 1};
@@ -106,7 +106,7 @@ TEST(ActionRepeatTest, ImageIsTheMaxOfTheLastTwoRawFrames) {
 TEST(ActionRepeatTest, FramesBeforeTheLastTwoDoNotCount) {
   ActionRepeat env(MakeScripted(), Skip(3));
   env.Reset(0);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   // Max of kF2 and kF3 only: kF1's 200 and 255 must not show.
   const std::vector<uint8_t> max23 = {20, 100, 30, 7,  1,   1,  1, 3, 2,  //
                                       6,  4,   5,  50, 100, 25, 9, 8, 10};
@@ -118,14 +118,14 @@ TEST(ActionRepeatTest, OneInnerStepGivesThatFrameAlone) {
   // reset frame kF0 (all 250, which would show everywhere).
   ActionRepeat env(MakeScripted({{1, true}, {2}, {4}}), Skip(3));
   env.Reset(0);
-  EXPECT_TRUE(env.Step(0).terminated);
+  EXPECT_TRUE(env.Step(DiscreteAction(0)).terminated);
   EXPECT_EQ(Bytes(env.image()), kF1);
   // With frame_skip 1 every step is a single inner step.
   ActionRepeat single(MakeScripted(), Skip(1));
   single.Reset(0);
-  single.Step(0);
+  single.Step(DiscreteAction(0));
   EXPECT_EQ(Bytes(single.image()), kF1);
-  single.Step(0);
+  single.Step(DiscreteAction(0));
   EXPECT_EQ(Bytes(single.image()), kF2);
 }
 
@@ -135,7 +135,7 @@ TEST(ActionRepeatTest, WithoutMaxPoolTheImageIsTheLastFrameAndOnlyItIsRendered) 
   ActionRepeat env(std::move(inner), Skip(2, /*max_pool=*/false));
   const int renders_before = scripted->renders;
   env.Reset(0);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   EXPECT_EQ(Bytes(env.image()), kF2);
   EXPECT_EQ(scripted->renders - renders_before, 2);  // The reset frame and kF2.
 }
@@ -143,7 +143,7 @@ TEST(ActionRepeatTest, WithoutMaxPoolTheImageIsTheLastFrameAndOnlyItIsRendered) 
 TEST(ActionRepeatTest, ResetShowsTheResetFrameAgain) {
   ActionRepeat env(MakeScripted(), Skip(2));
   env.Reset(0);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   env.Reset();
   EXPECT_EQ(Bytes(env.image()), kF0);
   EXPECT_EQ(env.observation()[0], 0.0f);
@@ -191,7 +191,7 @@ TEST(ActionRepeatTest, ExplicitRenderSizeUsesRenderSizedAndNoProbe) {
 TEST(ActionRepeatTest, RenderForwardsToTheWrappedEnv) {
   ActionRepeat env(MakeScripted(), Skip(2));
   env.Reset(0);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   // The wrapped env's own picture after its last inner step (kF2), not the pooled image.
   std::vector<uint8_t> rgb;
   int width = 0;
@@ -215,7 +215,8 @@ TEST(ActionRepeatTest, NoOpStartPlaysZeroActionsAfterReset) {
   EXPECT_EQ(scripted->steps_taken, 2);
   EXPECT_EQ(scripted->renders - renders_before, 1);  // only the frame after the no-ops
   EXPECT_EQ(Bytes(env.image()), kF2);
-  EXPECT_EQ(env.Step(0).reward, 4.0);  // the third inner step; 1 and 2 were discarded
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward,
+            4.0);  // the third inner step; 1 and 2 were discarded
 
   // An episode that ends during the no-ops starts again; one that always does is refused after
   // ten restarts instead of looping for ever (the scripted env ends every episode at step 2).
@@ -229,38 +230,6 @@ TEST(ActionRepeatTest, NoOpStartPlaysZeroActionsAfterReset) {
   EXPECT_EQ(ending_env->steps_taken, 22);
 }
 
-// The off-track rule tests the raw frame of every inner step at the article's pixels (row 75,
-// columns 41, 42, 52, 53 of 96 x 96; in a 3 x 2 frame all four are pixel (1, 1)).
-TEST(ActionRepeatTest, OffTrackReplacesTheRewardAndEndsTheStep) {
-  std::vector<uint8_t> grass = kF3;
-  grass[(1 * 3 + 1) * 3 + 1] = 204;  // green of pixel (1, 1)
-  auto inner = std::make_unique<ScriptedImageEnv>(
-      RgbShape(3, 2), std::vector<std::vector<uint8_t>>{kF0, kF1, grass, kF3, kF4},
-      std::vector<ScriptedStep>{{1}, {2}, {4}, {8}});
-  ScriptedImageEnv* scripted = inner.get();
-  ImagePipelineConfig config = Skip(3, /*max_pool=*/false);
-  config.off_track = true;
-  ActionRepeat env(std::move(inner), config);
-  env.Reset(1);
-  const int renders_before = scripted->renders;
-  const StepResult r = env.Step(0);
-  // Inner step 1 is on the road (G 50 at (1, 1)); inner step 2 shows grass: -10, terminated.
-  EXPECT_EQ(r.reward, 1.0 - 10.0);
-  EXPECT_TRUE(r.terminated);
-  EXPECT_EQ(scripted->steps_taken, 2);
-  EXPECT_EQ(scripted->renders - renders_before, 2);  // every inner step, none twice
-  EXPECT_EQ(Bytes(env.image()), grass);
-  // Without the rule the same steps run to the end of the skip.
-  auto plain = std::make_unique<ScriptedImageEnv>(
-      RgbShape(3, 2), std::vector<std::vector<uint8_t>>{kF0, kF1, grass, kF3, kF4},
-      std::vector<ScriptedStep>{{1}, {2}, {4}, {8}});
-  ActionRepeat off(std::move(plain), Skip(3, /*max_pool=*/false));
-  off.Reset(1);
-  const StepResult p = off.Step(0);
-  EXPECT_EQ(p.reward, 1.0 + 2.0 + 4.0);
-  EXPECT_FALSE(p.terminated);
-}
-
 TEST(ActionRepeatTest, RejectsNullAndBadConfigs) {
   EXPECT_THROW(ActionRepeat(nullptr, Skip(1)), std::invalid_argument);
   EXPECT_THROW(ActionRepeat(MakeScripted(), Skip(0)), std::invalid_argument);
@@ -270,10 +239,10 @@ TEST(ActionRepeatTest, StepBeforeResetAndBadActionsThrow) {
   auto inner = MakeScripted();
   ScriptedImageEnv* scripted = inner.get();
   ActionRepeat env(std::move(inner), Skip(2));
-  EXPECT_THROW(env.Step(0), std::logic_error);
+  EXPECT_THROW(env.Step(DiscreteAction(0)), std::logic_error);
   EXPECT_THROW(env.image(), std::logic_error);
   env.Reset(0);
-  EXPECT_THROW(env.Step(3), std::invalid_argument);
+  EXPECT_THROW(env.Step(DiscreteAction(3)), std::invalid_argument);
   EXPECT_EQ(scripted->steps_taken, 0);
   EXPECT_EQ(Bytes(env.image()), kF0);
 }

@@ -35,7 +35,7 @@ TEST(ClipRewardTest, ClampsRewardsToPlusMinusOneAndPassesTheFlags) {
   env.Reset(0);
   const std::vector<double> expected = {1, -1, 0.5, -0.25, 1, -1, 0, 1, -1};
   for (std::size_t t = 0; t < script.size(); ++t) {
-    const StepResult r = env.Step(0);
+    const StepResult r = env.Step(DiscreteAction(0));
     EXPECT_EQ(r.reward, expected[t]) << "step " << t + 1;
     EXPECT_EQ(r.terminated, script[t].terminated) << "step " << t + 1;
     EXPECT_EQ(r.truncated, script[t].truncated) << "step " << t + 1;
@@ -47,7 +47,7 @@ TEST(ClipRewardTest, NanPassesThrough) {
       GrayShape(1, 1), std::vector<std::vector<uint8_t>>(2, {0}),
       std::vector<ScriptedStep>{{.reward = std::numeric_limits<double>::quiet_NaN()}}));
   env.Reset(0);
-  EXPECT_TRUE(std::isnan(env.Step(0).reward));
+  EXPECT_TRUE(std::isnan(env.Step(DiscreteAction(0)).reward));
 }
 
 TEST(ClipRewardTest, ForwardsSpecObservationAndFrame) {
@@ -62,7 +62,7 @@ TEST(ClipRewardTest, ForwardsSpecObservationAndFrame) {
   EXPECT_EQ(env.spec().frame_stack, 2);
   EXPECT_EQ(env.spec().observation_size, 2);
   env.Reset(0);
-  EXPECT_EQ(env.Step(0).reward, 1.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, 1.0);
   EXPECT_EQ(env.frame()[0], 102);
   EXPECT_EQ(env.observation()[0], 0.2f);
   EXPECT_EQ(env.observation()[1], 0.4f);

@@ -123,7 +123,7 @@ TEST(FrameProcessorTest, ProcessesEveryStep) {
   FrameProcessor env(std::move(source), ResizeTo(1, 1));
   env.Reset(0);
   EXPECT_EQ(Bytes(env.image()), std::vector<uint8_t>{0});
-  const StepResult r = env.Step(0);
+  const StepResult r = env.Step(DiscreteAction(0));
   EXPECT_EQ(r.reward, 1.5);
   EXPECT_TRUE(r.terminated);
   // (255 + 255 + 200 + 201) / 4 = 227.75 -> 228.

@@ -56,12 +56,12 @@ TEST(FrameStackTest, ResetRepeatsTheFirstFrameAndStepsShiftTheStack) {
   FrameStack env(MakeScripted(), Stack(3));
   env.Reset(0);
   EXPECT_EQ(Floats(env.observation()), (std::vector<float>{0, 0.2f, 0, 0.2f, 0, 0.2f}));
-  EXPECT_EQ(env.Step(0).reward, 1.0);
+  EXPECT_EQ(env.Step(DiscreteAction(0)).reward, 1.0);
   EXPECT_EQ(Floats(env.observation()), (std::vector<float>{0, 0.2f, 0, 0.2f, 0.4f, 0.6f}));
   EXPECT_EQ(Bytes(env.frame()), (std::vector<uint8_t>{102, 153}));
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   EXPECT_EQ(Floats(env.observation()), (std::vector<float>{0, 0.2f, 0.4f, 0.6f, 0.8f, 1.0f}));
-  EXPECT_TRUE(env.Step(0).terminated);
+  EXPECT_TRUE(env.Step(DiscreteAction(0)).terminated);
   // The oldest frame (the reset frame) drops out.
   EXPECT_EQ(Floats(env.observation()), (std::vector<float>{0.4f, 0.6f, 0.8f, 1.0f, 0.2f, 0}));
   EXPECT_EQ(Bytes(env.frame()), (std::vector<uint8_t>{51, 0}));
@@ -70,12 +70,12 @@ TEST(FrameStackTest, ResetRepeatsTheFirstFrameAndStepsShiftTheStack) {
 TEST(FrameStackTest, NoFrameCrossesAnEpisodeBoundary) {
   FrameStack env(MakeScripted(), Stack(3));
   env.Reset(0);
-  env.Step(0);
-  env.Step(0);
+  env.Step(DiscreteAction(0));
+  env.Step(DiscreteAction(0));
   env.Reset();
   EXPECT_EQ(Floats(env.observation()), (std::vector<float>{0, 0.2f, 0, 0.2f, 0, 0.2f}));
   EXPECT_EQ(Bytes(env.frame()), (std::vector<uint8_t>{0, 51}));
-  env.Step(0);
+  env.Step(DiscreteAction(0));
   EXPECT_EQ(Floats(env.observation()), (std::vector<float>{0, 0.2f, 0, 0.2f, 0.4f, 0.6f}));
 }
 
@@ -97,7 +97,7 @@ TEST(FrameStackTest, RejectsRgbInputBadStacksAndUseBeforeReset) {
   EXPECT_THROW(FrameStack(MakeScripted(), Stack(0)), std::invalid_argument);
   EXPECT_THROW(FrameStack(nullptr, Stack(2)), std::invalid_argument);
   FrameStack env(MakeScripted(), Stack(2));
-  EXPECT_THROW(env.Step(0), std::logic_error);
+  EXPECT_THROW(env.Step(DiscreteAction(0)), std::logic_error);
   EXPECT_THROW(env.frame(), std::logic_error);
 }
 

@@ -65,7 +65,7 @@ TEST(PixelEnvAllocationTest, StepAndResetDoNotAllocateAfterTheFirstReset) {
   bool buffers_stable = true;
   int episodes = 0;
   while (episodes < 200) {
-    const StepResult r = env->Step(episodes % 3);
+    const StepResult r = env->Step(DiscreteAction(episodes % 3));
     buffers_stable =
         buffers_stable && env->observation().data() == observation && env->frame().data() == frame;
     if (r.terminated || r.truncated) {

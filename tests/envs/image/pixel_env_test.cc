@@ -142,7 +142,7 @@ TEST(MakePixelEnvTest, RunsTheWholePipeline) {
   // Inner steps 1 and 2: reward 1.5 + 1.5 = 3, clipped to 1. Max of frames 1 and 2 is
   // (204 204 0 0 / 0 0 102 102): left block (204 + 204 + 0 + 0) / 4 = 102, right block
   // (0 + 0 + 102 + 102) / 4 = 51.
-  StepResult r = env->Step(1);
+  StepResult r = env->Step(DiscreteAction(1));
   EXPECT_EQ(r.reward, 1.0);
   EXPECT_FALSE(r.terminated);
   EXPECT_EQ(Bytes(env->frame()), (std::vector<uint8_t>{102, 51}));
@@ -150,7 +150,7 @@ TEST(MakePixelEnvTest, RunsTheWholePipeline) {
 
   // Inner step 3 terminates: reward -4 clipped to -1, frame 3 alone: left block 255, right block
   // (255 + 255 + 51 + 51) / 4 = 153.
-  r = env->Step(1);
+  r = env->Step(DiscreteAction(1));
   EXPECT_EQ(r.reward, -1.0);
   EXPECT_TRUE(r.terminated);
   EXPECT_EQ(Bytes(env->frame()), (std::vector<uint8_t>{255, 153}));
@@ -203,10 +203,10 @@ TEST(MakePixelEnvTest, ContinuousEnvsStepThroughEveryWrapper) {
   plain->Reset(5);
   const float action[] = {1.0f, -0.7f};
   double plain_reward = 0;
-  for (int k = 0; k < 2; ++k) plain_reward += plain->StepContinuous(action).reward;
-  const StepResult r = pixel->Act(action);
+  for (int k = 0; k < 2; ++k) plain_reward += plain->Step(action).reward;
+  const StepResult r = pixel->Step(action);
   EXPECT_DOUBLE_EQ(r.reward, plain_reward);
-  EXPECT_THROW(pixel->Step(0), std::logic_error);
+  EXPECT_THROW(pixel->Step(DiscreteAction(0)), std::logic_error);
 }
 
 // The pixels of a grayscale frame of `width` columns that are 255, as (x, y); all others must be 0.
@@ -259,7 +259,7 @@ TEST(MakePixelEnvTest, CatchAtItsNativeSizeShowsTheBallAndPaddleCells) {
   const int ball = first.front().first / 8;
   EXPECT_EQ(first, CellPixels(8, 40, {{0, ball}, {9, 2}}));
   // Left: paddle to column 1, ball to row 1.
-  env->Step(0);
+  env->Step(DiscreteAction(0));
   EXPECT_EQ(BrightPixels(env->frame(), 40), CellPixels(8, 40, {{1, ball}, {9, 1}}));
 }
 
@@ -278,12 +278,13 @@ TEST(MakePixelEnvTest, CatchResizedTo20By40ShowsTheCellsAtHalfSize) {
   EXPECT_EQ(first, CellPixels(4, 20, {{0, ball}, {9, 2}}));
   // Two inner steps to the right. The frame is the max of the two raw frames, so it shows both
   // positions: the ball in rows 1 and 2, the paddle in columns 3 and 4.
-  env->Step(2);
+  env->Step(DiscreteAction(2));
   EXPECT_EQ(BrightPixels(env->frame(), 20),
             CellPixels(4, 20, {{1, ball}, {2, ball}, {9, 3}, {9, 4}}));
   // Steps 2-4 take inner steps 3-8; step 5 takes only inner step 9, which ends the episode.
-  for (int t = 2; t <= 4; ++t) EXPECT_FALSE(env->Step(1).terminated) << "step " << t;
-  const StepResult last = env->Step(1);
+  for (int t = 2; t <= 4; ++t)
+    EXPECT_FALSE(env->Step(DiscreteAction(1)).terminated) << "step " << t;
+  const StepResult last = env->Step(DiscreteAction(1));
   EXPECT_TRUE(last.terminated);
   EXPECT_EQ(last.reward, ball == 4 ? 1.0 : -1.0);
 }

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <utility>
@@ -27,33 +28,22 @@ class ScriptedImageEnv : public ImageSource {
  public:
   ScriptedImageEnv(ImageShape shape, std::vector<std::vector<uint8_t>> frames,
                    std::vector<ScriptedStep> steps = {})
-      : shape_(shape), frames_(std::move(frames)), steps_(std::move(steps)) {
+      : ImageSource(EnvSpec{.id = "Scripted-v0",
+                            .observation_size = 1,
+                            .num_actions = 3,
+                            .max_episode_steps = 10,
+                            .reward_threshold = 2.5}),
+        shape_(shape),
+        frames_(std::move(frames)),
+        steps_(std::move(steps)) {
     for (const auto& frame : frames_) {
       if (frame.size() != shape_.bytes()) throw std::invalid_argument("frame of the wrong size");
     }
   }
 
-  const EnvSpec& spec() const override { return spec_; }
   // The spec to adjust before wrapping (e.g. max_episode_steps, or a continuous action space).
-  EnvSpec& mutable_spec() { return spec_; }
+  using ImageSource::mutable_spec;
 
-  void Reset(uint64_t seed) override {
-    last_seed = seed;
-    Reset();
-  }
-  void Reset() override {
-    ++resets;
-    step_ = 0;
-    observation_[0] = 0;
-  }
-  StepResult Step(int action) override {
-    if (action < 0 || action >= spec_.num_actions) throw std::invalid_argument("bad action");
-    if (step_ >= steps_.size()) throw std::logic_error("past the end of the script");
-    ++step_;
-    ++steps_taken;
-    observation_[0] = static_cast<float>(step_);
-    return steps_[step_ - 1];
-  }
   std::span<const float> observation() const override { return observation_; }
 
   void Render(std::vector<uint8_t>* rgb, int* width, int* height) const override {
@@ -78,15 +68,26 @@ class ScriptedImageEnv : public ImageSource {
   uint64_t last_seed = ~uint64_t{0};
   mutable int last_sized_width = 0;
   mutable int last_sized_height = 0;
+  std::vector<float> last_action;  // The action of the last Step.
 
  private:
   const std::vector<uint8_t>& current() const { return frames_.at(step_); }
 
-  EnvSpec spec_{.id = "Scripted-v0",
-                .observation_size = 1,
-                .num_actions = 3,
-                .max_episode_steps = 10,
-                .reward_threshold = 2.5};
+  void OnReset(std::optional<uint64_t> seed) override {
+    if (seed.has_value()) last_seed = *seed;
+    ++resets;
+    step_ = 0;
+    observation_[0] = 0;
+  }
+  StepResult OnStep(std::span<const float> action) override {
+    last_action.assign(action.begin(), action.end());
+    if (step_ >= steps_.size()) throw std::logic_error("past the end of the script");
+    ++step_;
+    ++steps_taken;
+    observation_[0] = static_cast<float>(step_);
+    return steps_[step_ - 1];
+  }
+
   ImageShape shape_;
   std::vector<std::vector<uint8_t>> frames_;
   std::vector<ScriptedStep> steps_;

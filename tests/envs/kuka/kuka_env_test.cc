@@ -28,7 +28,7 @@ double RunEpisode(KukaDiverseObjectEnv& env, uint64_t seed, std::mt19937_64* rng
   for (int t = 0; t < env.config().max_steps + 1; ++t) {
     const int action =
         rng == nullptr ? kuka::OracleAction(env) : static_cast<int>(UniformInt(*rng, 0, 7));
-    const StepResult r = env.Step(action);
+    const StepResult r = env.Step(DiscreteAction(action));
     total += r.reward;
     if (r.terminated) return total;
   }
@@ -56,14 +56,14 @@ TEST(KukaEnvTest, SpecAndConfigValidation) {
 
 TEST(KukaEnvTest, StepChecksItsPreconditions) {
   KukaDiverseObjectEnv env;
-  EXPECT_THROW(env.Step(0), std::logic_error);
+  EXPECT_THROW(env.Step(DiscreteAction(0)), std::logic_error);
   std::vector<uint8_t> rgb;
   int w = 0, h = 0;
   EXPECT_THROW(env.Render(&rgb, &w, &h), std::logic_error);
   env.Reset(1);
-  EXPECT_THROW(env.Step(-1), std::invalid_argument);
-  EXPECT_THROW(env.Step(7), std::invalid_argument);
-  EXPECT_EQ(env.env_step(), 0);
+  EXPECT_THROW(env.Step(DiscreteAction(-1)), std::invalid_argument);
+  EXPECT_THROW(env.Step(DiscreteAction(7)), std::invalid_argument);
+  EXPECT_EQ(env.elapsed_steps(), 0);
 }
 
 TEST(KukaEnvTest, ResetDropsObjectsThatSettleInTheTray) {
@@ -102,7 +102,8 @@ TEST(KukaEnvTest, GripperDescendsAndAGraspEndsTheEpisode) {
   env.Reset(5);
   double previous_z = env.scene().LinkCenterOfMass(kuka::kEndEffectorLink).z();
   for (int t = 1; t <= env.config().max_steps; ++t) {
-    const StepResult r = env.Step(t % 2 == 0 ? 3 : 4);  // -y, +y: stays near the centre.
+    const StepResult r =
+        env.Step(DiscreteAction(t % 2 == 0 ? 3 : 4));  // -y, +y: stays near the centre.
     EXPECT_EQ(env.observation()[0], static_cast<float>(t));
     EXPECT_FLOAT_EQ(env.observation()[1], static_cast<float>(t) / 15);
     EXPECT_FALSE(r.truncated);
@@ -124,15 +125,15 @@ TEST(KukaEnvTest, SameSeedSameTrajectoryAndImages) {
   KukaDiverseObjectEnv b;
   // b runs another episode first: nothing may carry over.
   b.Reset(99);
-  b.Step(1);
+  b.Step(DiscreteAction(1));
   const int actions[] = {1, 4, 6, 2, 0, 3, 5, 0, 0, 0};
   a.Reset(7);
   b.Reset(7);
   std::vector<uint8_t> image_a, image_b;
   int w = 0, h = 0;
   for (int action : actions) {
-    const StepResult ra = a.Step(action);
-    const StepResult rb = b.Step(action);
+    const StepResult ra = a.Step(DiscreteAction(action));
+    const StepResult rb = b.Step(DiscreteAction(action));
     EXPECT_EQ(ra.reward, rb.reward);
     EXPECT_EQ(ra.terminated, rb.terminated);
     for (int i = 0; i < a.scene().num_objects(); ++i) {

@@ -57,7 +57,7 @@ TEST(KukaRenderTest, ImageChangesWhenTheArmMoves) {
   std::vector<uint8_t> before, after;
   int w = 0, h = 0;
   env.Render(&before, &w, &h);
-  env.Step(2);  // +x and down.
+  env.Step(rl::envs::DiscreteAction(2));  // +x and down.
   env.Render(&after, &w, &h);
   EXPECT_GT(CountDifferentPixels(before, after), 20);
 }
@@ -92,7 +92,7 @@ TEST(KukaRenderTest, GripperAppearsWhereTheCameraModelProjectsIt) {
   for (uint64_t seed : {3, 4}) {
     env.Reset(seed);
     for (int move = 0; move < 2; ++move) {
-      if (move == 1) env.Step(seed == 3 ? 4 : 1);
+      if (move == 1) env.Step(rl::envs::DiscreteAction(seed == 3 ? 4 : 1));
       std::vector<DrawItem> items;
       env.scene().CollectDrawItems(&items);
       std::erase_if(items, [](const DrawItem& d) { return d.group != DrawGroup::kGripper; });
@@ -160,7 +160,7 @@ TEST(KukaRenderTest, GripperStandsOutFromTheTrayInGrayscale) {
       ASSERT_GT(covered, 5) << "seed " << seed << " step " << step;
       // About 8 levels of 255 on the earlier mid-grey tray; 41..73 on the dark one.
       EXPECT_GT(sum / covered, 30.0) << "seed " << seed << " step " << step;
-      env.Step(0);  // stay: the gripper only descends
+      env.Step(rl::envs::DiscreteAction(0));  // stay: the gripper only descends
     }
   }
 }
