@@ -96,6 +96,7 @@
 #include "common/check.h"
 #include "common/clock.h"
 #include "common/message_auth.h"
+#include "common/message_examples.h"
 #include "replay/pixel_table.h"
 #include "replay/prioritized_sampler.h"
 #include "replay/replay_service.h"
@@ -129,22 +130,8 @@ bool WaitForReplay(rl::Bus* bus) {
   return *replay_up;
 }
 
-rlmsg::transition_batch_t Batch() {
-  rlmsg::transition_batch_t m{};
-  m.obs_size = 4;
-  m.count = 32;
-  m.num_values = 128;
-  m.obs.assign(128, 0.1f);
-  m.next_obs.assign(128, 0.2f);
-  m.action_width = 1;
-  m.num_action_values = 32;
-  m.action.assign(32, 1.0f);
-  m.reward.assign(32, 1.0f);
-  m.discount.assign(32, 0.99f);
-  m.episode_id.assign(32, 0);
-  m.priority.assign(32, 0.0f);
-  return m;
-}
+// 32 flat CartPole-size transitions (4 floats each).
+rlmsg::transition_batch_t Batch() { return rl::examples::FlatTransitions(0, 32, 4); }
 
 // Flat CartPole transitions: replay_inserts_lcm and replay_samples_lcm, on `port` and port + 1.
 int RunFlat(int repeats, double seconds, int port) {

@@ -9,6 +9,7 @@
 
 #include "common/channels.h"
 #include "common/message_auth.h"
+#include "common/message_examples.h"
 
 namespace rl {
 namespace {
@@ -18,21 +19,7 @@ BusConfig MemqConfig(int64_t run_id, const std::string& sender) {
 }
 
 rlmsg::transition_batch_t MakeBatch(int count, int obs_size) {
-  rlmsg::transition_batch_t m{};
-  m.actor_id = 1;
-  m.obs_size = obs_size;
-  m.count = count;
-  m.num_values = count * obs_size;
-  m.obs.assign(static_cast<size_t>(m.num_values), 0.5f);
-  m.next_obs.assign(static_cast<size_t>(m.num_values), 0.25f);
-  m.action_width = 1;
-  m.num_action_values = count;
-  m.action.assign(static_cast<size_t>(count), 1.0f);
-  m.reward.assign(static_cast<size_t>(count), 1.0f);
-  m.discount.assign(static_cast<size_t>(count), 0.99f);
-  m.episode_id.assign(static_cast<size_t>(count), 7);
-  m.priority.assign(static_cast<size_t>(count), 0.0f);
-  return m;
+  return examples::FlatTransitions(0, count, obs_size, 1, /*actor=*/1);
 }
 
 // Encoded as actor-1 of run 42 would send it now (a fresh time, an incarnation just before it).
