@@ -94,21 +94,20 @@ Shape& RunShape() {
 template <class Msg>
 Msg WithRunAction(Msg m) {
   m.action = RunShape().action;
+  m.action_width = m.num_action_values = static_cast<int32_t>(m.action.size());
   return m;
 }
-int RunActionWidth() { return static_cast<int>(RunShape().action.size()); }
-
 rlmsg::transition_batch_t Transitions() {
-  return WithRunAction(rl::examples::FlatTransitions(0, 1, RunShape().obs_size, RunActionWidth()));
+  return WithRunAction(rl::examples::FlatTransitions(0, 1, RunShape().obs_size));
 }
 rlmsg::transition_batch_t PixelTransitions() {
   return WithRunAction(rl::examples::PixelTransitions(0, 1, 2, 2));
 }
 rlmsg::sample_batch_t Samples() {
-  return WithRunAction(rl::examples::FlatSamples(1, RunShape().obs_size, RunActionWidth()));
+  return WithRunAction(rl::examples::FlatSamples(1, RunShape().obs_size));
 }
 rlmsg::sample_batch_t PixelSamples() {
-  return WithRunAction(rl::examples::PixelSamples(1, 2, 2, 2, RunActionWidth()));
+  return WithRunAction(rl::examples::PixelSamples(1, 2, 2, 2));
 }
 rlmsg::priority_update_t Priorities() { return rl::examples::Example<rlmsg::priority_update_t>(); }
 rlmsg::weights_chunk_t Chunk() { return rl::examples::WeightsChunk("linear(4,2)", 10, 1, 0); }

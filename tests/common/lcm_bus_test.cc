@@ -2,6 +2,10 @@
 
 #include <cmath>
 #include <limits>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -535,6 +539,56 @@ TEST(BusSenderTest, RefusesASenderNameUnfitForTheNonceAndDropsSuchMessagesAsMalf
   }
   EXPECT_EQ(got, 0);
   EXPECT_EQ(bus.counters().malformed, 2);
+}
+
+// The table of common/channels.h: every type of lcmtypes/ but header_t once, each on a channel of
+// its own; the example of each passes Validate() and reaches a subscriber of its channel (so the
+// publisher and the subscriber chose the same port), in the table's order.
+TEST(MessageTableTest, ListsEveryTypeOnceAndEachExampleCrossesTheBus) {
+  std::set<std::string_view> types, names;
+  for (const MessageInfo& m : kMessages) {
+    types.insert(m.type);
+    names.insert(m.channel);
+  }
+  EXPECT_EQ(types.size(), kNumMessages);
+  EXPECT_EQ(names.size(), kNumMessages);
+  EXPECT_EQ(LcmSchemas().size(), kNumMessages + 1) << "a .lcm file without a line in the table";
+  EXPECT_EQ(MessageIndex("header_t"), -1);
+
+  Bus bus(MemqConfig(5, "test"));
+  std::vector<std::string> got;
+  int index = 0;
+#define RL_CHECK_LINE(type, constant, name, port)                                         \
+  EXPECT_EQ(MessageIndex(rlmsg::type::getTypeName()), index++);                           \
+  EXPECT_EQ(FindChannel(channels::constant)->port, Port::port);                           \
+  bus.Subscribe<rlmsg::type>(name, [&got](const rlmsg::type&) { got.push_back(#type); }); \
+  {                                                                                       \
+    rlmsg::type m = examples::Example<rlmsg::type>();                                     \
+    EXPECT_EQ(Validate(m), nullptr) << #type;                                             \
+    EXPECT_TRUE(bus.Publish(name, &m));                                                   \
+  }
+  RL_MESSAGES(RL_CHECK_LINE)
+#undef RL_CHECK_LINE
+  for (int i = 0; i < 100 && got.size() < kNumMessages; ++i) bus.Handle(10);
+  ASSERT_EQ(got.size(), kNumMessages) << "some example was dropped or went on another port";
+  EXPECT_EQ(bus.counters().dropped(), 0);
+}
+
+// A channel of the table takes only its type, on its port; other channels take any.
+TEST(MessageTableTest, RefusesAnotherTypeOrPortOnAChannelOfTheTable) {
+  Bus bus(MemqConfig(5, "test"));
+  EXPECT_THROW(
+      bus.Subscribe<rlmsg::checkpoint_t>(channels::kTransitions, [](const rlmsg::checkpoint_t&) {}),
+      std::invalid_argument);
+  rlmsg::checkpoint_t c = examples::Example<rlmsg::checkpoint_t>();
+  EXPECT_THROW(bus.Publish(channels::kWeights, &c), std::invalid_argument);
+  rlmsg::weights_chunk_t w = examples::Example<rlmsg::weights_chunk_t>();
+  EXPECT_THROW(bus.Publish(channels::kWeights, &w, Port::kMain), std::invalid_argument);
+  EXPECT_EQ(ChannelPort(channels::kWeights, "weights_chunk_t", std::nullopt), Port::kBulk);
+  EXPECT_EQ(ChannelPort(channels::kWeights, "", std::nullopt), Port::kBulk);
+  EXPECT_EQ(ChannelPort("TEST_CHANNEL", "checkpoint_t", std::nullopt), Port::kMain);
+  EXPECT_EQ(ChannelPort("TEST_CHANNEL", "checkpoint_t", Port::kBulk), Port::kBulk);
+  EXPECT_TRUE(bus.Publish("TEST_CHANNEL", &c));
 }
 
 }  // namespace
