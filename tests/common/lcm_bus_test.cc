@@ -558,9 +558,9 @@ TEST(MessageTableTest, ListsEveryTypeOnceAndEachExampleCrossesTheBus) {
   Bus bus(MemqConfig(5, "test"));
   std::vector<std::string> got;
   int index = 0;
-#define RL_CHECK_LINE(type, constant, name, port)                                         \
+#define RL_CHECK_LINE(type, constant, name, on_port)                                      \
   EXPECT_EQ(MessageIndex(rlmsg::type::getTypeName()), index++);                           \
-  EXPECT_EQ(FindChannel(channels::constant)->port, Port::port);                           \
+  EXPECT_EQ(FindChannel(channels::constant)->port, Port::on_port);                        \
   bus.Subscribe<rlmsg::type>(name, [&got](const rlmsg::type&) { got.push_back(#type); }); \
   {                                                                                       \
     rlmsg::type m = examples::Example<rlmsg::type>();                                     \
