@@ -136,96 +136,98 @@ rlmsg::weights_chunk_t WeightsChunk(const std::string& architecture, int32_t tot
 // ---- One example of each type ----
 
 void MakeExample(rlmsg::checkpoint_t* m) {
-  *m = {.header = Header("learner", 7),
-        .path = "runs/cartpole/checkpoints/ckpt-000005000.bin",
-        .update = 5000,
-        .env_steps = 40000,
-        .wall_seconds = 61.5};
+  m->header = Header("learner", 7);
+  m->path = "runs/cartpole/checkpoints/ckpt-000005000.bin";
+  m->update = 5000;
+  m->env_steps = 40000;
+  m->wall_seconds = 61.5;
 }
 
 void MakeExample(rlmsg::eval_result_t* m) {
-  *m = {.header = Header("evaluator", 3),
-        .checkpoint = "runs/cartpole/checkpoints/ckpt-000005000.bin",
-        .update = 5000,
-        .env_steps = 40000,
-        .wall_seconds = 75.25,
-        .episodes = 100,
-        .mean = 487.5,
-        .std = 12.0,
-        .min = 410,
-        .max = 500,
-        .goal_reached = 1};
+  m->header = Header("evaluator", 3);
+  m->checkpoint = "runs/cartpole/checkpoints/ckpt-000005000.bin";
+  m->update = 5000;
+  m->env_steps = 40000;
+  m->wall_seconds = 75.25;
+  m->episodes = 100;
+  m->mean = 487.5;
+  m->std = 12.0;
+  m->min = 410;
+  m->max = 500;
+  m->goal_reached = 1;
 }
 
 void MakeExample(rlmsg::flow_control_t* m) {
-  *m = {.header = Header("replay", 120),
-        .insert_allowed = 1,
-        .samples_per_insert = 7.5,
-        .target_samples_per_insert = 8,
-        .error_buffer = 100,
-        .insert_credit = 64,
-        .num_actors = 2,
-        .actor_id = {0, 1},
-        .actor_inserts = {1000, 998}};
+  m->header = Header("replay", 120);
+  m->insert_allowed = 1;
+  m->samples_per_insert = 7.5;
+  m->target_samples_per_insert = 8;
+  m->error_buffer = 100;
+  m->insert_credit = 64;
+  m->num_actors = 2;
+  m->actor_id = {0, 1};
+  m->actor_inserts = {1000, 998};
 }
 
 void MakeExample(rlmsg::priority_update_t* m) {
-  *m = {.header = Header("learner", 9),
-        .count = 3,
-        .index = {5, 17, 99999},
-        .priority = {0.5f, 1.25f, 0.0f}};
+  m->header = Header("learner", 9);
+  m->count = 3;
+  m->index = {5, 17, 99999};
+  m->priority = {0.5f, 1.25f, 0.0f};
 }
 
 void MakeExample(rlmsg::sample_batch_t* m) { *m = FlatSamples(2, 4); }
 
 void MakeExample(rlmsg::sample_request_t* m) {
-  *m = {.header = Header("learner", 12), .request_id = 12, .batch_size = 64};
+  m->header = Header("learner", 12);
+  m->request_id = 12;
+  m->batch_size = 64;
 }
 
 void MakeExample(rlmsg::stats_actor_t* m) {
-  *m = {.header = Header("actor-0", 30),
-        .env_steps = 4000,
-        .episodes = 50,
-        .steps_per_second = 2000,
-        .mean_return = 85.5,
-        .epsilon = 0.4,
-        .weights_version = 12,
-        .transitions_published = 3990};
+  m->header = Header("actor-0", 30);
+  m->env_steps = 4000;
+  m->episodes = 50;
+  m->steps_per_second = 2000;
+  m->mean_return = 85.5;
+  m->epsilon = 0.4;
+  m->weights_version = 12;
+  m->transitions_published = 3990;
 }
 
 void MakeExample(rlmsg::stats_evaluator_t* m) {
-  *m = {.header = Header("evaluator", 4),
-        .checkpoints_scored = 3,
-        .last_mean = 200,
-        .best_mean = 250,
-        .best_update = 4000,
-        .busy = 1};
+  m->header = Header("evaluator", 4);
+  m->checkpoints_scored = 3;
+  m->last_mean = 200;
+  m->best_mean = 250;
+  m->best_update = 4000;
+  m->busy = 1;
 }
 
 void MakeExample(rlmsg::stats_learner_t* m) {
-  *m = {.header = Header("learner", 31),
-        .updates = 5000,
-        .updates_per_second = 150,
-        .samples_per_second = 9600,
-        .loss = 0.02,
-        .mean_q = 30,
-        .weights_version = 50,
-        .env_steps = 40000};
+  m->header = Header("learner", 31);
+  m->updates = 5000;
+  m->updates_per_second = 150;
+  m->samples_per_second = 9600;
+  m->loss = 0.02;
+  m->mean_q = 30;
+  m->weights_version = 50;
+  m->env_steps = 40000;
 }
 
 void MakeExample(rlmsg::stats_replay_t* m) {
-  *m = {.header = Header("replay", 32),
-        .size = 40000,
-        .capacity = 100000,
-        .total_inserts = 40000,
-        .total_samples = 320000,
-        .inserts_per_second = 2000,
-        .samples_per_second = 16000,
-        .samples_per_insert = 8,
-        .insert_allowed = 1,
-        .prioritized = 1,
-        .beta = 0.4,
-        .memory_bytes = 1 << 20};
+  m->header = Header("replay", 32);
+  m->size = 40000;
+  m->capacity = 100000;
+  m->total_inserts = 40000;
+  m->total_samples = 320000;
+  m->inserts_per_second = 2000;
+  m->samples_per_second = 16000;
+  m->samples_per_insert = 8;
+  m->insert_allowed = 1;
+  m->prioritized = 1;
+  m->beta = 0.4;
+  m->memory_bytes = 1 << 20;
 }
 
 void MakeExample(rlmsg::transition_batch_t* m) { *m = FlatTransitions(0, 2, 3, 1, 1); }
