@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/check.h"
+#include "common/message_examples.h"
 #include "rlmsg/transition_batch_t.hpp"
 
 namespace rl::bench {
@@ -102,21 +103,6 @@ class PixelActorSim {
 };
 
 // A batch of 32 CartPole-size transitions (4 floats per observation, one action).
-inline rlmsg::transition_batch_t FlatBatch() {
-  rlmsg::transition_batch_t m{};
-  m.obs_size = 4;
-  m.count = 32;
-  m.num_values = 128;
-  m.obs.assign(128, 0.1f);
-  m.next_obs.assign(128, 0.2f);
-  m.action_width = 1;
-  m.num_action_values = 32;
-  m.action.assign(32, 1.0f);
-  m.reward.assign(32, 1.0f);
-  m.discount.assign(32, 0.99f);
-  m.episode_id.assign(32, 0);
-  m.priority.assign(32, 0.0f);
-  return m;
-}
+inline rlmsg::transition_batch_t FlatBatch() { return rl::examples::FlatTransitions(0, kBatch, 4); }
 
 }  // namespace rl::bench

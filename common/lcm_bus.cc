@@ -53,6 +53,21 @@ bool PrintableName(std::string_view s, size_t max) {
 
 }  // namespace
 
+Port ChannelPort(std::string_view channel, std::string_view type, std::optional<Port> port) {
+  const MessageInfo* info = FindChannel(channel);
+  if (info == nullptr) return port.value_or(Port::kMain);
+  if (!type.empty() && type != info->type) {
+    throw std::invalid_argument(std::string(channel) + " carries " + std::string(info->type) +
+                                ", not " + std::string(type) + " (common/channels.h)");
+  }
+  if (port && *port != info->port) {
+    throw std::invalid_argument(std::string(channel) + " goes on the " +
+                                (info->port == Port::kBulk ? "bulk" : "main") +
+                                " port (common/channels.h)");
+  }
+  return info->port;
+}
+
 Bus::Bus(BusConfig config) : config_(std::move(config)), incarnation_(NewIncarnation()) {
   if (!ValidSenderName(config_.sender)) {
     throw std::invalid_argument("sender name '" + config_.sender +

@@ -50,11 +50,13 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
 
+#include "common/channels.h"
 #include "common/clock.h"
 #include "common/message_auth.h"
 #include "common/messages.h"
@@ -133,7 +135,12 @@ std::string FormatPositions(const std::vector<StreamPosition>& positions);
 std::vector<StreamPosition> ParsePositions(std::string_view text);
 inline constexpr size_t kMaxStoredPositions = 65536;
 
-enum class Port { kMain, kBulk };
+/// The port a message of `type` (lcm-gen's name) goes on when published or subscribed on
+/// `channel`: the channel's port in RL_MESSAGES (common/channels.h), or `port` (the main one if
+/// none) for a channel of no run message. Throws std::invalid_argument naming the channel when the
+/// table gives the channel another type (pass an empty type to skip this check, for raw bytes) or
+/// another port than `port`: a programming error, caught by the first test that runs it.
+Port ChannelPort(std::string_view channel, std::string_view type, std::optional<Port> port);
 
 class Bus {
  public:
@@ -144,22 +151,26 @@ class Bus {
   Bus& operator=(const Bus&) = delete;
   ~Bus();
 
-  // Fills msg->header and publishes. Returns false when LCM reported an error (it does not for
-  // fragmented messages; see the README's transport notes).
+  // Fills msg->header and publishes, on the channel's port (ChannelPort(): a channel of
+  // common/channels.h takes only its type). Returns false when LCM reported an error (it does not
+  // for fragmented messages; see the README's transport notes).
   template <class Msg>
-  bool Publish(const std::string& channel, Msg* msg, Port port = Port::kMain);
+  bool Publish(const std::string& channel, Msg* msg, std::optional<Port> port = std::nullopt);
 
-  // Publishes bytes as they are (for tools and tests that send foreign or broken messages).
+  // Publishes bytes as they are (for tools and tests that send foreign or broken messages), on
+  // the channel's port (ChannelPort() without the type check).
   bool PublishRaw(const std::string& channel, const void* data, size_t size,
-                  Port port = Port::kMain) {
-    return lcm(port).publish(channel, data, static_cast<unsigned>(size)) == 0;
+                  std::optional<Port> port = std::nullopt) {
+    return lcm(ChannelPort(channel, {}, port))
+               .publish(channel, data, static_cast<unsigned>(size)) == 0;
   }
 
-  // Calls handler(msg) for every good message of type Msg on `channel`. The subscription starts
+  // Calls handler(msg) for every good message of type Msg on `channel`, on the channel's port
+  // (ChannelPort(): a channel of common/channels.h takes only its type). The subscription starts
   // from the positions restored for its channel (LoadPositions()).
   template <class Msg>
   void Subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
-                 Port port = Port::kMain);
+                 std::optional<Port> port = std::nullopt);
 
   // Handles `size` bytes as if LCM had received them on `channel` at recv_utime (microseconds
   // since the Unix epoch): every subscription of the channel checks them (for tests, benchmarks
@@ -260,7 +271,8 @@ class Bus {
 };
 
 template <class Msg>
-bool Bus::Publish(const std::string& channel, Msg* msg, Port port) {
+bool Bus::Publish(const std::string& channel, Msg* msg, std::optional<Port> port) {
+  const Port checked = ChannelPort(channel, Msg::getTypeName(), port);
   msg->header.run_id = config_.run_id;
   msg->header.sender = config_.sender;
   msg->header.seq = publish_seq_[channel]++;
@@ -271,15 +283,15 @@ bool Bus::Publish(const std::string& channel, Msg* msg, Port port) {
   encode_buffer_.resize(static_cast<size_t>(size));
   if (msg->encode(encode_buffer_.data(), 0, size) != size) return false;
   if (!Sign(channel, encode_buffer_.data(), encode_buffer_.size(), msg->header)) return false;
-  return lcm(port).publish(channel, encode_buffer_.data(), static_cast<unsigned>(size)) == 0;
+  return lcm(checked).publish(channel, encode_buffer_.data(), static_cast<unsigned>(size)) == 0;
 }
 
 template <class Msg>
 void Bus::Subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
-                    Port port) {
+                    std::optional<Port> port) {
   auto decoded = std::make_shared<Msg>();
   SubscribeRaw(
-      channel, port, Msg::getHash(),
+      channel, ChannelPort(channel, Msg::getTypeName(), port), Msg::getHash(),
       [decoded](const uint8_t* data, size_t size) { return Decode(data, size, decoded.get()); },
       [this, channel, handler = std::move(handler), decoded] {
         const Msg& msg = *decoded;

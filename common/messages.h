@@ -12,19 +12,9 @@
 #include <cstdint>
 #include <exception>
 
+#include "common/channels.h"
 #include "common/lcm_schema.h"
-#include "rlmsg/checkpoint_t.hpp"
-#include "rlmsg/eval_result_t.hpp"
-#include "rlmsg/flow_control_t.hpp"
-#include "rlmsg/priority_update_t.hpp"
-#include "rlmsg/sample_batch_t.hpp"
-#include "rlmsg/sample_request_t.hpp"
-#include "rlmsg/stats_actor_t.hpp"
-#include "rlmsg/stats_evaluator_t.hpp"
-#include "rlmsg/stats_learner_t.hpp"
-#include "rlmsg/stats_replay_t.hpp"
-#include "rlmsg/transition_batch_t.hpp"
-#include "rlmsg/weights_chunk_t.hpp"
+#include "rlmsg/all_types.hpp"
 
 namespace rl {
 
@@ -60,17 +50,9 @@ int64_t Dropped(const Stats& s) {
          s.dropped_stale + s.dropped_replayed;
 }
 
-const char* Validate(const rlmsg::transition_batch_t& m);
-const char* Validate(const rlmsg::sample_request_t& m);
-const char* Validate(const rlmsg::sample_batch_t& m);
-const char* Validate(const rlmsg::weights_chunk_t& m);
-const char* Validate(const rlmsg::priority_update_t& m);
-const char* Validate(const rlmsg::checkpoint_t& m);
-const char* Validate(const rlmsg::flow_control_t& m);
-const char* Validate(const rlmsg::eval_result_t& m);
-const char* Validate(const rlmsg::stats_actor_t& m);
-const char* Validate(const rlmsg::stats_replay_t& m);
-const char* Validate(const rlmsg::stats_learner_t& m);
-const char* Validate(const rlmsg::stats_evaluator_t& m);
+/// One Validate() per message of common/channels.h, defined in messages.cc.
+#define RL_DECLARE_VALIDATE(type, constant, name, port) const char* Validate(const rlmsg::type& m);
+RL_MESSAGES(RL_DECLARE_VALIDATE)
+#undef RL_DECLARE_VALIDATE
 
 }  // namespace rl

@@ -2,7 +2,8 @@
 // the header read from the raw bytes (ReadWireHeader), type, run id, MAC (common/message_auth.h),
 // freshness (the time window, the sender incarnation and sequence), then decode (rl::Decode),
 // Validate(), handler. Input: as fuzz_messages's (one byte selecting the type, then an encoded
-// message), delivered on that type's channel to a bus with a key and subscribed to every type.
+// message), delivered on that type's channel (common/channels.h) to a bus with a key and
+// subscribed to every channel.
 //
 // Each input goes in three times, at a receive time of its own (a window later than the previous
 // input's, so that no position of an earlier input guards against this one): as it is (its MAC,
@@ -23,7 +24,6 @@
 
 #include "common/lcm_bus.h"
 #include "common/message_auth.h"
-#include "fuzz/message_types.h"
 
 namespace {
 
@@ -42,10 +42,9 @@ constexpr int64_t kStep = kMaxAge + kSkew + kSecond;
 
 struct Harness {
   Harness() : bus(Config()), auth(Key()) {
-#define RL_FUZZ_SUBSCRIBE(type)                     \
-  channels.push_back(std::string("FUZZ_") + #type); \
-  bus.Subscribe<rlmsg::type>(channels.back(), [this](const rlmsg::type&) { ++handled; });
-    RL_FUZZ_MESSAGE_TYPES(RL_FUZZ_SUBSCRIBE)
+#define RL_FUZZ_SUBSCRIBE(type, constant, name, port) \
+  bus.Subscribe<rlmsg::type>(name, [this](const rlmsg::type&) { ++handled; });
+    RL_MESSAGES(RL_FUZZ_SUBSCRIBE)
 #undef RL_FUZZ_SUBSCRIBE
   }
   static std::string Key() { return std::string(rl::kKeyBytes, '\x2a'); }
@@ -59,7 +58,6 @@ struct Harness {
 
   rl::Bus bus;
   rl::MessageAuthenticator auth;
-  std::vector<std::string> channels;
   int64_t handled = 0;
   int64_t inputs = 0;
 };
@@ -88,7 +86,7 @@ void MoveNear(int64_t receive, const rl::WireHeader& h, uint8_t* data) {
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static Harness* h = new Harness();  // one bus for the whole run (its LCM instance is costly)
   if (size == 0) return 0;
-  const std::string& channel = h->channels[data[0] % h->channels.size()];
+  const std::string channel(rl::kMessages[data[0] % rl::kNumMessages].channel);
   std::vector<uint8_t> msg(data + 1, data + size);
   const rl::BusCounters before = h->bus.counters();
   const int64_t handled_before = h->handled;

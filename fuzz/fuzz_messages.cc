@@ -1,7 +1,8 @@
-// Fuzz target: what every receiver does with a message's bytes, for each of the 12 types:
-// rl::Decode<Msg>() (prescan of every length against the buffer, lcm-gen's decoder, every byte
-// used), then rl::Validate(). Input: one byte selecting the type (message_types.h), then the
-// encoded message as it travels on its channel (fingerprint first).
+// Fuzz target: what every receiver does with a message's bytes, for each type of
+// common/channels.h: rl::Decode<Msg>() (prescan of every length against the buffer, lcm-gen's
+// decoder, every byte used), then rl::Validate(). Input: one byte selecting the type (its index
+// in RL_MESSAGES, modulo their count), then the encoded message as it travels on its channel
+// (fingerprint first).
 //
 // Beyond "no crash, no leak, no UB, no huge allocation", a decoded message must survive the round
 // trip: re-encoded it has the input's size, decodes again and validates the same way. A
@@ -14,7 +15,6 @@
 #include <vector>
 
 #include "common/messages.h"
-#include "fuzz/message_types.h"
 
 namespace {
 
@@ -51,15 +51,14 @@ void Check(const uint8_t* data, size_t size) {
 }
 
 using CheckFn = void (*)(const uint8_t*, size_t);
-#define RL_FUZZ_CHECK(type) Check<rlmsg::type>,
-constexpr CheckFn kChecks[] = {RL_FUZZ_MESSAGE_TYPES(RL_FUZZ_CHECK)};
+#define RL_FUZZ_CHECK(type, constant, name, port) Check<rlmsg::type>,
+constexpr CheckFn kChecks[] = {RL_MESSAGES(RL_FUZZ_CHECK)};
 #undef RL_FUZZ_CHECK
-constexpr size_t kNumTypes = sizeof(kChecks) / sizeof(kChecks[0]);
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size == 0) return 0;
-  kChecks[data[0] % kNumTypes](data + 1, size - 1);
+  kChecks[data[0] % rl::kNumMessages](data + 1, size - 1);
   return 0;
 }

@@ -20,12 +20,12 @@
 #include <utility>
 #include <vector>
 
+#include "common/message_examples.h"
 #include "common/messages.h"
 #include "envs/specs.h"
 #include "fuzz/fuzz_support.h"
 #include "fuzz/handler_setup.h"
 #include "fuzz/learner_state.h"
-#include "fuzz/message_types.h"
 #include "learner/td3.h"
 #include "learner/weights_publisher.h"
 #include "nn/checkpoint.h"
@@ -49,32 +49,12 @@ void WriteFile(const fs::path& path, const std::string& bytes) {
 
 // ---- Messages ----
 
-template <class Msg>
-constexpr int TypeIndex() {
-  int i = 0, found = -1;
-#define RL_FUZZ_INDEX(type)                        \
-  if (std::is_same_v<Msg, rlmsg::type>) found = i; \
-  ++i;
-  RL_FUZZ_MESSAGE_TYPES(RL_FUZZ_INDEX)
-#undef RL_FUZZ_INDEX
-  return found;
-}
-
-rlmsg::header_t Header(const char* sender, int64_t seq) {
-  rlmsg::header_t h{};
-  h.run_id = 0x5eed1234abcdLL;
-  h.sender = sender;
-  h.seq = seq;
-  h.utime = 1764072000000000LL;
-  return h;
-}
-
-// Writes `msg` as "<dir>/<type>-<variant>": its type index (message_types.h), then its encoding.
+// Writes `msg` as "<dir>/<type>-<variant>": its type index (common/channels.h), then its encoding.
 template <class Msg>
 void WriteMessage(const fs::path& dir, const Msg& msg, const std::string& variant) {
   const int size = msg.getEncodedSize();
   std::string bytes(static_cast<size_t>(size) + 1, '\0');
-  bytes[0] = static_cast<char>(TypeIndex<Msg>());
+  bytes[0] = static_cast<char>(rl::MessageIndex(Msg::getTypeName()));
   if (msg.encode(bytes.data() + 1, 0, size) != size) {
     std::fprintf(stderr, "fuzz_seeds: %s does not encode\n", Msg::getTypeName());
     std::exit(1);
@@ -93,211 +73,20 @@ void WriteMessage(const fs::path& dir, const Msg& msg, const std::string& varian
   WriteFile(dir / (name + "-" + variant), bytes);
 }
 
+// The example of every type (common/message_examples.h), and the other kind of each batch.
 void WriteMessages(const fs::path& dir) {
-  {
-    rlmsg::checkpoint_t m{};
-    m.header = Header("learner", 7);
-    m.path = "runs/cartpole/checkpoints/ckpt-000005000.bin";
-    m.update = 5000;
-    m.env_steps = 40000;
-    m.wall_seconds = 61.5;
-    WriteMessage(dir, m, "a");
-  }
-  {
-    rlmsg::eval_result_t m{};
-    m.header = Header("evaluator", 3);
-    m.checkpoint = "runs/cartpole/checkpoints/ckpt-000005000.bin";
-    m.update = 5000;
-    m.env_steps = 40000;
-    m.wall_seconds = 75.25;
-    m.episodes = 100;
-    m.mean = 487.5;
-    m.std = 12.0;
-    m.min = 410;
-    m.max = 500;
-    m.goal_reached = 1;
-    WriteMessage(dir, m, "a");
-  }
-  {
-    rlmsg::flow_control_t m{};
-    m.header = Header("replay", 120);
-    m.insert_allowed = 1;
-    m.samples_per_insert = 7.5;
-    m.target_samples_per_insert = 8;
-    m.error_buffer = 100;
-    m.insert_credit = 64;
-    m.num_actors = 2;
-    m.actor_id = {0, 1};
-    m.actor_inserts = {1000, 998};
-    WriteMessage(dir, m, "a");
-    m.num_actors = 0;
-    m.actor_id.clear();
-    m.actor_inserts.clear();
-    m.insert_credit = -1;
-    WriteMessage(dir, m, "no-actors");
-  }
-  {
-    rlmsg::priority_update_t m{};
-    m.header = Header("learner", 9);
-    m.count = 3;
-    m.index = {5, 17, 99999};
-    m.priority = {0.5f, 1.25f, 0.0f};
-    WriteMessage(dir, m, "a");
-  }
-  {
-    rlmsg::sample_batch_t m{};
-    m.header = Header("replay", 44);
-    m.requester = "learner";
-    m.request_id = 12;
-    m.count = 2;
-    m.obs_size = 4;
-    m.num_values = 8;
-    m.obs = {0.1f, -0.2f, 0.3f, -0.4f, 0.5f, 0.6f, -0.7f, 0.8f};
-    m.next_obs = {0.2f, -0.3f, 0.4f, -0.5f, 0.6f, 0.7f, -0.8f, 0.9f};
-    m.action_width = 1;
-    m.num_action_values = 2;
-    m.action = {0, 1};
-    m.reward = {1, 1};
-    m.discount = {0.99f, 0};
-    m.index = {3, 8};
-    m.weight = {1, 0.5f};
-    m.replay_size = 1000;
-    m.total_inserts = 1200;
-    WriteMessage(dir, m, "flat");
-
-    rlmsg::sample_batch_t p{};
-    p.header = Header("replay", 45);
-    p.requester = "learner";
-    p.request_id = 13;
-    p.count = 1;
-    p.height = 4;
-    p.width = 3;
-    p.stack = 2;
-    p.num_bytes = 24;
-    p.obs_pixels.assign(24, 17);
-    p.next_obs_pixels.assign(24, 200);
-    p.action_width = 3;
-    p.num_action_values = 3;
-    p.action = {-0.5f, 1, 0};
-    p.reward = {-0.1f};
-    p.discount = {0.97f};
-    p.index = {0};
-    p.weight = {1};
-    p.replay_size = 1;
-    p.total_inserts = 1;
-    WriteMessage(dir, p, "pixels");
-  }
-  {
-    rlmsg::sample_request_t m{};
-    m.header = Header("learner", 12);
-    m.request_id = 12;
-    m.batch_size = 64;
-    WriteMessage(dir, m, "a");
-  }
-  {
-    rlmsg::stats_actor_t m{};
-    m.header = Header("actor-0", 30);
-    m.env_steps = 4000;
-    m.episodes = 50;
-    m.steps_per_second = 2000;
-    m.mean_return = 85.5;
-    m.epsilon = 0.4;
-    m.weights_version = 12;
-    m.transitions_published = 3990;
-    WriteMessage(dir, m, "a");
-  }
-  {
-    rlmsg::stats_evaluator_t m{};
-    m.header = Header("evaluator", 4);
-    m.checkpoints_scored = 3;
-    m.last_mean = 200;
-    m.best_mean = 250;
-    m.best_update = 4000;
-    m.busy = 1;
-    WriteMessage(dir, m, "a");
-  }
-  {
-    rlmsg::stats_learner_t m{};
-    m.header = Header("learner", 31);
-    m.updates = 5000;
-    m.updates_per_second = 150;
-    m.samples_per_second = 9600;
-    m.loss = 0.02;
-    m.mean_q = 30;
-    m.weights_version = 50;
-    m.env_steps = 40000;
-    WriteMessage(dir, m, "a");
-  }
-  {
-    rlmsg::stats_replay_t m{};
-    m.header = Header("replay", 32);
-    m.size = 40000;
-    m.capacity = 100000;
-    m.total_inserts = 40000;
-    m.total_samples = 320000;
-    m.inserts_per_second = 2000;
-    m.samples_per_second = 16000;
-    m.samples_per_insert = 8;
-    m.insert_allowed = 1;
-    m.prioritized = 1;
-    m.beta = 0.4;
-    m.memory_bytes = 1 << 20;
-    WriteMessage(dir, m, "a");
-  }
-  {
-    rlmsg::transition_batch_t m{};
-    m.header = Header("actor-1", 77);
-    m.actor_id = 1;
-    m.count = 2;
-    m.obs_size = 3;
-    m.num_values = 6;
-    m.obs = {0.5f, -1, 2, 0.25f, 0, 1};
-    m.next_obs = {0.4f, -1, 2, 0.2f, 0, 1};
-    m.action_width = 1;
-    m.num_action_values = 2;
-    m.action = {0.75f, -2};
-    m.reward = {-3.5f, -1};
-    m.discount = {0.99f, 0.99f};
-    m.episode_id = {4, 4};
-    m.priority = {0, 2};
-    WriteMessage(dir, m, "flat");
-
-    rlmsg::transition_batch_t p{};
-    p.header = Header("actor-0", 78);
-    p.count = 1;
-    p.height = 2;
-    p.width = 3;
-    p.stack = 2;
-    p.num_frames = 2;
-    p.frame_id = {10, 11};
-    p.num_bytes = 12;
-    p.frames = {0, 1, 2, 3, 4, 5, 250, 251, 252, 253, 254, 255};
-    p.num_refs = 2;
-    p.obs_frames = {9, 10};
-    p.next_obs_frames = {10, 11};
-    p.action_width = 1;
-    p.num_action_values = 1;
-    p.action = {3};
-    p.reward = {1};
-    p.discount = {0};
-    p.episode_id = {2};
-    p.priority = {0};
-    WriteMessage(dir, p, "pixels");
-  }
-  {
-    rlmsg::weights_chunk_t m{};
-    m.header = Header("learner", 5);
-    m.version = 3;
-    m.architecture = "linear(4,8),relu,linear(8,2)";
-    m.total_size = 58;
-    m.num_chunks = 2;
-    m.chunk_index = 1;
-    m.offset = 40;
-    m.count = 18;
-    for (int i = 0; i < m.count; ++i) m.data.push_back(0.01f * static_cast<float>(i - 9));
-    m.crc32 = 0xCBF43926LL;
-    WriteMessage(dir, m, "a");
-  }
+#define RL_WRITE_EXAMPLE(type, constant, name, port) \
+  WriteMessage(dir, rl::examples::Example<rlmsg::type>(), "a");
+  RL_MESSAGES(RL_WRITE_EXAMPLE)
+#undef RL_WRITE_EXAMPLE
+  rlmsg::flow_control_t flow = rl::examples::Example<rlmsg::flow_control_t>();
+  flow.num_actors = 0;
+  flow.actor_id.clear();
+  flow.actor_inserts.clear();
+  flow.insert_credit = -1;
+  WriteMessage(dir, flow, "no-actors");
+  WriteMessage(dir, rl::examples::PixelSamples(1, 4, 3, 2, 3), "pixels");
+  WriteMessage(dir, rl::examples::PixelTransitions(10, 1, 2, 3), "pixels");
 }
 
 // ---- Learner state files ----
@@ -372,7 +161,7 @@ std::string WeightsInput(uint8_t selector, const std::string& arch, int versions
     for (float& p : params) p *= 0.9f;
     for (rlmsg::weights_chunk_t& c :
          rl::learner::MakeWeightChunks(1000 * v, arch, params, chunk_floats)) {
-      c.header = Header("learner", seq++);
+      c.header = rl::examples::Header("learner", seq++);
       rl::fuzz::AppendRecord(&input, Encoded(c));
     }
   }
@@ -390,45 +179,21 @@ void WriteWeights(const fs::path& dir) {
   WriteFile(dir / "pendulum-chunks", WeightsInput(1, actor, 2, 150));
 }
 
-// A reply of `count` transitions of `setup`'s env (its observation size or frames, its actions).
+// A reply of `count` transitions of `setup`'s env (its observation size or frames, its actions:
+// in range for a discrete env, spread over [-1, 1] for a continuous one).
 rlmsg::sample_batch_t SampleReply(const rl::fuzz::DecoderSetup& setup, int count, int64_t id) {
   const rl::envs::EnvSpec spec = rl::envs::LookupSpec(setup.env);
-  rlmsg::sample_batch_t m{};
-  m.header = Header("replay", id);
-  m.requester = "learner";
+  rlmsg::sample_batch_t m =
+      spec.frame_stack > 0
+          ? rl::examples::PixelSamples(count, spec.frame_height, spec.frame_width, spec.frame_stack,
+                                       spec.action_width())
+          : rl::examples::FlatSamples(count, spec.observation_size, spec.action_width());
+  m.header.seq = id;
   m.request_id = id;
-  m.count = count;
-  if (spec.frame_stack > 0) {
-    m.height = spec.frame_height;
-    m.width = spec.frame_width;
-    m.stack = spec.frame_stack;
-    m.num_bytes = count * m.stack * m.height * m.width;
-    for (int i = 0; i < m.num_bytes; ++i) {
-      m.obs_pixels.push_back(static_cast<uint8_t>(i * 7));
-      m.next_obs_pixels.push_back(static_cast<uint8_t>(i * 11));
-    }
-  } else {
-    m.obs_size = spec.observation_size;
-    m.num_values = count * m.obs_size;
-    for (int i = 0; i < m.num_values; ++i) {
-      m.obs.push_back(0.1f * static_cast<float>(i % 9) - 0.4f);
-      m.next_obs.push_back(0.1f * static_cast<float>(i % 7) - 0.3f);
-    }
-  }
-  m.action_width = spec.action_width();
-  m.num_action_values = count * m.action_width;
   for (int i = 0; i < m.num_action_values; ++i) {
-    m.action.push_back(spec.continuous() ? 0.5f * static_cast<float>(i % 5 - 2)
-                                         : static_cast<float>(i % spec.num_actions));
+    m.action[static_cast<size_t>(i)] = spec.continuous() ? 0.5f * static_cast<float>(i % 5 - 2)
+                                                         : static_cast<float>(i % spec.num_actions);
   }
-  for (int i = 0; i < count; ++i) {
-    m.reward.push_back(static_cast<float>(i % 3) - 1.0f);
-    m.discount.push_back(i % 4 == 3 ? 0.0f : 0.99f);
-    m.index.push_back(100 + i);
-    m.weight.push_back(1.0f - 0.1f * static_cast<float>(i % 3));
-  }
-  m.replay_size = 500;
-  m.total_inserts = 800;
   return m;
 }
 
@@ -486,7 +251,7 @@ void WriteTransitionBatches(const fs::path& dir) {
     for (const auto& [first, actor] :
          {std::pair{0, 0}, std::pair{0, 2}, std::pair{6, 1}, std::pair{0, 5000}}) {
       rlmsg::transition_batch_t m = rl::fuzz::SetupBatch(config, first, 4, actor);
-      m.header = Header("actor-fuzz", seq++);
+      m.header = rl::examples::Header("actor-fuzz", seq++);
       rl::fuzz::AppendRecord(&input, Encoded(m));
     }
     WriteFile(dir / kinds[config], input);

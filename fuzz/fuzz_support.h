@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <iterator>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -42,14 +43,14 @@ std::vector<std::string_view> Records(const uint8_t* data, size_t size);
 /// Appends `bytes` to `input` as one record (the seed writer's side of Records()).
 void AppendRecord(std::string* input, std::string_view bytes);
 
-/// Publishes `bytes` on `channel` of `bus` as a message of type Msg from `sender` arrives, and
-/// lets the bus dispatch it. When the bytes decode, their header is replaced by a valid one of the
-/// bus's run (`*seq` as sequence number, then incremented; the current time; incarnation 1; no
-/// MAC, the bus having no key), so that the fuzzed fields get past the header checks to the
-/// handler; otherwise the bytes go as they are (and the bus drops them).
+/// Publishes `bytes` on `channel` of `bus` (on its port: Bus::PublishRaw) as a message of type Msg
+/// from `sender` arrives, and lets the bus dispatch it. When the bytes decode, their header is
+/// replaced by a valid one of the bus's run (`*seq` as sequence number, then incremented; the
+/// current time; incarnation 1; no MAC, the bus having no key), so that the fuzzed fields get past
+/// the header checks to the handler; otherwise the bytes go as they are (and the bus drops them).
 template <class Msg>
 void Deliver(Bus* bus, const std::string& channel, std::string_view bytes,
-             const std::string& sender, int64_t* seq, Port port = Port::kMain) {
+             const std::string& sender, int64_t* seq, std::optional<Port> port = std::nullopt) {
   Msg m{};
   if (Decode(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), &m) != nullptr) {
     bus->PublishRaw(channel, bytes.data(), bytes.size(), port);

@@ -1,11 +1,11 @@
 #include "fuzz/replay_setup.h"
 
-#include <algorithm>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "common/channels.h"
+#include "common/message_examples.h"
 #include "fuzz/fuzz_support.h"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
@@ -16,55 +16,6 @@ namespace rl::fuzz {
 namespace {
 
 constexpr int64_t kRunId = 42;
-
-rlmsg::transition_batch_t FlatBatch(int first, int count, int32_t actor) {
-  rlmsg::transition_batch_t m{};
-  m.actor_id = actor;
-  m.obs_size = 2;
-  m.count = count;
-  m.num_values = 2 * count;
-  m.action_width = 1;
-  m.num_action_values = count;
-  for (int v = first; v < first + count; ++v) {
-    m.obs.insert(m.obs.end(), {static_cast<float>(v), 0.5f});
-    m.next_obs.insert(m.next_obs.end(), {static_cast<float>(v + 1), 0.5f});
-    m.action.push_back(static_cast<float>(v % 2));
-    m.reward.push_back(1.0f);
-    m.discount.push_back(v % 9 == 8 ? 0.0f : 0.99f);
-    m.episode_id.push_back(v / 9);
-    m.priority.push_back(static_cast<float>(v % 4) / 2.0f);
-  }
-  return m;
-}
-
-// Frames first .. first + count (2 x 2 bytes) and transitions naming frames {t - 1, t}, {t, t + 1}.
-rlmsg::transition_batch_t PixelBatch(int first, int count, int32_t actor) {
-  rlmsg::transition_batch_t m{};
-  m.actor_id = actor;
-  m.action_width = 1;
-  m.num_action_values = count;
-  m.height = 2;
-  m.width = 2;
-  m.stack = 2;
-  m.num_frames = count + 1;
-  for (int f = first; f <= first + count; ++f) {
-    m.frame_id.push_back(f);
-    m.frames.insert(m.frames.end(), 4, static_cast<uint8_t>(f + actor));
-  }
-  m.num_bytes = static_cast<int32_t>(m.frames.size());
-  m.count = count;
-  m.num_refs = 2 * count;
-  for (int t = first; t < first + count; ++t) {
-    m.obs_frames.insert(m.obs_frames.end(), {std::max(t - 1, first), t});
-    m.next_obs_frames.insert(m.next_obs_frames.end(), {t, t + 1});
-    m.action.push_back(static_cast<float>(t % 3));
-    m.reward.push_back(0.5f);
-    m.discount.push_back(0.99f);
-    m.episode_id.push_back(0);
-    m.priority.push_back(0.0f);
-  }
-  return m;
-}
 
 replay::ReplayServiceOptions Options(int config) {
   replay::ReplayServiceOptions o;
@@ -82,7 +33,8 @@ replay::ReplayServiceOptions Options(int config) {
 }  // namespace
 
 rlmsg::transition_batch_t SetupBatch(int config, int first, int count, int32_t actor) {
-  return config == 2 ? PixelBatch(first, count, actor) : FlatBatch(first, count, actor);
+  return config == 2 ? examples::PixelTransitions(first, count, 2, 2, actor)
+                     : examples::FlatTransitions(first, count, 2, 1, actor);
 }
 
 Replica::Replica(int config) : config_(config), bus_(InProcessBusConfig(kRunId, "replay")) {

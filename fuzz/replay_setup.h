@@ -22,8 +22,8 @@ namespace rl::fuzz {
 inline constexpr int kNumReplayConfigs = 3;
 
 /// The batches Fill() inserts: transitions first .. first + count - 1 of `actor`, of
-/// configuration `config`'s kind (2 x 1 floats and a width-1 action, or 2 x 2 frames in stacks of
-/// two with their new frames).
+/// configuration `config`'s kind (common/message_examples.h: 2 floats and a width-1 action, or
+/// 2 x 2 frames in stacks of two with their new frames).
 rlmsg::transition_batch_t SetupBatch(int config, int first, int count, int32_t actor);
 
 class Replica {

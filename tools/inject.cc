@@ -15,6 +15,7 @@
 // have dropped as replayed (or as stale, when the recording is older than their freshness window)
 // every recorded message of their channels (the test plays the file with lcm-logplayer
 // meanwhile), with the replay's inserts and every lost count unchanged.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -32,6 +33,7 @@
 #include "common/channels.h"
 #include "common/clock.h"
 #include "common/message_auth.h"
+#include "common/message_examples.h"
 #include "common/options.h"
 #include "common/shutdown.h"
 #include "envs/specs.h"
@@ -67,10 +69,10 @@ std::vector<uint8_t> Encode(Msg m, const rlmsg::header_t& header) {
   return bytes;
 }
 
-// One channel: a well-formed message of the channel's type, and one with invalid content.
+// One channel: a well-formed message of the channel's type, and one with invalid content (sent
+// on the channel's port, common/channels.h).
 struct Target {
   std::string channel;
-  rl::Port port;
   std::function<std::vector<uint8_t>(const rlmsg::header_t&)> good;
   std::function<std::vector<uint8_t>(const rlmsg::header_t&)> invalid;
 };
@@ -87,99 +89,40 @@ Shape& RunShape() {
   return shape;
 }
 
-// The columns transition and sample batches share: one transition of the run env.
+// One transition of the run env, flat or in stacks of two 2x2 frames (common/message_examples.h),
+// with the env's valid action.
 template <class Msg>
-Msg OneTransition() {
-  const Shape& shape = RunShape();
-  Msg m{};
-  m.count = 1;
-  m.obs_size = m.num_values = shape.obs_size;
-  m.obs = m.next_obs = std::vector<float>(static_cast<size_t>(shape.obs_size), 0.0f);
-  m.action_width = m.num_action_values = static_cast<int32_t>(shape.action.size());
-  m.action = shape.action;
-  m.reward = {1};
-  m.discount = {0.99f};
+Msg WithRunAction(Msg m) {
+  m.action = RunShape().action;
+  m.action_width = m.num_action_values = static_cast<int32_t>(m.action.size());
   return m;
 }
-
-// The same with pixel observations instead: stacks of two 2x2 frames.
-template <class Msg>
-Msg WithPixels(Msg m) {
-  m.obs_size = m.num_values = 0;
-  m.obs.clear();
-  m.next_obs.clear();
-  m.height = m.width = m.stack = 2;
-  return m;
-}
-
 rlmsg::transition_batch_t Transitions() {
-  auto m = OneTransition<rlmsg::transition_batch_t>();
-  m.episode_id = {0};
-  m.priority = {0};
-  return m;
+  return WithRunAction(rl::examples::FlatTransitions(0, 1, RunShape().obs_size));
 }
-
-// Two 2x2 frames and one transition naming them.
 rlmsg::transition_batch_t PixelTransitions() {
-  auto m = WithPixels(Transitions());
-  m.num_frames = 2;
-  m.frame_id = {0, 1};
-  m.num_bytes = 8;
-  m.frames.assign(8, 100);
-  m.num_refs = 2;
-  m.obs_frames = {0, 0};
-  m.next_obs_frames = {0, 1};
-  return m;
+  return WithRunAction(rl::examples::PixelTransitions(0, 1, 2, 2));
 }
-
 rlmsg::sample_batch_t Samples() {
-  auto m = OneTransition<rlmsg::sample_batch_t>();
-  m.requester = "learner";
-  m.index = {0};
-  m.weight = {1};
-  return m;
+  return WithRunAction(rl::examples::FlatSamples(1, RunShape().obs_size));
 }
-
 rlmsg::sample_batch_t PixelSamples() {
-  auto m = WithPixels(Samples());
-  m.num_bytes = 8;
-  m.obs_pixels.assign(8, 0);
-  m.next_obs_pixels.assign(8, 0);
-  return m;
+  return WithRunAction(rl::examples::PixelSamples(1, 2, 2, 2));
 }
-
-rlmsg::priority_update_t Priorities() {
-  rlmsg::priority_update_t m{};
-  m.count = 1;
-  m.index = {0};
-  m.priority = {1};
-  return m;
-}
-
-rlmsg::weights_chunk_t Chunk() {
-  rlmsg::weights_chunk_t m{};
-  m.version = 1;
-  m.architecture = "linear(4,2)";
-  m.total_size = 2;
-  m.chunk_index = 0;
-  m.num_chunks = 1;
-  m.offset = 0;
-  m.count = 2;
-  m.data = {0, 0};
-  return m;
-}
+rlmsg::priority_update_t Priorities() { return rl::examples::Example<rlmsg::priority_update_t>(); }
+rlmsg::weights_chunk_t Chunk() { return rl::examples::WeightsChunk("linear(4,2)", 10, 1, 0); }
 
 std::vector<Target> Targets() {
   const float nan = std::nanf("");
   std::vector<Target> t;
-  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
+  t.push_back({rl::channels::kTransitions,
                [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
                [nan](const rlmsg::header_t& r) {
                  auto m = Transitions();
                  m.reward[0] = nan;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kSampleRequest, rl::Port::kMain,
+  t.push_back({rl::channels::kSampleRequest,
                [](const rlmsg::header_t& r) {
                  rlmsg::sample_request_t m{};
                  m.batch_size = 1;
@@ -191,14 +134,14 @@ std::vector<Target> Targets() {
                  m.batch_size = -5;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kSamples, rl::Port::kBulk,
+  t.push_back({rl::channels::kSamples,
                [](const rlmsg::header_t& r) { return Encode(Samples(), r); },
                [nan](const rlmsg::header_t& r) {
                  auto m = Samples();
                  m.obs[0] = nan;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
+  t.push_back({rl::channels::kTransitions,
                [](const rlmsg::header_t& r) { return Encode(PixelTransitions(), r); },
                [](const rlmsg::header_t& r) {
                  auto m = PixelTransitions();
@@ -209,21 +152,21 @@ std::vector<Target> Targets() {
   // well-formed but not the run env's (refused by the replay, which knows the env): a value far
   // out of range (an index for a discrete env, a bound for a continuous one), and one action
   // value too many. Each counts as one invalid message.
-  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
+  t.push_back({rl::channels::kTransitions,
                [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
                [nan](const rlmsg::header_t& r) {
                  auto m = Transitions();
                  m.action[0] = nan;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
+  t.push_back({rl::channels::kTransitions,
                [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
                [](const rlmsg::header_t& r) {
                  auto m = Transitions();
                  m.action[0] = 99;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kTransitions, rl::Port::kMain,
+  t.push_back({rl::channels::kTransitions,
                [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
                [](const rlmsg::header_t& r) {
                  auto m = Transitions();
@@ -231,28 +174,27 @@ std::vector<Target> Targets() {
                  m.action_width = m.num_action_values = static_cast<int32_t>(m.action.size());
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kPriorities, rl::Port::kMain,
+  t.push_back({rl::channels::kPriorities,
                [](const rlmsg::header_t& r) { return Encode(Priorities(), r); },
                [nan](const rlmsg::header_t& r) {
                  auto m = Priorities();
                  m.priority[0] = nan;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kSamples, rl::Port::kBulk,
+  t.push_back({rl::channels::kSamples,
                [](const rlmsg::header_t& r) { return Encode(PixelSamples(), r); },
                [](const rlmsg::header_t& r) {
                  auto m = PixelSamples();
                  m.discount[0] = 2;  // outside [0, 1]
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kWeights, rl::Port::kBulk,
-               [](const rlmsg::header_t& r) { return Encode(Chunk(), r); },
+  t.push_back({rl::channels::kWeights, [](const rlmsg::header_t& r) { return Encode(Chunk(), r); },
                [](const rlmsg::header_t& r) {
                  auto m = Chunk();
                  m.chunk_index = 3;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kFlow, rl::Port::kMain,
+  t.push_back({rl::channels::kFlow,
                [](const rlmsg::header_t& r) {
                  rlmsg::flow_control_t m{};
                  m.insert_allowed = 1;
@@ -263,7 +205,7 @@ std::vector<Target> Targets() {
                  m.insert_allowed = 7;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kCheckpoint, rl::Port::kMain,
+  t.push_back({rl::channels::kCheckpoint,
                [](const rlmsg::header_t& r) {
                  rlmsg::checkpoint_t m{};
                  m.path = "/nonexistent/ckpt.bin";
@@ -276,8 +218,7 @@ std::vector<Target> Targets() {
   // Channels nobody subscribes to in a given role still get the garbage.
   for (const char* ch : {rl::channels::kEval, rl::channels::kStatsActor, rl::channels::kStatsReplay,
                          rl::channels::kStatsLearner, rl::channels::kStatsEvaluator}) {
-    t.push_back({ch, rl::Port::kMain,
-                 [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
+    t.push_back({ch, [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
                  [](const rlmsg::header_t& r) { return Encode(Transitions(), r); }});
   }
   return t;
@@ -497,7 +438,7 @@ int Main(int argc, char** argv) {
   int sent = 0;
   for (const Target& t : Targets()) {
     auto send = [&](const std::vector<uint8_t>& bytes) {
-      bus.PublishRaw(t.channel, bytes.data(), bytes.size(), t.port);
+      bus.PublishRaw(t.channel, bytes.data(), bytes.size());
       ++sent;
     };
     for (int k = 0; k < count; ++k) {

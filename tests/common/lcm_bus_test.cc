@@ -2,6 +2,10 @@
 
 #include <cmath>
 #include <limits>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -9,6 +13,7 @@
 
 #include "common/channels.h"
 #include "common/message_auth.h"
+#include "common/message_examples.h"
 
 namespace rl {
 namespace {
@@ -18,21 +23,7 @@ BusConfig MemqConfig(int64_t run_id, const std::string& sender) {
 }
 
 rlmsg::transition_batch_t MakeBatch(int count, int obs_size) {
-  rlmsg::transition_batch_t m{};
-  m.actor_id = 1;
-  m.obs_size = obs_size;
-  m.count = count;
-  m.num_values = count * obs_size;
-  m.obs.assign(static_cast<size_t>(m.num_values), 0.5f);
-  m.next_obs.assign(static_cast<size_t>(m.num_values), 0.25f);
-  m.action_width = 1;
-  m.num_action_values = count;
-  m.action.assign(static_cast<size_t>(count), 1.0f);
-  m.reward.assign(static_cast<size_t>(count), 1.0f);
-  m.discount.assign(static_cast<size_t>(count), 0.99f);
-  m.episode_id.assign(static_cast<size_t>(count), 7);
-  m.priority.assign(static_cast<size_t>(count), 0.0f);
-  return m;
+  return examples::FlatTransitions(0, count, obs_size, 1, /*actor=*/1);
 }
 
 // Encoded as actor-1 of run 42 would send it now (a fresh time, an incarnation just before it).
@@ -548,6 +539,56 @@ TEST(BusSenderTest, RefusesASenderNameUnfitForTheNonceAndDropsSuchMessagesAsMalf
   }
   EXPECT_EQ(got, 0);
   EXPECT_EQ(bus.counters().malformed, 2);
+}
+
+// The table of common/channels.h: every type of lcmtypes/ but header_t once, each on a channel of
+// its own; the example of each passes Validate() and reaches a subscriber of its channel (so the
+// publisher and the subscriber chose the same port), in the table's order.
+TEST(MessageTableTest, ListsEveryTypeOnceAndEachExampleCrossesTheBus) {
+  std::set<std::string_view> types, names;
+  for (const MessageInfo& m : kMessages) {
+    types.insert(m.type);
+    names.insert(m.channel);
+  }
+  EXPECT_EQ(types.size(), kNumMessages);
+  EXPECT_EQ(names.size(), kNumMessages);
+  EXPECT_EQ(LcmSchemas().size(), kNumMessages + 1) << "a .lcm file without a line in the table";
+  EXPECT_EQ(MessageIndex("header_t"), -1);
+
+  Bus bus(MemqConfig(5, "test"));
+  std::vector<std::string> got;
+  int index = 0;
+#define RL_CHECK_LINE(type, constant, name, on_port)                                      \
+  EXPECT_EQ(MessageIndex(rlmsg::type::getTypeName()), index++);                           \
+  EXPECT_EQ(FindChannel(channels::constant)->port, Port::on_port);                        \
+  bus.Subscribe<rlmsg::type>(name, [&got](const rlmsg::type&) { got.push_back(#type); }); \
+  {                                                                                       \
+    rlmsg::type m = examples::Example<rlmsg::type>();                                     \
+    EXPECT_EQ(Validate(m), nullptr) << #type;                                             \
+    EXPECT_TRUE(bus.Publish(name, &m));                                                   \
+  }
+  RL_MESSAGES(RL_CHECK_LINE)
+#undef RL_CHECK_LINE
+  for (int i = 0; i < 100 && got.size() < kNumMessages; ++i) bus.Handle(10);
+  ASSERT_EQ(got.size(), kNumMessages) << "some example was dropped or went on another port";
+  EXPECT_EQ(bus.counters().dropped(), 0);
+}
+
+// A channel of the table takes only its type, on its port; other channels take any.
+TEST(MessageTableTest, RefusesAnotherTypeOrPortOnAChannelOfTheTable) {
+  Bus bus(MemqConfig(5, "test"));
+  EXPECT_THROW(
+      bus.Subscribe<rlmsg::checkpoint_t>(channels::kTransitions, [](const rlmsg::checkpoint_t&) {}),
+      std::invalid_argument);
+  rlmsg::checkpoint_t c = examples::Example<rlmsg::checkpoint_t>();
+  EXPECT_THROW(bus.Publish(channels::kWeights, &c), std::invalid_argument);
+  rlmsg::weights_chunk_t w = examples::Example<rlmsg::weights_chunk_t>();
+  EXPECT_THROW(bus.Publish(channels::kWeights, &w, Port::kMain), std::invalid_argument);
+  EXPECT_EQ(ChannelPort(channels::kWeights, "weights_chunk_t", std::nullopt), Port::kBulk);
+  EXPECT_EQ(ChannelPort(channels::kWeights, "", std::nullopt), Port::kBulk);
+  EXPECT_EQ(ChannelPort("TEST_CHANNEL", "checkpoint_t", std::nullopt), Port::kMain);
+  EXPECT_EQ(ChannelPort("TEST_CHANNEL", "checkpoint_t", Port::kBulk), Port::kBulk);
+  EXPECT_TRUE(bus.Publish("TEST_CHANNEL", &c));
 }
 
 }  // namespace

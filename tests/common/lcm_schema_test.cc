@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/message_examples.h"
 #include "common/messages.h"
 
 namespace rl {
@@ -86,71 +87,27 @@ TEST(LcmSchemaTest, RefusesWhatItCannotReadWithTheFileName) {
 
 // Every type of lcmtypes/ is embedded, under its file's name.
 TEST(LcmSchemaTest, EmbedsEveryMessageType) {
-  for (const char* type :
-       {"header_t", "transition_batch_t", "sample_batch_t", "sample_request_t", "priority_update_t",
-        "flow_control_t", "weights_chunk_t", "checkpoint_t", "eval_result_t", "stats_actor_t",
-        "stats_replay_t", "stats_learner_t", "stats_evaluator_t"}) {
-    ASSERT_EQ(LcmSchemas().count(type), 1u) << type;
-    EXPECT_EQ(LcmSchemas().at(type).package, "rlmsg") << type;
-  }
+  size_t types = 0;
+#define RL_EXPECT_EMBEDDED(type)                               \
+  ASSERT_EQ(LcmSchemas().count(#type), 1u) << #type;           \
+  EXPECT_EQ(LcmSchemas().at(#type).package, "rlmsg") << #type; \
+  ++types;
+  RLMSG_ALL_TYPES(RL_EXPECT_EMBEDDED)
+#undef RL_EXPECT_EMBEDDED
+  EXPECT_EQ(types, LcmSchemas().size());
   EXPECT_STREQ(PrescanEncoded("no_such_t", nullptr, 0), "no schema");
 }
 
+// Every message of common/channels.h, empty and as its example (every array filled), and the
+// pixel kinds of the batches.
 TEST(LcmSchemaTest, PrescanAgreesWithTheEncodingOfEveryType) {
-  rlmsg::transition_batch_t t{};
-  t.header.sender = "actor-1";
-  t.count = 2;
-  t.obs_size = 0;
-  t.height = t.width = 2;
-  t.stack = 2;
-  t.num_frames = 3;
-  t.frame_id = {0, 1, 2};
-  t.num_bytes = 12;
-  t.frames.assign(12, 7);
-  t.num_refs = 4;
-  t.obs_frames = t.next_obs_frames = {0, 1, 1, 2};
-  t.action_width = 3;
-  t.num_action_values = 6;
-  t.action.assign(6, 0.5f);
-  t.reward = t.discount = t.priority = {1, 0};
-  t.episode_id = {4, 4};
-  ExpectPrescanAgrees(t);
-
-  rlmsg::sample_batch_t s{};
-  s.requester = "learner";
-  s.count = 1;
-  s.obs_size = 3;
-  s.num_values = 3;
-  s.obs = s.next_obs = {1, 2, 3};
-  s.action_width = 1;
-  s.num_action_values = 1;
-  s.action = {2};
-  s.reward = s.discount = s.weight = {1};
-  s.index = {9};
-  ExpectPrescanAgrees(s);
-
-  rlmsg::weights_chunk_t w{};
-  w.architecture = "linear(2,1)";
-  w.count = 3;
-  w.data = {1, 2, 3};
-  ExpectPrescanAgrees(w);
-
-  rlmsg::priority_update_t p{};
-  p.count = 2;
-  p.index = {1, 2};
-  p.priority = {0.5f, 0.25f};
-  ExpectPrescanAgrees(p);
-
-  rlmsg::checkpoint_t c{};
-  c.path = "/runs/x/ckpt.bin";
-  ExpectPrescanAgrees(c);
-  ExpectPrescanAgrees(rlmsg::sample_request_t{});
-  ExpectPrescanAgrees(rlmsg::flow_control_t{});
-  ExpectPrescanAgrees(rlmsg::eval_result_t{});
-  ExpectPrescanAgrees(rlmsg::stats_actor_t{});
-  ExpectPrescanAgrees(rlmsg::stats_replay_t{});
-  ExpectPrescanAgrees(rlmsg::stats_learner_t{});
-  ExpectPrescanAgrees(rlmsg::stats_evaluator_t{});
+#define RL_EXPECT_AGREES(type, constant, name, port) \
+  ExpectPrescanAgrees(rlmsg::type{});                \
+  ExpectPrescanAgrees(examples::Example<rlmsg::type>());
+  RL_MESSAGES(RL_EXPECT_AGREES)
+#undef RL_EXPECT_AGREES
+  ExpectPrescanAgrees(examples::PixelTransitions(0, 2, 2, 2));
+  ExpectPrescanAgrees(examples::PixelSamples(2, 2, 2, 2, 3));
 }
 
 // A forged length is refused from the bytes, before anything is sized from it.

@@ -1,5 +1,6 @@
 #include "common/messages.h"
 #include "common/message_auth.h"
+#include "common/message_examples.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,21 +22,7 @@ std::vector<uint8_t> Encode(Msg m) {
 
 // A valid flat batch: `count` transitions of `obs_size` floats and `action_width` action values.
 rlmsg::transition_batch_t FlatBatch(int count, int obs_size, int action_width) {
-  rlmsg::transition_batch_t m{};
-  m.header.sender = "actor-0";
-  m.count = count;
-  m.obs_size = obs_size;
-  m.num_values = count * obs_size;
-  m.obs.assign(static_cast<size_t>(m.num_values), 1.0f);
-  m.next_obs.assign(static_cast<size_t>(m.num_values), 2.0f);
-  m.action_width = action_width;
-  m.num_action_values = count * action_width;
-  m.action.assign(static_cast<size_t>(m.num_action_values), 1.0f);
-  m.reward.assign(static_cast<size_t>(count), 0.5f);
-  m.discount.assign(static_cast<size_t>(count), 0.9f);
-  m.episode_id.assign(static_cast<size_t>(count), 3);
-  m.priority.assign(static_cast<size_t>(count), 0.0f);
-  return m;
+  return examples::FlatTransitions(0, count, obs_size, action_width);
 }
 
 TEST(ValidateTest, AcceptsAFlatBatchAndRefusesAnInconsistentOne) {
@@ -101,42 +88,12 @@ TEST(ValidateTest, RefusesBatchesWithBothOrNeitherObservationKind) {
 }
 
 TEST(ValidateTest, AcceptsAWeightsChunk) {
-  rlmsg::weights_chunk_t m{};
-  m.header.sender = "test";
-  m.version = 3;
-  m.architecture = "linear(4,2)";
-  m.total_size = 10;
-  m.num_chunks = 1;
-  m.count = 10;
-  m.data.assign(10, 0.25f);
-  m.crc32 = 12345;
+  const rlmsg::weights_chunk_t m = examples::WeightsChunk("linear(4,2)", 10, 1, 0);
   EXPECT_EQ(Validate(m), nullptr);
 }
 
 // Two 2 x 3 frames (ids 7 and 8) and one transition of stack 2 naming them.
-rlmsg::transition_batch_t PixelBatch() {
-  rlmsg::transition_batch_t m{};
-  m.header.sender = "actor-0";
-  m.height = 2;
-  m.width = 3;
-  m.stack = 2;
-  m.num_frames = 2;
-  m.frame_id = {7, 8};
-  m.num_bytes = 12;
-  m.frames.assign(12, 200);
-  m.count = 1;
-  m.num_refs = 2;
-  m.obs_frames = {7, 7};
-  m.next_obs_frames = {7, 8};
-  m.action_width = 1;
-  m.num_action_values = 1;
-  m.action = {2};
-  m.reward = {1.0f};
-  m.discount = {0.99f};
-  m.episode_id = {0};
-  m.priority = {0.0f};
-  return m;
-}
+rlmsg::transition_batch_t PixelBatch() { return examples::PixelTransitions(7, 1, 2, 3); }
 
 TEST(PrescanTest, RefusesAPixelBatchWithAForgedFrameLength) {
   rlmsg::transition_batch_t m = PixelBatch();
@@ -172,23 +129,7 @@ TEST(ValidateTest, RefusesInconsistentPixelBatches) {
 }
 
 TEST(ValidateTest, ChecksPixelSampleBatchesAndPriorityUpdates) {
-  rlmsg::sample_batch_t m{};
-  m.header.sender = "replay";
-  m.requester = "learner";
-  m.height = 2;
-  m.width = 2;
-  m.stack = 3;
-  m.count = 2;
-  m.num_bytes = 24;
-  m.obs_pixels.assign(24, 1);
-  m.next_obs_pixels.assign(24, 2);
-  m.action_width = 1;
-  m.num_action_values = 2;
-  m.action = {0, 1};
-  m.reward = {0.0f, 1.0f};
-  m.discount = {0.9f, 0.0f};
-  m.index = {4, 5};
-  m.weight = {1.0f, 0.5f};
+  rlmsg::sample_batch_t m = examples::PixelSamples(2, 2, 2, 3);
   EXPECT_EQ(Validate(m), nullptr);
   m.num_bytes = 23;
   EXPECT_STREQ(Validate(m), "num_bytes mismatch");

@@ -16,6 +16,7 @@
 
 #include "common/channels.h"
 #include "common/lcm_bus.h"
+#include "common/message_examples.h"
 
 namespace rl::replay {
 namespace {
@@ -33,26 +34,12 @@ ReplayServiceOptions Options(double spi, int64_t min_size, double error_buffer) 
   return o;
 }
 
-// Transition v has obs {v, v + 0.5, ...}, next_obs obs + 1000, action v % 2, reward v / 4.
+// Transition v has obs {v, v + 0.5, ...}, next_obs obs + 1000, action v % 2, reward v / 4,
+// no priority given.
 rlmsg::transition_batch_t MakeBatch(int first, int count, int obs_size) {
-  rlmsg::transition_batch_t m{};
-  m.actor_id = 0;
-  m.obs_size = obs_size;
-  m.count = count;
-  m.num_values = count * obs_size;
-  m.action_width = 1;
-  m.num_action_values = count;
-  for (int v = first; v < first + count; ++v) {
-    for (int j = 0; j < obs_size; ++j) {
-      m.obs.push_back(static_cast<float>(v) + 0.5f * static_cast<float>(j));
-      m.next_obs.push_back(static_cast<float>(v) + 0.5f * static_cast<float>(j) + 1000.0f);
-    }
-    m.action.push_back(static_cast<float>(v % 2));
-    m.reward.push_back(static_cast<float>(v) / 4.0f);
-    m.discount.push_back(0.99f);
-    m.episode_id.push_back(0);
-    m.priority.push_back(0.0f);
-  }
+  rlmsg::transition_batch_t m = examples::FlatTransitions(first, count, obs_size);
+  for (float& r : m.reward) r /= 4.0f;
+  m.priority.assign(m.priority.size(), 0.0f);
   return m;
 }
 
@@ -375,30 +362,7 @@ TEST_F(ReplayServiceTest, TickPublishesFlowAndStatsAtTheirRates) {
 // to f), transition t with stack 2 naming frames {t - 1, t} (frame 0 repeated for t = 0) and
 // next stack {t, t + 1}, action t % 3.
 rlmsg::transition_batch_t MakePixelBatch(int count) {
-  rlmsg::transition_batch_t m{};
-  m.action_width = 1;
-  m.num_action_values = count;
-  m.height = 2;
-  m.width = 2;
-  m.stack = 2;
-  m.num_frames = count + 1;
-  for (int f = 0; f <= count; ++f) {
-    m.frame_id.push_back(f);
-    m.frames.insert(m.frames.end(), 4, static_cast<uint8_t>(f));
-  }
-  m.num_bytes = static_cast<int32_t>(m.frames.size());
-  m.count = count;
-  m.num_refs = 2 * count;
-  for (int t = 0; t < count; ++t) {
-    m.obs_frames.insert(m.obs_frames.end(), {std::max(t - 1, 0), t});
-    m.next_obs_frames.insert(m.next_obs_frames.end(), {t, t + 1});
-    m.action.push_back(static_cast<float>(t % 3));
-    m.reward.push_back(static_cast<float>(t));
-    m.discount.push_back(0.99f);
-    m.episode_id.push_back(0);
-    m.priority.push_back(0.0f);
-  }
-  return m;
+  return examples::PixelTransitions(0, count, 2, 2);
 }
 
 TEST_F(ReplayServiceTest, StoresPixelTransitionsAndAnswersWithRebuiltStacks) {

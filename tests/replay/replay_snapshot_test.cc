@@ -21,6 +21,7 @@
 #include "common/channels.h"
 #include "common/crc32.h"
 #include "common/lcm_bus.h"
+#include "common/message_examples.h"
 #include "common/state_file.h"
 #include "replay/replay_service.h"
 #include "replay/snapshotter.h"
@@ -33,57 +34,15 @@ namespace fs = std::filesystem;
 constexpr int64_t kRunId = 42;
 
 // Transitions first .. first + count - 1 of one actor, obs {v, v + 0.5, v + 1, v + 1.5},
-// priority (v % 7) / 2 (0: none given).
+// reward v, priority (v % 7) / 2 (0: none given).
 rlmsg::transition_batch_t FlatBatch(int first, int count, int32_t actor = 0) {
-  rlmsg::transition_batch_t m{};
-  m.actor_id = actor;
-  m.obs_size = 4;
-  m.count = count;
-  m.num_values = count * 4;
-  m.action_width = 1;
-  m.num_action_values = count;
-  for (int v = first; v < first + count; ++v) {
-    for (int j = 0; j < 4; ++j) {
-      m.obs.push_back(static_cast<float>(v) + 0.5f * static_cast<float>(j));
-      m.next_obs.push_back(static_cast<float>(v) + 0.5f * static_cast<float>(j) + 1000.0f);
-    }
-    m.action.push_back(static_cast<float>(v % 2));
-    m.reward.push_back(static_cast<float>(v));
-    m.discount.push_back(0.99f);
-    m.episode_id.push_back(v / 10);
-    m.priority.push_back(static_cast<float>(v % 7) / 2.0f);
-  }
-  return m;
+  return examples::FlatTransitions(first, count, 4, 1, actor);
 }
 
 // Pixel frames first_frame .. first_frame + count of one actor (3 x 2 bytes, every byte of frame
 // f equal to f + actor), and transitions t naming frames {t - 1, t} and {t, t + 1}.
 rlmsg::transition_batch_t PixelBatch(int first_frame, int count, int32_t actor) {
-  rlmsg::transition_batch_t m{};
-  m.actor_id = actor;
-  m.action_width = 1;
-  m.num_action_values = count;
-  m.height = 3;
-  m.width = 2;
-  m.stack = 2;
-  m.num_frames = count + 1;
-  for (int f = first_frame; f <= first_frame + count; ++f) {
-    m.frame_id.push_back(f);
-    m.frames.insert(m.frames.end(), 6, static_cast<uint8_t>(f + actor));
-  }
-  m.num_bytes = static_cast<int32_t>(m.frames.size());
-  m.count = count;
-  m.num_refs = 2 * count;
-  for (int t = first_frame; t < first_frame + count; ++t) {
-    m.obs_frames.insert(m.obs_frames.end(), {std::max(t - 1, first_frame), t});
-    m.next_obs_frames.insert(m.next_obs_frames.end(), {t, t + 1});
-    m.action.push_back(static_cast<float>(t % 3));
-    m.reward.push_back(static_cast<float>(t));
-    m.discount.push_back(0.99f);
-    m.episode_id.push_back(0);
-    m.priority.push_back(0.0f);
-  }
-  return m;
+  return examples::PixelTransitions(first_frame, count, 3, 2, actor);
 }
 
 ReplayServiceOptions Options(bool prioritized, int64_t capacity = 200) {
