@@ -128,20 +128,20 @@ RL_INSTANTIATE_KERNEL_PATHS(Bf16GemmTest);
 // bound). The bound scale of an entry adds |bias| and |start| to sum |a| |b|.
 void CheckBf16Gemm(int m, int n, int k) {
   std::mt19937 rng(static_cast<unsigned>(m * 7919 + n * 131 + k));
-  Vector workspace;
   const GemmOperands o(m, n, k, &rng);
   const Matrix reference = Bf16Product(o.a, o.b);
   const Matrix exact = (o.a.cast<double>() * o.b.cast<double>()).cast<float>();
   const Matrix abs_product = AbsProduct(o.a, o.b);
-  for (int mode = 0; mode < 64; ++mode) {
-    Matrix offset, offset_scale;
-    const Matrix got = GemmInMode(o, mode, Precision::kBf16, &workspace, &offset, &offset_scale);
-    const Matrix scale = abs_product + offset_scale;
-    EXPECT_LE(WorstBoundRatio(got, reference + offset, scale, SharpBf16Bound(k)), 1.0)
-        << m << "x" << k << " * " << k << "x" << n << " mode " << mode << " against the reference";
-    EXPECT_LE(WorstBoundRatio(got, exact + offset, scale, Bf16Bound(k)), 1.0)
-        << m << "x" << k << " * " << k << "x" << n << " mode " << mode << " against fp32";
-  }
+  ForEachGemmMode(
+      o, Precision::kBf16,
+      [&](int mode, const Matrix& got, const Matrix& offset, const Matrix& offset_scale) {
+        const Matrix scale = abs_product + offset_scale;
+        EXPECT_LE(WorstBoundRatio(got, reference + offset, scale, SharpBf16Bound(k)), 1.0)
+            << m << "x" << k << " * " << k << "x" << n << " mode " << mode
+            << " against the reference";
+        EXPECT_LE(WorstBoundRatio(got, exact + offset, scale, Bf16Bound(k)), 1.0)
+            << m << "x" << k << " * " << k << "x" << n << " mode " << mode << " against fp32";
+      });
 }
 
 TEST_P(Bf16GemmTest, MatchesTheReferenceOnEveryLayout) {
