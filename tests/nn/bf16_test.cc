@@ -314,7 +314,7 @@ TEST(Bf16BoundTest, CatchesAWrongKernel) {
 }
 
 // The convolution geometries of the unit tests and of the networks.
-struct ConvCase {
+struct Bf16ConvCase {
   int in_channels, out_channels, kernel, stride, padding, height, width;
 };
 
@@ -371,9 +371,10 @@ void CheckBf16Layer(const MakeLayer& make, int batch, int k, const std::string& 
 }
 
 TEST_P(Bf16LayerTest, ConvolutionsMatchTheFp32KernelOnRoundedInputs) {
-  for (const ConvCase& g : {ConvCase{4, 32, 8, 4, 0, 84, 84}, ConvCase{32, 64, 4, 2, 0, 20, 20},
-                            ConvCase{64, 64, 3, 1, 0, 9, 9}, ConvCase{3, 20, 3, 2, 1, 13, 11},
-                            ConvCase{16, 32, 4, 2, 0, 20, 20}, ConvCase{8, 24, 5, 1, 0, 5, 5}}) {
+  for (const Bf16ConvCase& g :
+       {Bf16ConvCase{4, 32, 8, 4, 0, 84, 84}, Bf16ConvCase{32, 64, 4, 2, 0, 20, 20},
+        Bf16ConvCase{64, 64, 3, 1, 0, 9, 9}, Bf16ConvCase{3, 20, 3, 2, 1, 13, 11},
+        Bf16ConvCase{16, 32, 4, 2, 0, 20, 20}, Bf16ConvCase{8, 24, 5, 1, 0, 5, 5}}) {
     const int batch = 5;
     const int oh = (g.height + 2 * g.padding - g.kernel) / g.stride + 1;
     const int ow = (g.width + 2 * g.padding - g.kernel) / g.stride + 1;
