@@ -20,8 +20,10 @@ endfunction()
 # rl_add_test(name SOURCES ... DEPS ... [LABELS ...] [NO_UNITY]): a GoogleTest unit test, label
 # "unit". With RL_UNITY_TESTS its sources compile in batches of 8 (one translation unit each),
 # which parses GoogleTest and Eigen once a batch instead of once a file: a test file's names at
-# namespace scope must then differ from those of the other files of its program. NO_UNITY: one
-# translation unit a file (for programs whose files define the same names).
+# namespace scope must then differ from those of the other files of its batch: a repeated type or
+# variable fails to compile, but a repeated function name of other parameters becomes an overload
+# set, where a call may silently take another file's function. NO_UNITY: one translation unit a
+# file (for programs whose files define the same names).
 function(rl_add_test name)
   cmake_parse_arguments(ARG "NO_UNITY" "" "SOURCES;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
