@@ -17,10 +17,19 @@ function(rl_add_executable name)
   rl_set_warnings(${name})
 endfunction()
 
-# rl_add_test(name SOURCES ... DEPS ... [LABELS ...]): a GoogleTest unit test, label "unit".
+# rl_add_test(name SOURCES ... DEPS ... [LABELS ...] [NO_UNITY]): a GoogleTest unit test, label
+# "unit". With RL_UNITY_TESTS its sources compile in batches of 8 (one translation unit each),
+# which parses GoogleTest and Eigen once a batch instead of once a file: a test file's names at
+# namespace scope must then differ from those of the other files of its batch: a repeated type or
+# variable fails to compile, but a repeated function name of other parameters becomes an overload
+# set, where a call may silently take another file's function. NO_UNITY: one translation unit a
+# file (for programs whose files define the same names).
 function(rl_add_test name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "NO_UNITY" "" "SOURCES;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
+  if(RL_UNITY_TESTS AND NOT ARG_NO_UNITY)
+    set_target_properties(${name} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
+  endif()
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   rl_set_warnings(${name})
   if(NOT ARG_LABELS)

@@ -131,17 +131,13 @@ expect_resumable_after_launcher_death() {  # expect_resumable_after_launcher_dea
     fail "the replay did not stop cleanly (no last snapshot): $(tail -3 "$run/logs/replay.log")"
   grep -q "^learner: stopped after " "$run/logs/learner.log" ||
     fail "the learner did not stop cleanly: $(tail -3 "$run/logs/learner.log")"
-  set +e
-  "$root/scripts/launch.sh" --stop "$run" > "$run/../stop.log" 2>&1
-  status=$?
-  set -e
+  status=0
+  "$root/scripts/launch.sh" --stop "$run" > "$run/../stop.log" 2>&1 || status=$?
   [ "$status" -eq 1 ] && grep -q "is not going" "$run/../stop.log" ||
     fail "--stop after the launcher's end (status $status): $(cat "$run/../stop.log")"
-  set +e
+  status=0
   "$root/scripts/launch.sh" --resume "$run" --no-setup --build-dir "$build_dir" --time-budget 240 \
-    > "$run/../resumed.log" 2>&1
-  status=$?
-  set -e
+    > "$run/../resumed.log" 2>&1 || status=$?
   tail -4 "$run/../resumed.log"
   [ "$status" -eq 0 ] || fail "the resumed run exited with $status"
   grep -q "resumed at update [1-9]" "$run/logs/learner.log" || fail "the learner did not resume"

@@ -23,6 +23,16 @@ namespace {
 using testing::AllocationCount;
 using testing::AllocationCountingAvailable;
 
+// The heap allocations of `repeats` calls of `work` made after `warmup` calls (which may allocate:
+// they size the buffers).
+template <typename Work>
+int64_t AllocationsOfRepeats(int warmup, int repeats, Work&& work) {
+  for (int i = 0; i < warmup; ++i) work();
+  const int64_t before = AllocationCount();
+  for (int i = 0; i < repeats; ++i) work();
+  return AllocationCount() - before;
+}
+
 TEST(AllocationTest, CounterSeesAllocations) {
   ASSERT_TRUE(AllocationCountingAvailable()) << "this test needs glibc without a sanitizer";
   const int64_t before = AllocationCount();
@@ -75,10 +85,7 @@ TEST(AllocationTest, DqnUpdateDoesNotAllocateOnceShapesAreStable) {
     adam.Step();
     target.SoftUpdateFrom(online, 0.005f);
   };
-  update();
-  const int64_t before = AllocationCount();
-  for (int i = 0; i < 10; ++i) update();
-  EXPECT_EQ(AllocationCount() - before, 0);
+  EXPECT_EQ(AllocationsOfRepeats(1, 10, update), 0);
   // The full backward pass too.
   online.Forward(obs);
   online.Backward(grad_q);
@@ -137,10 +144,7 @@ TEST(AllocationTest, GraspCnnUpdateDoesNotAllocateOnceShapesAreStable) {
     rmsprop.Step();
     target.CopyParamsFrom(online);
   };
-  update();
-  const int64_t before = AllocationCount();
-  for (int i = 0; i < 3; ++i) update();
-  EXPECT_EQ(AllocationCount() - before, 0);
+  EXPECT_EQ(AllocationsOfRepeats(1, 3, update), 0);
 }
 
 // With two threads (nn/parallel.h) the pool hands out work without allocating and every task
@@ -159,18 +163,15 @@ TEST(AllocationTest, PixelNetworksDoNotAllocateWithTwoThreads) {
   const Matrix grasp_x = RandomMatrix(grasp.InputSize(), 32, &rng).cwiseAbs();
   const Matrix nature_dq = RandomMatrix(7, 4, &rng);
   const Matrix grasp_dq = RandomMatrix(7, 32, &rng);
-  auto work = [&] {
+  int sum = 0;
+  const int64_t allocations = AllocationsOfRepeats(1, 3, [&] {
     nature.Forward(nature_x);
     nature.BackwardParams(nature_dq);
     grasp.Forward(grasp_x);
     grasp.BackwardParams(grasp_dq);
-    return nature_actor.Argmax(nature_x.data(), nature.InputSize()) +
+    sum += nature_actor.Argmax(nature_x.data(), nature.InputSize()) +
            grasp_actor.Argmax(grasp_x.data(), grasp.InputSize());
-  };
-  int sum = work();
-  const int64_t before = AllocationCount();
-  for (int i = 0; i < 3; ++i) sum += work();
-  const int64_t allocations = AllocationCount() - before;
+  });
   SetNumThreads(1);
   EXPECT_EQ(allocations, 0) << sum;
   EXPECT_GT(internal::ParallelSections(), sections) << "nothing ran on two threads";
@@ -194,17 +195,15 @@ TEST(AllocationTest, Bf16NetworksDoNotAllocateOnEveryPath) {
       const Matrix nature_dq = RandomMatrix(7, 4, &rng);
       const Matrix mlp_x = RandomMatrix(10, 256, &rng);
       const Matrix mlp_dq = RandomMatrix(1, 256, &rng);
-      auto work = [&] {
+      int sum = 0;
+      const int64_t allocations = AllocationsOfRepeats(2, 3, [&] {
         nature.Forward(nature_x);
         nature.BackwardParams(nature_dq);
         mlp.Forward(mlp_x);
         mlp.Backward(mlp_dq);
-        return actor.Argmax(nature_x.data(), nature.InputSize());
-      };
-      int sum = work() + work();
-      const int64_t before = AllocationCount();
-      for (int i = 0; i < 3; ++i) sum += work();
-      EXPECT_EQ(AllocationCount() - before, 0) << path << ", " << threads << " threads " << sum;
+        sum += actor.Argmax(nature_x.data(), nature.InputSize());
+      });
+      EXPECT_EQ(allocations, 0) << path << ", " << threads << " threads " << sum;
     }
   }
   SetNumThreads(1);

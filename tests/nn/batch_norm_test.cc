@@ -71,7 +71,7 @@ TEST(BatchNorm2dTest, TrainingModeRejectsASingleValuePerChannel) {
   EXPECT_NO_THROW(bn.Forward(Matrix::Ones(3, 2)));
 }
 
-void CheckGradients(bool training) {
+void CheckBatchNormGradients(bool training) {
   SCOPED_TRACE(training ? "training" : "eval");
   std::mt19937 rng(3);
   BatchNorm2d bn(3, 2, 3);
@@ -91,9 +91,11 @@ void CheckGradients(bool training) {
   ExpectGradientsClose(bn.bias_grad(), NumericalGradient(loss, &bn.bias()), "bias");
 }
 
-TEST(BatchNorm2dTest, TrainingModeGradientsMatchFiniteDifferences) { CheckGradients(true); }
+TEST(BatchNorm2dTest, TrainingModeGradientsMatchFiniteDifferences) {
+  CheckBatchNormGradients(true);
+}
 
-TEST(BatchNorm2dTest, EvalModeGradientsMatchFiniteDifferences) { CheckGradients(false); }
+TEST(BatchNorm2dTest, EvalModeGradientsMatchFiniteDifferences) { CheckBatchNormGradients(false); }
 
 TEST(BatchNorm2dTest, ExposesAffineParamsAndRunningStatisticsSeparately) {
   BatchNorm2d bn(4, 3, 3);

@@ -128,20 +128,20 @@ RL_INSTANTIATE_KERNEL_PATHS(Bf16GemmTest);
 // bound). The bound scale of an entry adds |bias| and |start| to sum |a| |b|.
 void CheckBf16Gemm(int m, int n, int k) {
   std::mt19937 rng(static_cast<unsigned>(m * 7919 + n * 131 + k));
-  Vector workspace;
   const GemmOperands o(m, n, k, &rng);
   const Matrix reference = Bf16Product(o.a, o.b);
   const Matrix exact = (o.a.cast<double>() * o.b.cast<double>()).cast<float>();
   const Matrix abs_product = AbsProduct(o.a, o.b);
-  for (int mode = 0; mode < 64; ++mode) {
-    Matrix offset, offset_scale;
-    const Matrix got = GemmInMode(o, mode, Precision::kBf16, &workspace, &offset, &offset_scale);
-    const Matrix scale = abs_product + offset_scale;
-    EXPECT_LE(WorstBoundRatio(got, reference + offset, scale, SharpBf16Bound(k)), 1.0)
-        << m << "x" << k << " * " << k << "x" << n << " mode " << mode << " against the reference";
-    EXPECT_LE(WorstBoundRatio(got, exact + offset, scale, Bf16Bound(k)), 1.0)
-        << m << "x" << k << " * " << k << "x" << n << " mode " << mode << " against fp32";
-  }
+  ForEachGemmMode(
+      o, Precision::kBf16,
+      [&](int mode, const Matrix& got, const Matrix& offset, const Matrix& offset_scale) {
+        const Matrix scale = abs_product + offset_scale;
+        EXPECT_LE(WorstBoundRatio(got, reference + offset, scale, SharpBf16Bound(k)), 1.0)
+            << m << "x" << k << " * " << k << "x" << n << " mode " << mode
+            << " against the reference";
+        EXPECT_LE(WorstBoundRatio(got, exact + offset, scale, Bf16Bound(k)), 1.0)
+            << m << "x" << k << " * " << k << "x" << n << " mode " << mode << " against fp32";
+      });
 }
 
 TEST_P(Bf16GemmTest, MatchesTheReferenceOnEveryLayout) {
@@ -314,7 +314,7 @@ TEST(Bf16BoundTest, CatchesAWrongKernel) {
 }
 
 // The convolution geometries of the unit tests and of the networks.
-struct ConvCase {
+struct Bf16ConvCase {
   int in_channels, out_channels, kernel, stride, padding, height, width;
 };
 
@@ -371,9 +371,10 @@ void CheckBf16Layer(const MakeLayer& make, int batch, int k, const std::string& 
 }
 
 TEST_P(Bf16LayerTest, ConvolutionsMatchTheFp32KernelOnRoundedInputs) {
-  for (const ConvCase& g : {ConvCase{4, 32, 8, 4, 0, 84, 84}, ConvCase{32, 64, 4, 2, 0, 20, 20},
-                            ConvCase{64, 64, 3, 1, 0, 9, 9}, ConvCase{3, 20, 3, 2, 1, 13, 11},
-                            ConvCase{16, 32, 4, 2, 0, 20, 20}, ConvCase{8, 24, 5, 1, 0, 5, 5}}) {
+  for (const Bf16ConvCase& g :
+       {Bf16ConvCase{4, 32, 8, 4, 0, 84, 84}, Bf16ConvCase{32, 64, 4, 2, 0, 20, 20},
+        Bf16ConvCase{64, 64, 3, 1, 0, 9, 9}, Bf16ConvCase{3, 20, 3, 2, 1, 13, 11},
+        Bf16ConvCase{16, 32, 4, 2, 0, 20, 20}, Bf16ConvCase{8, 24, 5, 1, 0, 5, 5}}) {
     const int batch = 5;
     const int oh = (g.height + 2 * g.padding - g.kernel) / g.stride + 1;
     const int ow = (g.width + 2 * g.padding - g.kernel) / g.stride + 1;

@@ -20,16 +20,14 @@ RL_INSTANTIATE_KERNEL_PATHS(GemmTest);
 // transposed operands, transposed output, accumulation, row bias and column bias.
 void CheckAgainstEigen(int m, int n, int k) {
   std::mt19937 rng(static_cast<unsigned>(m * 10007 + n * 101 + k));
-  Vector workspace;
   const GemmOperands o(m, n, k, &rng);
   const Matrix product = o.a * o.b;
-  for (int mode = 0; mode < 64; ++mode) {
-    Matrix offset, offset_scale;
-    const Matrix got = GemmInMode(o, mode, Precision::kFp32, &workspace, &offset, &offset_scale);
-    const float tol = 1e-5f * static_cast<float>(k + 1);
-    EXPECT_LE((got - (product + offset)).cwiseAbs().maxCoeff(), tol)
-        << m << "x" << k << " * " << k << "x" << n << " mode " << mode;
-  }
+  const float tol = 1e-5f * static_cast<float>(k + 1);
+  ForEachGemmMode(o, Precision::kFp32,
+                  [&](int mode, const Matrix& got, const Matrix& offset, const Matrix&) {
+                    EXPECT_LE((got - (product + offset)).cwiseAbs().maxCoeff(), tol)
+                        << m << "x" << k << " * " << k << "x" << n << " mode " << mode;
+                  });
 }
 
 TEST_P(GemmTest, MatchesEigenOnRaggedShapes) {

@@ -94,6 +94,18 @@ inline Matrix GemmInMode(const GemmOperands& o, int mode, Precision precision, V
   return trans_c ? Matrix(c_t.transpose()) : c;
 }
 
+/// Calls check(mode, got, offset, offset_scale) with GemmInMode()'s result and offsets for each
+/// of the 64 ways of calling Gemm() on `o` in `precision`, one workspace shared by all.
+template <typename Check>
+void ForEachGemmMode(const GemmOperands& o, Precision precision, Check&& check) {
+  Vector workspace;
+  for (int mode = 0; mode < 64; ++mode) {
+    Matrix offset, offset_scale;
+    const Matrix got = GemmInMode(o, mode, precision, &workspace, &offset, &offset_scale);
+    check(mode, got, offset, offset_scale);
+  }
+}
+
 /// The matrix with every entry rounded to bfloat16 (RoundToBf16).
 inline Matrix RoundedToBf16(const Matrix& m) { return m.unaryExpr(&RoundToBf16); }
 
