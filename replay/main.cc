@@ -99,6 +99,16 @@ int Main(int argc, char** argv) {
   if (!env_id.empty()) {
     // The static spec: the replay builds no env and links no physics.
     const rl::envs::EnvSpec spec = rl::envs::LookupSpec(env_id);
+    // The table of the env's observations: flat floats, or frames stored once.
+    if (spec.frame_stack > 0) {
+      options.kind = rl::replay::TableKind::kPixels;
+      options.frame_height = spec.frame_height;
+      options.frame_width = spec.frame_width;
+      options.frame_stack = spec.frame_stack;
+    } else {
+      options.kind = rl::replay::TableKind::kFlat;
+      if (options.table.obs_size == 0) options.table.obs_size = spec.observation_size;
+    }
     options.table.action_width = spec.action_width();
     options.check_action = [spec](std::span<const float> action) {
       return rl::envs::CheckAction(spec, action);

@@ -9,8 +9,6 @@
 
 #include "common/check.h"
 #include "common/state_file.h"
-#include "replay/priorities.h"
-#include "replay/uniform_sampler.h"
 
 namespace rl::replay {
 namespace {
@@ -29,6 +27,12 @@ constexpr int kMaxRedraws = 16;
 // Entry of local frame id `id` in an actor's window (ids may be any int64).
 size_t WindowEntry(int64_t id) {
   return static_cast<size_t>(static_cast<uint64_t>(id) & static_cast<uint64_t>(kWindow - 1));
+}
+
+// Validated options, so that the base is built from a checked capacity.
+PixelTableOptions Checked(PixelTableOptions options) {
+  options.Validate();
+  return options;
 }
 
 }  // namespace
@@ -83,15 +87,13 @@ void PixelSampleBatch::Resize(int new_count, int new_height, int new_width, int 
   weight.resize(n);
 }
 
-PixelSampleSpans PixelSampleBatch::spans() {
-  return PixelSampleSpans{obs, next_obs, {action, reward, discount, index, weight, {}}};
+SampleSpans PixelSampleBatch::spans() {
+  return SampleSpans{{}, {}, {action, reward, discount, index, weight, {}}, obs, next_obs};
 }
 
 PixelTable::PixelTable(PixelTableOptions options, std::unique_ptr<Sampler> sampler)
-    : options_(options), sampler_(std::move(sampler)) {
-  options_.Validate();
+    : Table(Checked(options).capacity, std::move(sampler)), options_(options) {
   frame_capacity_ = options_.frames_kept();
-  if (sampler_ == nullptr) sampler_ = std::make_unique<UniformSampler>(options_.capacity);
   if (options_.height > 0 && options_.width > 0 && options_.stack > 0) {
     Allocate(options_.height, options_.width, options_.stack);
   }
@@ -152,8 +154,9 @@ void PixelTable::DropAllStale() {
   }
 }
 
-const char* PixelTable::Insert(const PixelBatchView& batch) {
+const char* PixelTable::Insert(const TransitionBatchView& batch) {
   // Check the whole batch before storing any of it.
+  if (batch.obs_size != 0) return "a flat batch (obs_size > 0); this run stores pixel transitions";
   if (batch.actor_id < 0 || batch.actor_id > kMaxActorId) return "actor_id outside [0, 65535]";
   if (batch.num_frames < 0 || batch.count < 0) return "negative num_frames or count";
   if (batch.num_frames == 0 && batch.count == 0) return "empty batch";
@@ -221,36 +224,26 @@ const char* PixelTable::Insert(const PixelBatchView& batch) {
       ++missing_frames_;
       continue;
     }
-    const int64_t slot = total_inserts_ % options_.capacity;
-    const auto s = static_cast<size_t>(slot);
+    const size_t s = Append(batch.columns, i);
     std::copy(global, global + 2 * stack, frame_refs_.data() + s * 2 * stack);
-    if (columns_.insert_numbers()[s] < 0) ++size_;
-    columns_.Store(s, batch.columns, i, total_inserts_);
-    sampler_->Insert(slot, batch.columns.priority.empty() ? 0.0 : batch.columns.priority[i]);
-    ++total_inserts_;
   }
   return nullptr;
 }
 
-bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const PixelSampleSpans& out) {
+bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const SampleSpans& out) {
   RL_CHECK(batch_size > 0) << "batch_size must be positive, got " << batch_size;
   if (size_ == 0) return false;
   const auto n = static_cast<size_t>(batch_size);
   const auto stack = static_cast<size_t>(stack_);
   const size_t frame_bytes = static_cast<size_t>(height_) * static_cast<size_t>(width_);
   const size_t stack_bytes = stack * frame_bytes;
-  RL_CHECK(out.obs.size() == n * stack_bytes && out.next_obs.size() == n * stack_bytes)
-      << "obs and next_obs must hold batch_size * stack * height * width = " << n * stack_bytes
-      << " bytes";
-  RL_CHECK(columns_.Fits(out.columns, n))
-      << "action must hold batch_size * action_width floats, reward, discount, index and weight "
-         "batch_size = "
-      << n << " values";
+  RL_CHECK(out.obs_pixels.size() == n * stack_bytes &&
+           out.next_obs_pixels.size() == n * stack_bytes)
+      << "obs_pixels and next_obs_pixels must hold batch_size * stack * height * width = "
+      << n * stack_bytes << " bytes";
 
   // Let the sampler choose the slots, drawing again for each stale one (removed on the way).
-  if (items_.size() < n) items_.resize(n);
-  const std::span<SampledItem> items(items_.data(), n);
-  sampler_->Sample(rng, items);
+  const std::span<SampledItem> items = Draw(n, rng, out);
   bool dropped = false;
   for (size_t i = 0; i < n; ++i) {
     int redraws = 0;
@@ -279,36 +272,22 @@ bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const PixelSampleS
     for (size_t k = 0; k < 2 * stack; ++k) {
       const uint8_t* frame =
           frames_.data() + static_cast<size_t>(refs[k] % frame_capacity_) * frame_bytes;
-      uint8_t* to = k < stack ? out.obs.data() + i * stack_bytes + k * frame_bytes
-                              : out.next_obs.data() + i * stack_bytes + (k - stack) * frame_bytes;
+      uint8_t* to = k < stack
+                        ? out.obs_pixels.data() + i * stack_bytes + k * frame_bytes
+                        : out.next_obs_pixels.data() + i * stack_bytes + (k - stack) * frame_bytes;
       std::memcpy(to, frame, frame_bytes);
     }
-    columns_.Gather(s, i, out.columns);
-    out.columns.weight[i] = ImportanceWeight(items[i].probability, min_probability, beta_);
+    Gather(items[i], i, min_probability, out);
   }
   total_samples_ += batch_size;
   return true;
 }
 
-int64_t PixelTable::UpdatePriorities(std::span<const int64_t> index,
-                                     std::span<const float> priority) {
-  return ApplyPriorities(index, priority, columns_.insert_numbers(), total_inserts_,
-                         sampler_.get());
-}
-
-void PixelTable::set_importance_exponent(double beta) {
-  if (!(beta >= 0.0 && beta <= 1.0)) {
-    throw std::invalid_argument("pixel table: importance exponent must be in [0, 1], got " +
-                                std::to_string(beta));
-  }
-  beta_ = beta;
-}
-
 int64_t PixelTable::memory_bytes() const {
   size_t bytes = frames_.capacity() + frame_refs_.capacity() * sizeof(int64_t) +
-                 items_.capacity() * sizeof(SampledItem) + actors_.capacity() * sizeof(ActorFrames);
+                 actors_.capacity() * sizeof(ActorFrames);
   for (const ActorFrames& actor : actors_) bytes += actor.window.capacity() * sizeof(FrameRef);
-  return static_cast<int64_t>(bytes) + columns_.memory_bytes() + sampler_->memory_bytes();
+  return static_cast<int64_t>(bytes) + common_memory_bytes();
 }
 
 }  // namespace rl::replay

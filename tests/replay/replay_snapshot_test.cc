@@ -282,19 +282,17 @@ TEST_F(ReplaySnapshotTest, ARestoredPixelReplayKeepsFramesAndActorWindows) {
   const std::string summary = restored.service().RestoreSnapshot(saved.Snapshot());
   EXPECT_NE(summary.find("frames"), std::string::npos) << summary;
   ExpectSameState(saved.service(), restored.service());
-  ASSERT_NE(restored.service().pixel_table(), nullptr);
-  EXPECT_EQ(restored.service().pixel_table()->total_frames(),
-            saved.service().pixel_table()->total_frames());
-  EXPECT_EQ(restored.service().pixel_table()->stale_draws(),
-            saved.service().pixel_table()->stale_draws());
+  ASSERT_EQ(restored.service().table().kind(), TableKind::kPixels);
+  EXPECT_EQ(restored.service().table().total_frames(), saved.service().table().total_frames());
+  EXPECT_EQ(restored.service().table().stale_draws(), saved.service().table().stale_draws());
   ExpectSameReplies(&saved, &restored, 4);
   // A next batch that names a frame of the previous one resolves through the restored window.
   rlmsg::transition_batch_t next = PixelBatch(160, 10, 0);
   next.obs_frames[0] = 159;
   saved.Publish(channels::kTransitions, next, "actor-0");
   restored.Publish(channels::kTransitions, next, "actor-0");
-  EXPECT_EQ(restored.service().pixel_table()->transitions_missing_frames(),
-            saved.service().pixel_table()->transitions_missing_frames());
+  EXPECT_EQ(restored.service().table().transitions_missing_frames(),
+            saved.service().table().transitions_missing_frames());
   EXPECT_EQ(restored.service().total_inserts(), saved.service().total_inserts());
   ExpectSameReplies(&saved, &restored, 3);
 }
