@@ -104,9 +104,7 @@ int Main(int argc, char** argv) {
     // The table of the env's observations: flat floats, or frames stored once.
     if (spec.frame_stack > 0) {
       options.kind = rl::replay::TableKind::kPixels;
-      options.frame_height = spec.frame_height;
-      options.frame_width = spec.frame_width;
-      options.frame_stack = spec.frame_stack;
+      options.frames = {0, spec.frame_height, spec.frame_width, spec.frame_stack};
     } else {
       options.kind = rl::replay::TableKind::kFlat;
       if (options.table.obs_size == 0) options.table.obs_size = spec.observation_size;

@@ -102,9 +102,9 @@ PixelTable::PixelTable(PixelTableOptions options, std::unique_ptr<Sampler> sampl
 PixelTable::~PixelTable() = default;
 
 void PixelTable::Allocate(int height, int width, int stack) {
-  height_ = height;
-  width_ = width;
-  stack_ = stack;
+  shape_.height = height;
+  shape_.width = width;
+  shape_.stack = stack;
   const auto slots = static_cast<size_t>(options_.capacity);
   frames_.assign(static_cast<size_t>(frame_capacity_) * static_cast<size_t>(height) *
                      static_cast<size_t>(width),
@@ -135,7 +135,7 @@ bool PixelTable::Resolve(const ActorFrames& actor, std::span<const int64_t> loca
 }
 
 bool PixelTable::Stale(int64_t slot) const {
-  const size_t refs = 2 * static_cast<size_t>(stack_);
+  const size_t refs = 2 * static_cast<size_t>(shape_.stack);
   const int64_t* first = frame_refs_.data() + static_cast<size_t>(slot) * refs;
   return *std::min_element(first, first + refs) < total_frames_ - frame_capacity_;
 }
@@ -165,9 +165,9 @@ const char* PixelTable::Insert(const TransitionBatchView& batch) {
   }
   if (batch.stack < 1 || batch.stack > kMaxStack) return "stack outside [1, 64]";
   // The table's geometry once known, else the configured parts of it.
-  const int want_height = height_ > 0 ? height_ : options_.height;
-  const int want_width = width_ > 0 ? width_ : options_.width;
-  const int want_stack = stack_ > 0 ? stack_ : options_.stack;
+  const int want_height = shape_.height > 0 ? shape_.height : options_.height;
+  const int want_width = shape_.width > 0 ? shape_.width : options_.width;
+  const int want_stack = shape_.stack > 0 ? shape_.stack : options_.stack;
   if ((want_height > 0 && batch.height != want_height) ||
       (want_width > 0 && batch.width != want_width) ||
       (want_stack > 0 && batch.stack != want_stack)) {
@@ -193,7 +193,7 @@ const char* PixelTable::Insert(const TransitionBatchView& batch) {
   }
   ActorFrames* actor = FindOrAddActor(batch.actor_id);
   if (actor == nullptr) return "too many actors (1024 distinct actor ids at most)";
-  if (height_ == 0) Allocate(batch.height, batch.width, batch.stack);
+  if (shape_.height == 0) Allocate(batch.height, batch.width, batch.stack);
   if (n > 0 && !columns_.allocated()) {
     columns_.Allocate(options_.capacity, batch.columns.action_width);
   }
@@ -234,8 +234,8 @@ bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const SampleSpans&
   RL_CHECK(batch_size > 0) << "batch_size must be positive, got " << batch_size;
   if (size_ == 0) return false;
   const auto n = static_cast<size_t>(batch_size);
-  const auto stack = static_cast<size_t>(stack_);
-  const size_t frame_bytes = static_cast<size_t>(height_) * static_cast<size_t>(width_);
+  const auto stack = static_cast<size_t>(shape_.stack);
+  const size_t frame_bytes = static_cast<size_t>(shape_.height) * static_cast<size_t>(shape_.width);
   const size_t stack_bytes = stack * frame_bytes;
   RL_CHECK(out.obs_pixels.size() == n * stack_bytes &&
            out.next_obs_pixels.size() == n * stack_bytes)
@@ -295,8 +295,8 @@ int64_t PixelTable::memory_bytes() const {
 namespace rl::replay {
 
 void PixelTable::Save(const std::string& prefix, StateStream* out) const {
-  const int64_t shape[] = {options_.capacity,      frame_capacity_, height_, width_, stack_,
-                           columns_.action_width()};
+  const int64_t shape[] = {options_.capacity, frame_capacity_, shape_.height,
+                           shape_.width,      shape_.stack,    columns_.action_width()};
   const int64_t counts[] = {size_,         total_inserts_,  total_samples_,
                             total_frames_, missing_frames_, stale_draws_};
   out->PutInts(prefix + "shape", shape);
@@ -382,7 +382,7 @@ void PixelTable::Restore(const std::string& prefix, const StateView& in) {
   if (geometry) {
     Allocate(static_cast<int>(height), static_cast<int>(width), static_cast<int>(stack));
   } else {
-    height_ = width_ = stack_ = 0;
+    shape_ = {};
     frames_.clear();
     frame_refs_.clear();
   }
@@ -430,8 +430,8 @@ void PixelTable::Restore(const std::string& prefix, const StateView& in) {
     if (n >= inserts || n < inserts - capacity || n % capacity != static_cast<int64_t>(slot)) {
       refuse("the snapshot's insert numbers are not a table's");
     }
-    const int64_t* refs = frame_refs_.data() + slot * 2 * static_cast<size_t>(stack_);
-    for (int64_t k = 0; k < 2 * stack_; ++k) {
+    const int64_t* refs = frame_refs_.data() + slot * 2 * static_cast<size_t>(shape_.stack);
+    for (int64_t k = 0; k < 2 * shape_.stack; ++k) {
       if (refs[k] < 0 || refs[k] >= frames)
         refuse("the snapshot's transitions name unknown frames");
     }

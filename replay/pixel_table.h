@@ -121,11 +121,11 @@ class PixelTable final : public Table {
   /// O(batch_size * (stack * height * width + log capacity)).
   bool Sample(int batch_size, std::mt19937_64* rng, const SampleSpans& out) override;
 
-  ObservationShape shape() const override { return {0, height_, width_, stack_}; }
+  ObservationShape shape() const override { return shape_; }
   /// Frame geometry; 0 until known.
-  int height() const { return height_; }
-  int width() const { return width_; }
-  int stack() const { return stack_; }
+  int height() const { return shape_.height; }
+  int width() const { return shape_.width; }
+  int stack() const { return shape_.stack; }
 
   /// Frames kept (the effective frame_capacity).
   int64_t frame_capacity() const override { return frame_capacity_; }
@@ -171,18 +171,16 @@ class PixelTable final : public Table {
 
   PixelTableOptions options_;
   int64_t frame_capacity_ = 0;
-  int height_ = 0;
-  int width_ = 0;
-  int stack_ = 0;
+  ObservationShape shape_;  // the frames' geometry (obs_size 0); 0 until known
   int64_t total_frames_ = 0;
   int64_t missing_frames_ = 0;
   int64_t stale_draws_ = 0;
 
-  // frame_capacity_ frames of height_ * width_ bytes, in huge pages where the kernel offers them
+  // frame_capacity_ frames of height * width bytes, in huge pages where the kernel offers them
   std::vector<uint8_t, HugePageAllocator<uint8_t>> frames_;
   std::vector<ActorFrames> actors_;  // sorted by actor_id
 
-  // Per-slot storage (frame_refs_: 2 * stack_ global frame numbers per slot, obs then next_obs).
+  // Per-slot storage (frame_refs_: 2 * stack global frame numbers per slot, obs then next_obs).
   std::vector<int64_t> frame_refs_;
 };
 

@@ -82,9 +82,9 @@ PixelTableOptions ReplayServiceOptions::pixel_table() const {
   PixelTableOptions o;
   o.capacity = table.capacity;
   o.frame_capacity = frame_capacity;
-  o.height = frame_height;
-  o.width = frame_width;
-  o.stack = frame_stack;
+  o.height = frames.height;
+  o.width = frames.width;
+  o.stack = frames.stack;
   o.action_width = table.action_width;
   return o;
 }

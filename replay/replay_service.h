@@ -77,10 +77,8 @@ struct ReplayServiceOptions {
   // The kind of table, from the env's static spec (flat, or pixels when the env gives frames);
   // none: the kind of the first batch.
   std::optional<TableKind> kind;
-  // Pixel tables: frame height, width and frames per stack (0: from the first batch).
-  int frame_height = 0;
-  int frame_width = 0;
-  int frame_stack = 0;
+  // Pixel tables: the frames' height, width and stack (0: from the first batch).
+  ObservationShape frames;
   // Samples-per-insert ratio, minimum size and tolerance.
   RateLimiterOptions limiter;
   // Seed of the sampler's random generator.

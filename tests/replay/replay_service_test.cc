@@ -440,7 +440,7 @@ TEST_F(ReplayServiceTest, StoresPixelTransitionsAndAnswersWithRebuiltStacks) {
 TEST_F(ReplayServiceTest, ThePixelTableOfTheEnvsKindRefusesAFirstFlatBatchOrOtherGeometry) {
   ReplayServiceOptions o = Options(8, 10, 200);
   o.kind = TableKind::kPixels;
-  o.frame_height = o.frame_width = o.frame_stack = 2;
+  o.frames = {0, 2, 2, 2};
   Start(o);
   EXPECT_EQ(service_->table().kind(), TableKind::kPixels);
   SendTransitions(0, 5);
