@@ -5,7 +5,6 @@
 #include <limits>
 #include <numeric>
 #include <stdexcept>
-#include <type_traits>
 #include <utility>
 
 #include "common/channels.h"
@@ -37,46 +36,139 @@ uint64_t TrainingSeed(uint64_t run_seed, int actor_id, int env_index) {
          static_cast<uint64_t>(env_index);
 }
 
+namespace {
+
+// Flat envs: a transition carries the observation's floats.
+struct FlatCodec {
+  using Value = float;
+  static int Size(const envs::EnvSpec& spec) { return spec.observation_size; }
+  // The observation after a reset.
+  void First(const envs::Env& env, std::vector<float>* obs) const {
+    const std::span<const float> o = env.observation();
+    obs->assign(o.begin(), o.end());
+  }
+  // The observation after a step from `obs`.
+  void Next(const envs::Env& env, std::span<const float> /*obs*/, std::vector<float>* next) const {
+    First(env, next);
+  }
+  static void Write(const Transition& t, rlmsg::transition_batch_t* batch) {
+    batch->obs.insert(batch->obs.end(), t.obs.begin(), t.obs.end());
+    batch->next_obs.insert(batch->next_obs.end(), t.next_obs.begin(), t.next_obs.end());
+  }
+};
+
+// Pixel envs: a transition carries the ids of the frames of its stacks, oldest first; each new
+// frame goes into the batch once, under the actor's next frame id.
+struct FrameCodec {
+  using Value = int64_t;
+  rlmsg::transition_batch_t* batch;
+  int64_t* next_id;
+
+  static int Size(const envs::EnvSpec& spec) { return spec.frame_stack; }
+  // Queues the env's newest frame and returns its id.
+  int64_t Add(const envs::Env& env) const {
+    const std::span<const uint8_t> f = env.frame();
+    batch->frames.insert(batch->frames.end(), f.begin(), f.end());
+    batch->frame_id.push_back(*next_id);
+    return (*next_id)++;
+  }
+  // After a reset the env repeats its first frame to fill the stack; the ids say the same.
+  void First(const envs::Env& env, std::vector<int64_t>* stack) const {
+    std::fill(stack->begin(), stack->end(), Add(env));
+  }
+  // The stack after a step: the old one shifted by one, then the new frame.
+  void Next(const envs::Env& env, std::span<const int64_t> stack,
+            std::vector<int64_t>* next) const {
+    std::copy(stack.begin() + 1, stack.end(), next->begin());
+    next->back() = Add(env);
+  }
+  static void Write(const FrameTransition& t, rlmsg::transition_batch_t* batch) {
+    batch->obs_frames.insert(batch->obs_frames.end(), t.obs.begin(), t.obs.end());
+    batch->next_obs_frames.insert(batch->next_obs_frames.end(), t.next_obs.begin(),
+                                  t.next_obs.end());
+  }
+};
+
+}  // namespace
+
+template <class Codec>
+class Actor::Encoder final : public Actor::ObservationEncoder {
+ public:
+  using Value = typename Codec::Value;
+
+  Encoder(Actor* actor, Codec codec)
+      : actor_(actor),
+        codec_(codec),
+        nstep_(actor->config_.n_step, actor->config_.gamma, Codec::Size(actor->spec_),
+               actor->spec_.action_width()),
+        obs_(static_cast<size_t>(Codec::Size(actor->spec_))),
+        next_(obs_.size()) {}
+
+  void Start(const envs::Env& env) override { codec_.First(env, &obs_); }
+
+  void Step(const envs::Env& env, std::span<const float> action, double reward, bool terminated,
+            bool truncated, int64_t episode_id) override {
+    codec_.Next(env, obs_, &next_);
+    nstep_.Add(obs_, action, reward, next_, terminated, truncated, Sink(episode_id));
+    obs_.swap(next_);
+  }
+
+  void Flush(int64_t episode_id) override { nstep_.Flush(Sink(episode_id)); }
+
+ private:
+  // Appends each transition to the actor's batch.
+  typename BasicNStepAccumulator<Value>::Sink Sink(int64_t episode_id) {
+    return [this, episode_id](const BasicTransition<Value>& t) {
+      Codec::Write(t, &actor_->batch_);
+      actor_->Append(t.action, t.reward, t.discount, episode_id);
+    };
+  }
+
+  Actor* actor_;
+  Codec codec_;
+  BasicNStepAccumulator<Value> nstep_;
+  std::vector<Value> obs_;   // the observation the next step starts from
+  std::vector<Value> next_;  // scratch for the one it ends in
+};
+
+std::unique_ptr<Actor::ObservationEncoder> Actor::MakeEncoder() {
+  if (spec_.frame_stack > 0) {
+    return std::make_unique<Encoder<FrameCodec>>(this, FrameCodec{&batch_, &next_frame_id_});
+  }
+  return std::make_unique<Encoder<FlatCodec>>(this, FlatCodec{});
+}
+
 Actor::Actor(ActorConfig config, Bus* bus)
     : config_(std::move(config)),
       bus_(bus),
       assembler_([this](const std::string& architecture) { return WeightsSize(architecture); }) {
   config_.Validate();
   for (int j = 0; j < config_.envs_per_actor; ++j) {
-    auto env = envs::MakeEnv(config_.env_id);
-    spec_ = env->spec();
-    pixels_ = spec_.frame_stack > 0;
-    env->Reset(TrainingSeed(config_.seed, config_.actor_id, j));
-    auto o = env->observation();
-    // A pixel env's transitions are frame ids: the float accumulator only needs a token size.
-    const int nstep_size = pixels_ ? 1 : spec_.observation_size;
-    const int stack = std::max(1, spec_.frame_stack);
-    const int width = spec_.action_width();
-    slots_.push_back(EnvSlot{std::move(env), std::vector<float>(o.begin(), o.end()),
-                             std::vector<float>(static_cast<size_t>(width)),
-                             NStepAccumulator(config_.n_step, config_.gamma, nstep_size, width),
-                             0.0, 0, std::vector<int64_t>(static_cast<size_t>(stack)),
-                             std::vector<int64_t>(static_cast<size_t>(stack)),
-                             FrameNStepAccumulator(config_.n_step, config_.gamma, stack, width)});
-    if (pixels_) StartStack(&slots_.back());
+    EnvSlot& s = slots_.emplace_back();
+    s.env = envs::MakeEnv(config_.env_id);
+    spec_ = s.env->spec();
+    s.env->Reset(TrainingSeed(config_.seed, config_.actor_id, j));
+    s.action.resize(static_cast<size_t>(spec_.action_width()));
+    s.encoder = MakeEncoder();
+    s.encoder->Start(*s.env);
   }
   policy_ = MakePolicy(spec_, config_.exploration, config_.actor_id, config_.num_actors,
                        TrainingSeed(config_.seed, config_.actor_id, 99));
   batch_.actor_id = config_.actor_id;
   batch_.action_width = spec_.action_width();
-  if (pixels_) {
-    batch_.height = spec_.frame_height;
-    batch_.width = spec_.frame_width;
-    batch_.stack = spec_.frame_stack;
-  } else {
-    batch_.obs_size = spec_.observation_size;
-  }
+  // The observations' shape: floats per observation, or the frames' geometry.
+  batch_.obs_size = spec_.frame_stack > 0 ? 0 : spec_.observation_size;
+  batch_.height = spec_.frame_height;
+  batch_.width = spec_.frame_width;
+  batch_.stack = spec_.frame_stack;
 
   bus_->Subscribe<rlmsg::weights_chunk_t>(
       channels::kWeights, [this](const rlmsg::weights_chunk_t& c) { OnWeights(c); }, Port::kBulk);
   bus_->Subscribe<rlmsg::flow_control_t>(channels::kFlow,
                                          [this](const rlmsg::flow_control_t& f) { OnFlow(f); });
 }
+
+Actor::~Actor() = default;
 
 void Actor::OnFlow(const rlmsg::flow_control_t& f) {
   // Counts far beyond any run's (2^62) are capped, so that no sum below overflows.
@@ -145,14 +237,7 @@ void Actor::TakeUpCount(int64_t stored) {
 }
 
 void Actor::FlushEpisodes() {
-  for (EnvSlot& s : slots_) {
-    const int64_t episode_id = s.episode_id;
-    if (pixels_) {
-      s.frame_nstep.Flush([this, episode_id](const FrameTransition& t) { Append(t, episode_id); });
-    } else {
-      s.nstep.Flush([this, episode_id](const Transition& t) { Append(t, episode_id); });
-    }
-  }
+  for (EnvSlot& s : slots_) s.encoder->Flush(s.episode_id);
 }
 
 void Actor::OnWeights(const rlmsg::weights_chunk_t& chunk) {
@@ -176,19 +261,11 @@ void Actor::OnWeights(const rlmsg::weights_chunk_t& chunk) {
   weights_version_ = w->version;
 }
 
-template <class T>
-void Actor::Append(const BasicTransition<T>& t, int64_t episode_id) {
-  if constexpr (std::is_same_v<T, int64_t>) {
-    batch_.obs_frames.insert(batch_.obs_frames.end(), t.obs.begin(), t.obs.end());
-    batch_.next_obs_frames.insert(batch_.next_obs_frames.end(), t.next_obs.begin(),
-                                  t.next_obs.end());
-  } else {
-    batch_.obs.insert(batch_.obs.end(), t.obs.begin(), t.obs.end());
-    batch_.next_obs.insert(batch_.next_obs.end(), t.next_obs.begin(), t.next_obs.end());
-  }
-  batch_.action.insert(batch_.action.end(), t.action.begin(), t.action.end());
-  batch_.reward.push_back(t.reward);
-  batch_.discount.push_back(t.discount);
+void Actor::Append(std::span<const float> action, float reward, float discount,
+                   int64_t episode_id) {
+  batch_.action.insert(batch_.action.end(), action.begin(), action.end());
+  batch_.reward.push_back(reward);
+  batch_.discount.push_back(discount);
   batch_.episode_id.push_back(episode_id);
   batch_.priority.push_back(0.0f);
   if (static_cast<int>(batch_.reward.size()) >= config_.batch_size) PublishBatch();
@@ -210,38 +287,13 @@ void Actor::PublishBatch() {
   b.frames.clear();
 }
 
-int64_t Actor::AddFrame(const envs::Env& env) {
-  const std::span<const uint8_t> f = env.frame();
-  batch_.frames.insert(batch_.frames.end(), f.begin(), f.end());
-  batch_.frame_id.push_back(next_frame_id_);
-  return next_frame_id_++;
-}
-
-void Actor::StartStack(EnvSlot* s) {
-  // The env repeats its first frame to fill the stack; the ids say the same.
-  const int64_t id = AddFrame(*s->env);
-  std::fill(s->stack_ids.begin(), s->stack_ids.end(), id);
-}
-
 int Actor::StepEnvs() {
   for (EnvSlot& s : slots_) {
-    policy_->Act(s.obs, env_steps_, s.action);
+    policy_->Act(s.env->observation(), env_steps_, s.action);
     const envs::StepResult r = s.env->Step(s.action);
-    const std::span<const float> next = s.env->observation();
     s.episode_return += r.reward;
     const double reward = config_.clip_rewards ? std::clamp(r.reward, -1.0, 1.0) : r.reward;
-    const int64_t episode_id = s.episode_id;
-    if (pixels_) {
-      // The new stack: the old one shifted by one, then the new frame.
-      std::copy(s.stack_ids.begin() + 1, s.stack_ids.end(), s.next_stack_ids.begin());
-      s.next_stack_ids.back() = AddFrame(*s.env);
-      s.frame_nstep.Add(s.stack_ids, s.action, reward, s.next_stack_ids, r.terminated, r.truncated,
-                        [this, episode_id](const FrameTransition& t) { Append(t, episode_id); });
-      s.stack_ids.swap(s.next_stack_ids);
-    } else {
-      s.nstep.Add(s.obs, s.action, reward, next, r.terminated, r.truncated,
-                  [this, episode_id](const Transition& t) { Append(t, episode_id); });
-    }
+    s.encoder->Step(*s.env, s.action, reward, r.terminated, r.truncated, s.episode_id);
     if (r.terminated || r.truncated) {
       recent_returns_.push_back(s.episode_return);
       if (recent_returns_.size() > 100) recent_returns_.pop_front();
@@ -249,11 +301,7 @@ int Actor::StepEnvs() {
       ++s.episode_id;
       s.episode_return = 0;
       s.env->Reset();
-      const std::span<const float> o = s.env->observation();
-      s.obs.assign(o.begin(), o.end());
-      if (pixels_) StartStack(&s);
-    } else {
-      s.obs.assign(next.begin(), next.end());
+      s.encoder->Start(*s.env);
     }
   }
   env_steps_ += static_cast<int64_t>(slots_.size());

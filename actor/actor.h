@@ -23,6 +23,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,7 @@ class Actor {
   Actor(ActorConfig config, Bus* bus);
   Actor(const Actor&) = delete;
   Actor& operator=(const Actor&) = delete;
+  ~Actor();
 
   // Acts, publishes and handles LCM until StopRequested() or max_steps.
   void Run();
@@ -117,18 +119,31 @@ class Actor {
   // Emits the pending n-step transitions of every env as truncated (the actor stops).
   void FlushEpisodes();
 
+  // How one env's transitions carry its observations, chosen once from the env's spec: the
+  // observation's floats (flat envs), or the ids of the frames of its stack, each new frame
+  // queued into the batch once (pixel envs). It holds the env's n-step accumulator; the
+  // implementations are in actor.cc.
+  class ObservationEncoder {
+   public:
+    virtual ~ObservationEncoder() = default;
+    // The env was reset: its observation starts an episode.
+    virtual void Start(const envs::Env& env) = 0;
+    // The env took `action` from the last observation and gave `reward` and a new observation:
+    // records the step and appends the transitions it completes to the batch.
+    virtual void Step(const envs::Env& env, std::span<const float> action, double reward,
+                      bool terminated, bool truncated, int64_t episode_id) = 0;
+    // Appends the pending transitions as truncated ones (the actor stops).
+    virtual void Flush(int64_t episode_id) = 0;
+  };
+  template <class Codec>
+  class Encoder;
+
   struct EnvSlot {
     std::unique_ptr<envs::Env> env;
-    std::vector<float> obs;     // observation the next action is chosen from
     std::vector<float> action;  // action_width floats
-    NStepAccumulator nstep;     // flat envs
+    std::unique_ptr<ObservationEncoder> encoder;
     double episode_return = 0;
     int64_t episode_id = 0;
-    // Pixel envs: ids of the frames of the current stack (oldest first), and their n-step
-    // accumulator.
-    std::vector<int64_t> stack_ids;
-    std::vector<int64_t> next_stack_ids;
-    FrameNStepAccumulator frame_nstep;
   };
 
   void OnWeights(const rlmsg::weights_chunk_t& chunk);
@@ -136,14 +151,12 @@ class Actor {
   // env (the policy's own, or a candidate built now and kept for when its version completes),
   // or -1 with the reason logged.
   int64_t WeightsSize(const std::string& architecture);
-  // Appends a transition (flat observations, or stacks of frame ids) to the batch.
-  template <class T>
-  void Append(const BasicTransition<T>& t, int64_t episode_id);
+  // The encoder of an env of this actor's spec.
+  std::unique_ptr<ObservationEncoder> MakeEncoder();
+  // Appends a transition's other fields to the batch (its encoder has appended its
+  // observations), and publishes the batch when it is full.
+  void Append(std::span<const float> action, float reward, float discount, int64_t episode_id);
   void PublishBatch();
-  // Pixel envs: queues the env's newest frame and returns its id.
-  int64_t AddFrame(const envs::Env& env);
-  // Pixel envs: starts the stack of a freshly reset env.
-  void StartStack(EnvSlot* s);
 
   ActorConfig config_;
   Bus* bus_;
@@ -173,7 +186,7 @@ class Actor {
   int64_t lost_ = 0;
   std::deque<double> recent_returns_;  // last 100 episode returns
   rlmsg::transition_batch_t batch_{};
-  bool pixels_ = false;  // the env gives frames
+  // Pixel envs: the id of this actor's next frame (shared by its envs).
   int64_t next_frame_id_ = 0;
 
   RateMeter steps_rate_;

@@ -144,7 +144,7 @@ int RunFlat(int repeats, double seconds, int port) {
     o.stats_hz = 20;
     rl::replay::ReplayService service(&bus, o);
     service.Run([&] {
-      inserted.store(service.table().total_inserts());
+      inserted.store(service.total_inserts());
       return stop.load();
     });
   });
@@ -249,20 +249,6 @@ constexpr int64_t kCapacity = 100'000;    // transitions kept by the pixel repla
 constexpr int64_t kMemoryFill = 100'000;  // transitions put in the table of the memory figure
 constexpr int kSampleInFlight = 4;        // the learner's default requests_in_flight
 
-rl::replay::PixelBatchView View(const rlmsg::transition_batch_t& m) {
-  return rl::replay::PixelBatchView{m.actor_id,
-                                    m.height,
-                                    m.width,
-                                    m.stack,
-                                    m.num_frames,
-                                    m.frame_id,
-                                    m.frames,
-                                    m.count,
-                                    m.obs_frames,
-                                    m.next_obs_frames,
-                                    rl::replay::ColumnsView{m.action_width, m.action, m.reward,
-                                                            m.discount, m.episode_id, m.priority}};
-}
 
 // What the pixel replay service's thread exposes to the main thread.
 struct ServiceProbe {
@@ -339,9 +325,7 @@ void RunPixelService(int port, ServiceProbe* probe, const std::string& key) {
   rl::replay::ReplayService service(&bus, o);
   service.Run([&] {
     probe->inserts.store(service.total_inserts());
-    if (const rl::replay::PixelTable* t = service.pixel_table()) {
-      probe->missing_frames.store(t->transitions_missing_frames());
-    }
+    probe->missing_frames.store(service.table().transitions_missing_frames());
     const rl::BusCounters& c = bus.counters();
     probe->lost.store(c.lost);
     probe->dropped.store(c.dropped() + service.counters().batches_refused);
@@ -860,7 +844,7 @@ void PixelMemory(bool prioritized) {
   const double alloc_s = rl::MonoSeconds() - start;
   while (table.total_inserts() < kMemoryFill) {
     for (size_t a = 0; a < sims.size() && table.total_inserts() < kMemoryFill; ++a) {
-      const char* why = table.Insert(View(*next[a]));
+      const char* why = table.Insert(rl::replay::ViewOf(*next[a]));
       RL_CHECK(why == nullptr) << why;
       next[a] = sims[a].Next();
     }
@@ -987,7 +971,7 @@ void PixelSnapshots(int repeats) {
   for (int a = 0; a < kActors; ++a) sims.emplace_back(a, 900 + static_cast<uint64_t>(a));
   size_t turn = 0;
   const auto insert = [&] {
-    const char* why = table.Insert(View(*sims[turn++ % sims.size()].Next()));
+    const char* why = table.Insert(rl::replay::ViewOf(*sims[turn++ % sims.size()].Next()));
     RL_CHECK(why == nullptr) << why;
     return kBatch;
   };
@@ -1008,8 +992,11 @@ void FlatSnapshots(int repeats) {
   rl::replay::ReplayTable table(o);
   std::vector<float> obs(kBatch * 4, 0.5f), action(kBatch, 1.0f), reward(kBatch, 1.0f),
       discount(kBatch, 0.99f);
-  const rl::replay::TransitionBatchView batch{
-      4, kBatch, obs, obs, rl::replay::ColumnsView{1, action, reward, discount, {}, {}}};
+  rl::replay::TransitionBatchView batch;
+  batch.obs_size = 4;
+  batch.count = kBatch;
+  batch.obs = batch.next_obs = obs;
+  batch.columns = rl::replay::ColumnsView{1, action, reward, discount, {}, {}};
   const auto insert = [&] {
     const char* why = table.Insert(batch);
     RL_CHECK(why == nullptr) << why;

@@ -42,12 +42,14 @@ int Main(int argc, char** argv) {
   rl::AddCommonOptions(&desc, &common);
   desc.add_options()  //
       ("env", po::value(&env_id),
-       "environment of the run: actions are checked against its action space (none: any "
-       "action of the first batch's width)")  //
+       "environment of the run: its static spec picks the table (flat observations of its "
+       "size, or its frames) and actions are checked against its action space (none: the first "
+       "batch decides, any action of its width)")  //
       ("capacity", po::value(&options.table.capacity)->default_value(options.table.capacity),
        "transitions kept; the oldest are overwritten")  //
       ("obs-size", po::value(&options.table.obs_size)->default_value(options.table.obs_size),
-       "floats per observation (0: from the first batch); other sizes are refused")  //
+       "floats per observation (0: the flat env's with --env, else from the first batch); other "
+       "sizes are refused")  //
       ("min-size",
        po::value(&options.limiter.min_size_to_sample)
            ->default_value(options.limiter.min_size_to_sample),
@@ -99,6 +101,14 @@ int Main(int argc, char** argv) {
   if (!env_id.empty()) {
     // The static spec: the replay builds no env and links no physics.
     const rl::envs::EnvSpec spec = rl::envs::LookupSpec(env_id);
+    // The table of the env's observations: flat floats, or frames stored once.
+    if (spec.frame_stack > 0) {
+      options.kind = rl::replay::TableKind::kPixels;
+      options.frames = {0, spec.frame_height, spec.frame_width, spec.frame_stack};
+    } else {
+      options.kind = rl::replay::TableKind::kFlat;
+      if (options.table.obs_size == 0) options.table.obs_size = spec.observation_size;
+    }
     options.table.action_width = spec.action_width();
     options.check_action = [spec](std::span<const float> action) {
       return rl::envs::CheckAction(spec, action);

@@ -9,8 +9,6 @@
 
 #include "common/check.h"
 #include "common/state_file.h"
-#include "replay/priorities.h"
-#include "replay/uniform_sampler.h"
 
 namespace rl::replay {
 namespace {
@@ -29,6 +27,12 @@ constexpr int kMaxRedraws = 16;
 // Entry of local frame id `id` in an actor's window (ids may be any int64).
 size_t WindowEntry(int64_t id) {
   return static_cast<size_t>(static_cast<uint64_t>(id) & static_cast<uint64_t>(kWindow - 1));
+}
+
+// Validated options, so that the base is built from a checked capacity.
+PixelTableOptions Checked(PixelTableOptions options) {
+  options.Validate();
+  return options;
 }
 
 }  // namespace
@@ -83,15 +87,13 @@ void PixelSampleBatch::Resize(int new_count, int new_height, int new_width, int 
   weight.resize(n);
 }
 
-PixelSampleSpans PixelSampleBatch::spans() {
-  return PixelSampleSpans{obs, next_obs, {action, reward, discount, index, weight, {}}};
+SampleSpans PixelSampleBatch::spans() {
+  return SampleSpans{{}, {}, {action, reward, discount, index, weight, {}}, obs, next_obs};
 }
 
 PixelTable::PixelTable(PixelTableOptions options, std::unique_ptr<Sampler> sampler)
-    : options_(options), sampler_(std::move(sampler)) {
-  options_.Validate();
+    : Table(Checked(options).capacity, std::move(sampler)), options_(options) {
   frame_capacity_ = options_.frames_kept();
-  if (sampler_ == nullptr) sampler_ = std::make_unique<UniformSampler>(options_.capacity);
   if (options_.height > 0 && options_.width > 0 && options_.stack > 0) {
     Allocate(options_.height, options_.width, options_.stack);
   }
@@ -100,9 +102,9 @@ PixelTable::PixelTable(PixelTableOptions options, std::unique_ptr<Sampler> sampl
 PixelTable::~PixelTable() = default;
 
 void PixelTable::Allocate(int height, int width, int stack) {
-  height_ = height;
-  width_ = width;
-  stack_ = stack;
+  shape_.height = height;
+  shape_.width = width;
+  shape_.stack = stack;
   const auto slots = static_cast<size_t>(options_.capacity);
   frames_.assign(static_cast<size_t>(frame_capacity_) * static_cast<size_t>(height) *
                      static_cast<size_t>(width),
@@ -133,7 +135,7 @@ bool PixelTable::Resolve(const ActorFrames& actor, std::span<const int64_t> loca
 }
 
 bool PixelTable::Stale(int64_t slot) const {
-  const size_t refs = 2 * static_cast<size_t>(stack_);
+  const size_t refs = 2 * static_cast<size_t>(shape_.stack);
   const int64_t* first = frame_refs_.data() + static_cast<size_t>(slot) * refs;
   return *std::min_element(first, first + refs) < total_frames_ - frame_capacity_;
 }
@@ -152,8 +154,9 @@ void PixelTable::DropAllStale() {
   }
 }
 
-const char* PixelTable::Insert(const PixelBatchView& batch) {
+const char* PixelTable::Insert(const TransitionBatchView& batch) {
   // Check the whole batch before storing any of it.
+  if (batch.obs_size != 0) return "a flat batch (obs_size > 0); this run stores pixel transitions";
   if (batch.actor_id < 0 || batch.actor_id > kMaxActorId) return "actor_id outside [0, 65535]";
   if (batch.num_frames < 0 || batch.count < 0) return "negative num_frames or count";
   if (batch.num_frames == 0 && batch.count == 0) return "empty batch";
@@ -162,9 +165,9 @@ const char* PixelTable::Insert(const PixelBatchView& batch) {
   }
   if (batch.stack < 1 || batch.stack > kMaxStack) return "stack outside [1, 64]";
   // The table's geometry once known, else the configured parts of it.
-  const int want_height = height_ > 0 ? height_ : options_.height;
-  const int want_width = width_ > 0 ? width_ : options_.width;
-  const int want_stack = stack_ > 0 ? stack_ : options_.stack;
+  const int want_height = shape_.height > 0 ? shape_.height : options_.height;
+  const int want_width = shape_.width > 0 ? shape_.width : options_.width;
+  const int want_stack = shape_.stack > 0 ? shape_.stack : options_.stack;
   if ((want_height > 0 && batch.height != want_height) ||
       (want_width > 0 && batch.width != want_width) ||
       (want_stack > 0 && batch.stack != want_stack)) {
@@ -190,7 +193,7 @@ const char* PixelTable::Insert(const PixelBatchView& batch) {
   }
   ActorFrames* actor = FindOrAddActor(batch.actor_id);
   if (actor == nullptr) return "too many actors (1024 distinct actor ids at most)";
-  if (height_ == 0) Allocate(batch.height, batch.width, batch.stack);
+  if (shape_.height == 0) Allocate(batch.height, batch.width, batch.stack);
   if (n > 0 && !columns_.allocated()) {
     columns_.Allocate(options_.capacity, batch.columns.action_width);
   }
@@ -221,36 +224,26 @@ const char* PixelTable::Insert(const PixelBatchView& batch) {
       ++missing_frames_;
       continue;
     }
-    const int64_t slot = total_inserts_ % options_.capacity;
-    const auto s = static_cast<size_t>(slot);
+    const size_t s = Append(batch.columns, i);
     std::copy(global, global + 2 * stack, frame_refs_.data() + s * 2 * stack);
-    if (columns_.insert_numbers()[s] < 0) ++size_;
-    columns_.Store(s, batch.columns, i, total_inserts_);
-    sampler_->Insert(slot, batch.columns.priority.empty() ? 0.0 : batch.columns.priority[i]);
-    ++total_inserts_;
   }
   return nullptr;
 }
 
-bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const PixelSampleSpans& out) {
+bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const SampleSpans& out) {
   RL_CHECK(batch_size > 0) << "batch_size must be positive, got " << batch_size;
   if (size_ == 0) return false;
   const auto n = static_cast<size_t>(batch_size);
-  const auto stack = static_cast<size_t>(stack_);
-  const size_t frame_bytes = static_cast<size_t>(height_) * static_cast<size_t>(width_);
+  const auto stack = static_cast<size_t>(shape_.stack);
+  const size_t frame_bytes = static_cast<size_t>(shape_.height) * static_cast<size_t>(shape_.width);
   const size_t stack_bytes = stack * frame_bytes;
-  RL_CHECK(out.obs.size() == n * stack_bytes && out.next_obs.size() == n * stack_bytes)
-      << "obs and next_obs must hold batch_size * stack * height * width = " << n * stack_bytes
-      << " bytes";
-  RL_CHECK(columns_.Fits(out.columns, n))
-      << "action must hold batch_size * action_width floats, reward, discount, index and weight "
-         "batch_size = "
-      << n << " values";
+  RL_CHECK(out.obs_pixels.size() == n * stack_bytes &&
+           out.next_obs_pixels.size() == n * stack_bytes)
+      << "obs_pixels and next_obs_pixels must hold batch_size * stack * height * width = "
+      << n * stack_bytes << " bytes";
 
   // Let the sampler choose the slots, drawing again for each stale one (removed on the way).
-  if (items_.size() < n) items_.resize(n);
-  const std::span<SampledItem> items(items_.data(), n);
-  sampler_->Sample(rng, items);
+  const std::span<SampledItem> items = Draw(n, rng, out);
   bool dropped = false;
   for (size_t i = 0; i < n; ++i) {
     int redraws = 0;
@@ -279,36 +272,22 @@ bool PixelTable::Sample(int batch_size, std::mt19937_64* rng, const PixelSampleS
     for (size_t k = 0; k < 2 * stack; ++k) {
       const uint8_t* frame =
           frames_.data() + static_cast<size_t>(refs[k] % frame_capacity_) * frame_bytes;
-      uint8_t* to = k < stack ? out.obs.data() + i * stack_bytes + k * frame_bytes
-                              : out.next_obs.data() + i * stack_bytes + (k - stack) * frame_bytes;
+      uint8_t* to = k < stack
+                        ? out.obs_pixels.data() + i * stack_bytes + k * frame_bytes
+                        : out.next_obs_pixels.data() + i * stack_bytes + (k - stack) * frame_bytes;
       std::memcpy(to, frame, frame_bytes);
     }
-    columns_.Gather(s, i, out.columns);
-    out.columns.weight[i] = ImportanceWeight(items[i].probability, min_probability, beta_);
+    Gather(items[i], i, min_probability, out);
   }
   total_samples_ += batch_size;
   return true;
 }
 
-int64_t PixelTable::UpdatePriorities(std::span<const int64_t> index,
-                                     std::span<const float> priority) {
-  return ApplyPriorities(index, priority, columns_.insert_numbers(), total_inserts_,
-                         sampler_.get());
-}
-
-void PixelTable::set_importance_exponent(double beta) {
-  if (!(beta >= 0.0 && beta <= 1.0)) {
-    throw std::invalid_argument("pixel table: importance exponent must be in [0, 1], got " +
-                                std::to_string(beta));
-  }
-  beta_ = beta;
-}
-
 int64_t PixelTable::memory_bytes() const {
   size_t bytes = frames_.capacity() + frame_refs_.capacity() * sizeof(int64_t) +
-                 items_.capacity() * sizeof(SampledItem) + actors_.capacity() * sizeof(ActorFrames);
+                 actors_.capacity() * sizeof(ActorFrames);
   for (const ActorFrames& actor : actors_) bytes += actor.window.capacity() * sizeof(FrameRef);
-  return static_cast<int64_t>(bytes) + columns_.memory_bytes() + sampler_->memory_bytes();
+  return static_cast<int64_t>(bytes) + common_memory_bytes();
 }
 
 }  // namespace rl::replay
@@ -316,8 +295,8 @@ int64_t PixelTable::memory_bytes() const {
 namespace rl::replay {
 
 void PixelTable::Save(const std::string& prefix, StateStream* out) const {
-  const int64_t shape[] = {options_.capacity,      frame_capacity_, height_, width_, stack_,
-                           columns_.action_width()};
+  const int64_t shape[] = {options_.capacity, frame_capacity_, shape_.height,
+                           shape_.width,      shape_.stack,    columns_.action_width()};
   const int64_t counts[] = {size_,         total_inserts_,  total_samples_,
                             total_frames_, missing_frames_, stale_draws_};
   out->PutInts(prefix + "shape", shape);
@@ -403,7 +382,7 @@ void PixelTable::Restore(const std::string& prefix, const StateView& in) {
   if (geometry) {
     Allocate(static_cast<int>(height), static_cast<int>(width), static_cast<int>(stack));
   } else {
-    height_ = width_ = stack_ = 0;
+    shape_ = {};
     frames_.clear();
     frame_refs_.clear();
   }
@@ -451,8 +430,8 @@ void PixelTable::Restore(const std::string& prefix, const StateView& in) {
     if (n >= inserts || n < inserts - capacity || n % capacity != static_cast<int64_t>(slot)) {
       refuse("the snapshot's insert numbers are not a table's");
     }
-    const int64_t* refs = frame_refs_.data() + slot * 2 * static_cast<size_t>(stack_);
-    for (int64_t k = 0; k < 2 * stack_; ++k) {
+    const int64_t* refs = frame_refs_.data() + slot * 2 * static_cast<size_t>(shape_.stack);
+    for (int64_t k = 0; k < 2 * shape_.stack; ++k) {
       if (refs[k] < 0 || refs[k] >= frames)
         refuse("the snapshot's transitions name unknown frames");
     }

@@ -1,5 +1,5 @@
-// PixelTable: the replay daemon's storage for pixel transitions, where every frame is stored
-// once and observations are stacks rebuilt from frame references when sampled.
+// PixelTable: the Table (table.h) of pixel transitions, where every frame is stored once and
+// observations are stacks rebuilt from frame references when sampled.
 //
 // Consecutive transitions of an episode share all but one frame of their stacks (obs of step
 // t+1 is next_obs of step t, which is obs of step t shifted by one frame), so storing stacks
@@ -45,8 +45,7 @@
 #include <vector>
 
 #include "replay/huge_page_allocator.h"
-#include "replay/sampler.h"
-#include "replay/transition_columns.h"
+#include "replay/table.h"
 
 namespace rl::replay {
 
@@ -72,34 +71,6 @@ struct PixelTableOptions {
   int64_t frames_kept() const;
 };
 
-/// A batch from one actor, as views of the caller's arrays. num_frames new frames with their
-/// local ids (strictly increasing) and num_frames * height * width bytes; count transitions, each
-/// naming its obs and next_obs stacks by local frame id, oldest first (count * stack ids each;
-/// transition i at [i * stack, (i + 1) * stack)), which may be frames of this batch or of an
-/// earlier batch of the same actor. The other fields as ColumnsView (transition_columns.h).
-struct PixelBatchView {
-  int32_t actor_id = 0;
-  int height = 0;
-  int width = 0;
-  int stack = 0;
-  int num_frames = 0;
-  std::span<const int64_t> frame_id;
-  std::span<const uint8_t> frames;
-  int count = 0;
-  std::span<const int64_t> obs_frames;
-  std::span<const int64_t> next_obs_frames;
-  ColumnsView columns;
-};
-
-/// Where Sample() writes a batch of `count` transitions: obs and next_obs have room for
-/// count * stack * height * width bytes (transition i's stack at [i * stack * height * width,
-/// ...), its frames oldest first); the other fields as ColumnSpans (transition_columns.h).
-struct PixelSampleSpans {
-  std::span<uint8_t> obs;
-  std::span<uint8_t> next_obs;
-  ColumnSpans columns;
-};
-
 /// A batch that owns its arrays, for callers that have none of their own. Resize() allocates
 /// only when the batch grows.
 struct PixelSampleBatch {
@@ -118,87 +89,60 @@ struct PixelSampleBatch {
 
   void Resize(int new_count, int new_height, int new_width, int new_stack,
               int new_action_width = 1);
-  PixelSampleSpans spans();
+  SampleSpans spans();
 };
 
-class PixelTable {
+class PixelTable final : public Table {
  public:
   /// Throws std::invalid_argument when the options are bad. A null sampler means uniform; a
   /// sampler given must have `capacity` slots.
   explicit PixelTable(PixelTableOptions options, std::unique_ptr<Sampler> sampler = nullptr);
-  PixelTable(const PixelTable&) = delete;
-  PixelTable& operator=(const PixelTable&) = delete;
-  ~PixelTable();
+  ~PixelTable() override;
+
+  TableKind kind() const override { return TableKind::kPixels; }
 
   /// Stores the batch's frames, then each of its transitions whose frames are all known (see
   /// the top of the file), overwriting the oldest when full. Returns nullptr on success (even
   /// when some transitions were skipped), or a short reason why the whole batch was refused
-  /// (nothing stored): actor_id outside [0, 65535], a geometry other than the table's or out of
-  /// range, views whose sizes do not match the counts, frame ids not strictly increasing within
-  /// the batch, no frames and no transitions, or a 1025th distinct actor. A batch whose first
-  /// frame id is not above the last one of its actor is taken to come from a restarted actor:
-  /// the ids of its earlier frames are forgotten. O(num_frames * height * width + count * stack);
-  /// allocates only for the first batch (when the geometry was not configured) and for the
-  /// first batch of each actor.
-  [[nodiscard]] const char* Insert(const PixelBatchView& batch);
+  /// (nothing stored): a flat batch (obs_size > 0), actor_id outside [0, 65535], a geometry
+  /// other than the table's or out of range, views whose sizes do not match the counts, frame
+  /// ids not strictly increasing within the batch, no frames and no transitions, or a 1025th
+  /// distinct actor. A batch whose first frame id is not above the last one of its actor is
+  /// taken to come from a restarted actor: the ids of its earlier frames are forgotten.
+  /// O(num_frames * height * width + count * stack); allocates only for the first batch (when
+  /// the geometry was not configured) and for the first batch of each actor.
+  [[nodiscard]] const char* Insert(const TransitionBatchView& batch) override;
 
-  /// Draws batch_size transitions with replacement, as the sampler decides, into `out`, whose
-  /// spans must have exactly the sizes batch_size and the geometry call for (a mismatch is a
-  /// caller bug and aborts). Weights as in ReplayTable::Sample(). A drawn transition that has
+  /// As Table::Sample(), into obs_pixels and next_obs_pixels. A drawn transition that has
   /// become stale is removed from the sampler and the element is drawn again (without
   /// stratification); after 16 stale draws for one element, every stale transition is removed
   /// in one pass over the table (O(capacity * stack)), so the next draw is fresh. Returns
   /// false, writing nothing, when the table holds no transition that can be drawn.
-  /// O(batch_size * (stack * height * width + log capacity)); no allocation once a batch of this
-  /// size has been drawn.
-  bool Sample(int batch_size, std::mt19937_64* rng, const PixelSampleSpans& out);
+  /// O(batch_size * (stack * height * width + log capacity)).
+  bool Sample(int batch_size, std::mt19937_64* rng, const SampleSpans& out) override;
 
-  /// As ReplayTable::UpdatePriorities(); transitions removed as stale are skipped too.
-  int64_t UpdatePriorities(std::span<const int64_t> index, std::span<const float> priority);
-
-  /// As ReplayTable::set_importance_exponent().
-  void set_importance_exponent(double beta);
-  double importance_exponent() const { return beta_; }
-
-  /// Transitions stored that can be drawn (at most capacity(); stale ones that Sample() has met
-  /// are no longer counted).
-  int64_t size() const { return size_; }
-  int64_t capacity() const { return options_.capacity; }
-  /// Frames kept (the effective frame_capacity).
-  int64_t frame_capacity() const { return frame_capacity_; }
-  /// Transitions ever stored (including overwritten ones; skipped ones are not counted).
-  int64_t total_inserts() const { return total_inserts_; }
-  /// Transitions ever drawn by Sample() (redraws count once).
-  int64_t total_samples() const { return total_samples_; }
-  /// Frames ever stored (including overwritten ones).
-  int64_t total_frames() const { return total_frames_; }
+  ObservationShape shape() const override { return shape_; }
   /// Frame geometry; 0 until known.
-  int height() const { return height_; }
-  int width() const { return width_; }
-  int stack() const { return stack_; }
-  /// Floats per action; 0 until known.
-  int action_width() const { return columns_.action_width(); }
-  /// Transitions skipped at Insert() because a frame they name is unknown or overwritten.
-  int64_t transitions_missing_frames() const { return missing_frames_; }
-  /// Draws made again because the drawn transition's oldest frame had been overwritten.
-  int64_t stale_draws() const { return stale_draws_; }
-  /// Bytes held by the table and its sampler (the capacities of their arrays).
-  int64_t memory_bytes() const;
-  /// The sampler, for inspection (probabilities, size).
-  const Sampler& sampler() const { return *sampler_; }
+  int height() const { return shape_.height; }
+  int width() const { return shape_.width; }
+  int stack() const { return shape_.stack; }
 
-  /// Adds the table (geometry, counters, the frame ring, every slot, each actor's window of
-  /// frame ids, the sampler's state) to a snapshot as sections prefix + "...", referring to its
-  /// arrays: the table must not change until the snapshot is written (a fork()ed child writes a
-  /// copy-on-write image of it). O(actors) besides the section entries.
-  void Save(const std::string& prefix, StateStream* out) const;
-  /// Replaces the table's contents by a snapshot's. Throws std::runtime_error saying why it is
-  /// refused: another capacity or frame capacity, a geometry or action width other than the
-  /// configured ones, or contents that are not a table's (counters, insert numbers, frame
-  /// references, actor windows or sampler state inconsistent). Every length is checked against
-  /// the configuration before anything is allocated. A table whose Restore threw must not be
-  /// used further. O(frame bytes + capacity * stack + actors * 4096).
-  void Restore(const std::string& prefix, const StateView& in);
+  /// Frames kept (the effective frame_capacity).
+  int64_t frame_capacity() const override { return frame_capacity_; }
+  /// Frames ever stored (including overwritten ones).
+  int64_t total_frames() const override { return total_frames_; }
+  /// Transitions skipped at Insert() because a frame they name is unknown or overwritten.
+  int64_t transitions_missing_frames() const override { return missing_frames_; }
+  /// Draws made again because the drawn transition's oldest frame had been overwritten.
+  int64_t stale_draws() const override { return stale_draws_; }
+  int64_t memory_bytes() const override;
+
+  /// Adds the geometry, counters, the frame ring, every slot, each actor's window of frame ids
+  /// and the sampler's state. O(actors) besides the section entries.
+  void Save(const std::string& prefix, StateStream* out) const override;
+  /// Also refused: another frame capacity, frame references or actor windows inconsistent.
+  /// O(frame bytes + capacity * stack + actors * 4096).
+  void Restore(const std::string& prefix, const StateView& in) override;
 
  private:
   // Where an actor's recent local frame ids are: entry local_id % kWindow.
@@ -226,29 +170,18 @@ class PixelTable {
   void DropAllStale();
 
   PixelTableOptions options_;
-  std::unique_ptr<Sampler> sampler_;
   int64_t frame_capacity_ = 0;
-  int height_ = 0;
-  int width_ = 0;
-  int stack_ = 0;
-  int64_t size_ = 0;
-  int64_t total_inserts_ = 0;
-  int64_t total_samples_ = 0;
+  ObservationShape shape_;  // the frames' geometry (obs_size 0); 0 until known
   int64_t total_frames_ = 0;
   int64_t missing_frames_ = 0;
   int64_t stale_draws_ = 0;
-  double beta_ = 1.0;
 
-  // frame_capacity_ frames of height_ * width_ bytes, in huge pages where the kernel offers them
+  // frame_capacity_ frames of height * width bytes, in huge pages where the kernel offers them
   std::vector<uint8_t, HugePageAllocator<uint8_t>> frames_;
   std::vector<ActorFrames> actors_;  // sorted by actor_id
 
-  // Per-slot storage (frame_refs_: 2 * stack_ global frame numbers per slot, obs then next_obs).
+  // Per-slot storage (frame_refs_: 2 * stack global frame numbers per slot, obs then next_obs).
   std::vector<int64_t> frame_refs_;
-  // Insert numbers of -1 mark slots that hold no transition that can be drawn.
-  TransitionColumns columns_;
-
-  std::vector<SampledItem> items_;  // scratch for Sample()
 };
 
 }  // namespace rl::replay

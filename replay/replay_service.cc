@@ -70,7 +70,7 @@ void ReplayServiceOptions::Validate() const {
             priority_epsilon);
   }
   require(beta_anneal_samples >= 0, "beta_anneal_samples", ">= 0", beta_anneal_samples);
-  require(frame_capacity >= 0, "frame_capacity", ">= 0", frame_capacity);
+  pixel_table().Validate();
   require(handle_timeout_ms >= 0, "handle_timeout_ms", ">= 0", handle_timeout_ms);
   require(max_actors >= 1 && max_actors <= kMaxActorsLimit, "max_actors", "in [1, 1024]",
           max_actors);
@@ -78,10 +78,39 @@ void ReplayServiceOptions::Validate() const {
   require(stop_drain_ms >= 0, "stop_drain_ms", ">= 0", stop_drain_ms);
 }
 
+PixelTableOptions ReplayServiceOptions::pixel_table() const {
+  PixelTableOptions o;
+  o.capacity = table.capacity;
+  o.frame_capacity = frame_capacity;
+  o.height = frames.height;
+  o.width = frames.width;
+  o.stack = frames.stack;
+  o.action_width = table.action_width;
+  return o;
+}
+
+TransitionBatchView ViewOf(const rlmsg::transition_batch_t& m) {
+  return TransitionBatchView{
+      .obs_size = m.obs_size,
+      .count = m.count,
+      .obs = m.obs,
+      .next_obs = m.next_obs,
+      .columns = {m.action_width, m.action, m.reward, m.discount, m.episode_id, m.priority},
+      .actor_id = m.actor_id,
+      .height = m.height,
+      .width = m.width,
+      .stack = m.stack,
+      .num_frames = m.num_frames,
+      .frame_id = m.frame_id,
+      .frames = m.frames,
+      .obs_frames = m.obs_frames,
+      .next_obs_frames = m.next_obs_frames};
+}
+
 ReplayService::ReplayService(Bus* bus, ReplayServiceOptions options)
     : bus_(*bus),
       options_(Validated(std::move(options))),
-      table_(options_.table, MakeSampler()),
+      table_(MakeTable(options_.kind.value_or(TableKind::kFlat))),
       limiter_(options_.limiter),
       rng_(options_.seed) {
   insert_allowed_ = limiter_.CanInsert(options_.insert_unit);
@@ -98,6 +127,13 @@ std::unique_ptr<Sampler> ReplayService::MakeSampler() const {
   if (!options_.prioritized) return std::make_unique<UniformSampler>(options_.table.capacity);
   return std::make_unique<PrioritizedSampler>(options_.table.capacity, options_.alpha,
                                               options_.priority_epsilon);
+}
+
+std::unique_ptr<Table> ReplayService::MakeTable(TableKind kind) const {
+  if (kind == TableKind::kPixels) {
+    return std::make_unique<PixelTable>(options_.pixel_table(), MakeSampler());
+  }
+  return std::make_unique<ReplayTable>(options_.table, MakeSampler());
 }
 
 double ReplayService::beta() const {
@@ -128,7 +164,7 @@ void ReplayService::OnTransitions(const rlmsg::transition_batch_t& m) {
     }
   }
   const int64_t before = total_inserts();
-  if (why == nullptr) why = m.obs_size > 0 ? InsertFlat(m) : InsertPixels(m);
+  if (why == nullptr) why = Insert(m);
   if (why != nullptr) {
     ++counters_.batches_refused;
     LogRefusal("transition batch", why);
@@ -139,31 +175,17 @@ void ReplayService::OnTransitions(const rlmsg::transition_batch_t& m) {
   PublishFlow(/*force=*/false);
 }
 
-const char* ReplayService::InsertFlat(const rlmsg::transition_batch_t& m) {
-  if (pixels_ != nullptr) return "this run stores pixel transitions";
-  return table_.Insert(TransitionBatchView{
-      m.obs_size, m.count, m.obs, m.next_obs,
-      ColumnsView{m.action_width, m.action, m.reward, m.discount, m.episode_id, m.priority}});
-}
-
-const char* ReplayService::InsertPixels(const rlmsg::transition_batch_t& m) {
-  if (table_.total_inserts() > 0) return "this run stores flat transitions";
-  if (pixels_ == nullptr) {
-    PixelTableOptions options;
-    options.capacity = options_.table.capacity;
-    options.frame_capacity = options_.frame_capacity;
-    options.action_width = options_.table.action_width;
-    pixels_ = std::make_unique<PixelTable>(options, MakeSampler());
-  }
-  return pixels_->Insert(PixelBatchView{
-      m.actor_id, m.height, m.width, m.stack, m.num_frames, m.frame_id, m.frames, m.count,
-      m.obs_frames, m.next_obs_frames,
-      ColumnsView{m.action_width, m.action, m.reward, m.discount, m.episode_id, m.priority}});
+const char* ReplayService::Insert(const rlmsg::transition_batch_t& m) {
+  const TransitionBatchView batch = ViewOf(m);
+  // Without a kind from the env's spec, the first batch decides: an unused table of the other
+  // kind gives way.
+  const TableKind kind = batch.obs_size > 0 ? TableKind::kFlat : TableKind::kPixels;
+  if (!options_.kind && kind != table_->kind() && table_->unused()) table_ = MakeTable(kind);
+  return table_->Insert(batch);
 }
 
 void ReplayService::OnPriorities(const rlmsg::priority_update_t& m) {
-  const int64_t applied = pixels_ ? pixels_->UpdatePriorities(m.index, m.priority)
-                                  : table_.UpdatePriorities(m.index, m.priority);
+  const int64_t applied = table_->UpdatePriorities(m.index, m.priority);
   counters_.priorities_applied += applied;
   counters_.priorities_stale += m.count - applied;
 }
@@ -193,14 +215,12 @@ const char* ReplayService::Unanswerable(const PendingRequest& request) {
     return "batch_size above 2 * error_buffer - samples_per_insert (the limiter could never "
            "allow it)";
   }
-  // The reply's size is known once the observation size (or geometry) and action width are.
-  const int width = pixels_ ? pixels_->action_width() : table_.action_width();
-  const bool pixels = pixels_ != nullptr && pixels_->height() > 0;
-  if (width == 0 || (!pixels && table_.obs_size() == 0)) return nullptr;
+  // The reply's size is known once the observations and the action width are.
+  const ObservationShape shape = table_->shape();
+  const int width = table_->action_width();
+  if (width == 0 || !shape.known()) return nullptr;
   // The observation arrays alone, in 64 bits (also keeps the counts from overflowing).
-  const int64_t obs_bytes = pixels
-                                ? int64_t{pixels_->stack()} * pixels_->height() * pixels_->width()
-                                : int64_t{table_.obs_size()} * 4;
+  const int64_t obs_bytes = int64_t{shape.obs_size} * 4 + shape.pixel_bytes();
   if (int64_t{request.batch_size} * 2 * obs_bytes > options_.max_reply_bytes) {
     return "reply above max_reply_bytes";
   }
@@ -209,8 +229,8 @@ const char* ReplayService::Unanswerable(const PendingRequest& request) {
   r.header.sender = bus_.config().sender;
   r.requester = request.requester;
   r.count = request.batch_size;
-  r.num_values = pixels ? 0 : request.batch_size * table_.obs_size();
-  r.num_bytes = pixels ? static_cast<int32_t>(request.batch_size * obs_bytes) : 0;
+  r.num_values = request.batch_size * shape.obs_size;
+  r.num_bytes = static_cast<int32_t>(request.batch_size * shape.pixel_bytes());
   r.num_action_values = request.batch_size * width;
   if (r.getEncodedSize() > options_.max_reply_bytes) return "reply above max_reply_bytes";
   return nullptr;
@@ -244,52 +264,38 @@ void ReplayService::Answer(const PendingRequest& request) {
   r.requester = request.requester;
   r.request_id = request.request_id;
   r.count = count;
-  r.action_width = pixels_ ? pixels_->action_width() : table_.action_width();
+  const ObservationShape shape = table_->shape();
+  r.obs_size = shape.obs_size;
+  r.height = shape.height;
+  r.width = shape.width;
+  r.stack = shape.stack;
+  r.num_values = count * shape.obs_size;
+  r.num_bytes = static_cast<int32_t>(count * shape.pixel_bytes());
+  r.action_width = table_->action_width();
   r.num_action_values = count * r.action_width;
+  r.obs.resize(static_cast<size_t>(r.num_values));
+  r.next_obs.resize(static_cast<size_t>(r.num_values));
+  r.obs_pixels.resize(static_cast<size_t>(r.num_bytes));
+  r.next_obs_pixels.resize(static_cast<size_t>(r.num_bytes));
   r.action.resize(static_cast<size_t>(r.num_action_values));
   r.reward.resize(n);
   r.discount.resize(n);
   r.index.resize(n);
   r.weight.resize(n);
+  table_->set_importance_exponent(beta());
   const ColumnSpans columns{r.action, r.reward, r.discount, r.index, r.weight, {}};
-  bool sampled = false;
-  if (pixels_ != nullptr) {
-    r.obs_size = r.num_values = 0;
-    r.obs.clear();
-    r.next_obs.clear();
-    r.height = pixels_->height();
-    r.width = pixels_->width();
-    r.stack = pixels_->stack();
-    r.num_bytes = count * r.stack * r.height * r.width;
-    r.obs_pixels.resize(static_cast<size_t>(r.num_bytes));
-    r.next_obs_pixels.resize(static_cast<size_t>(r.num_bytes));
-    pixels_->set_importance_exponent(beta());
-    sampled =
-        pixels_->Sample(count, &rng_, PixelSampleSpans{r.obs_pixels, r.next_obs_pixels, columns});
-    if (!sampled) {
-      // Every stored transition names an overwritten frame (a frame ring far too small for the
-      // traffic): nothing can be drawn until new transitions arrive.
-      ++counters_.requests_refused;
-      LogRefusal("sample request", "every stored transition names an overwritten frame");
-      return;
-    }
-    r.replay_size = pixels_->size();
-    r.total_inserts = pixels_->total_inserts();
-  } else {
-    r.height = r.width = r.stack = r.num_bytes = 0;
-    r.obs_pixels.clear();
-    r.next_obs_pixels.clear();
-    r.obs_size = table_.obs_size();
-    r.num_values = count * r.obs_size;
-    r.obs.resize(static_cast<size_t>(r.num_values));
-    r.next_obs.resize(static_cast<size_t>(r.num_values));
-    table_.set_importance_exponent(beta());
-    // CanSample() held, so at least min_size_to_sample >= 1 transitions are stored.
-    sampled = table_.Sample(count, &rng_, SampleSpans{r.obs, r.next_obs, columns});
-    RL_CHECK(sampled) << "the limiter allowed a sample from an empty table";
-    r.replay_size = table_.size();
-    r.total_inserts = table_.total_inserts();
+  if (!table_->Sample(count, &rng_,
+                      SampleSpans{r.obs, r.next_obs, columns, r.obs_pixels, r.next_obs_pixels})) {
+    // CanSample() held, so transitions were stored; none can be drawn when each names an
+    // overwritten frame (a frame ring far too small for the traffic) until new ones arrive.
+    ++counters_.requests_refused;
+    LogRefusal("sample request",
+               "no stored transition can be drawn (each names an overwritten "
+               "frame)");
+    return;
   }
+  r.replay_size = table_->size();
+  r.total_inserts = table_->total_inserts();
   limiter_.Sample(count);
   bus_.Publish(channels::kSamples, &r, Port::kBulk);
   ++counters_.requests_answered;
@@ -324,7 +330,7 @@ void ReplayService::PublishFlow(bool force) {
 
 void ReplayService::PublishStats(double now) {
   stats_.size = size();
-  stats_.capacity = table_.capacity();
+  stats_.capacity = table_->capacity();
   stats_.total_inserts = total_inserts();
   stats_.total_samples = total_samples();
   stats_.inserts_per_second = stats_insert_rate_.Take(total_inserts(), now);
@@ -332,11 +338,11 @@ void ReplayService::PublishStats(double now) {
   stats_.prioritized = options_.prioritized ? 1 : 0;
   stats_.beta = beta();
   stats_.memory_bytes = memory_bytes();
-  stats_.frames = pixels_ ? std::min(pixels_->total_frames(), pixels_->frame_capacity()) : 0;
+  stats_.frames = std::min(table_->total_frames(), table_->frame_capacity());
   stats_.priorities_applied = counters_.priorities_applied;
   stats_.priorities_stale = counters_.priorities_stale;
-  stats_.missing_frames = pixels_ ? pixels_->transitions_missing_frames() : 0;
-  stats_.stale_draws = pixels_ ? pixels_->stale_draws() : 0;
+  stats_.missing_frames = table_->transitions_missing_frames();
+  stats_.stale_draws = table_->stale_draws();
   stats_.samples_per_insert = limiter_.samples_per_insert();
   stats_.insert_allowed = insert_allowed_ ? 1 : 0;
   stats_.pending_requests = pending_requests();
@@ -353,7 +359,7 @@ void ReplayService::PrintProgress(double now) {
   std::printf(
       "replay: size %lld/%lld inserts %lld (%.1f/s) samples %lld (%.1f/s) spi %.2f "
       "insert_allowed %d pending %d dropped %lld lost %lld memory %.1f MB",
-      static_cast<long long>(size()), static_cast<long long>(table_.capacity()),
+      static_cast<long long>(size()), static_cast<long long>(table_->capacity()),
       static_cast<long long>(total_inserts()), inserts_per_second,
       static_cast<long long>(total_samples()), samples_per_second, limiter_.samples_per_insert(),
       insert_allowed_ ? 1 : 0, pending_requests(),
@@ -365,11 +371,12 @@ void ReplayService::PrintProgress(double now) {
                 static_cast<long long>(counters_.priorities_applied),
                 static_cast<long long>(counters_.priorities_stale));
   }
-  if (pixels_ != nullptr) {
+  // Tables that store frames.
+  if (table_->frame_capacity() > 0) {
     std::printf(" frames %lld missing_frames %lld stale_draws %lld",
-                static_cast<long long>(pixels_->total_frames()),
-                static_cast<long long>(pixels_->transitions_missing_frames()),
-                static_cast<long long>(pixels_->stale_draws()));
+                static_cast<long long>(table_->total_frames()),
+                static_cast<long long>(table_->transitions_missing_frames()),
+                static_cast<long long>(table_->stale_draws()));
   }
   std::printf("\n");
   std::fflush(stdout);

@@ -1,11 +1,11 @@
-// ReplayService: the replay daemon's LCM side. It connects a ReplayTable and a RateLimiter to
-// the bus.
+// ReplayService: the replay daemon's LCM side. It connects a Table (table.h) and a RateLimiter
+// to the bus.
 //
 // In (main port):
 //   RL_TRANSITIONS     transition_batch_t  every valid batch is stored, whatever the limiter says
-//                                          (the limiter only tells actors to pause); flat ones in
-//                                          the ReplayTable, pixel ones (frames stored once) in
-//                                          the PixelTable
+//                                          (the limiter only tells actors to pause): flat ones
+//                                          in a ReplayTable, pixel ones (frames stored once) in
+//                                          a PixelTable
 //   RL_SAMPLE_REQUEST  sample_request_t    queued; several may be in flight
 //   RL_PRIORITIES      priority_update_t   new priorities (prioritized replay)
 // Out:
@@ -19,8 +19,9 @@
 // itself refuses (a batch the table will not store, a request that can never be answered) is
 // counted here and reported in stats_replay_t.dropped_invalid together with the bus's count.
 //
-// A run stores either flat or pixel transitions: the kind of the first batch decides, and
-// batches of the other kind are refused. Actions are stored as the env's action width of floats
+// A run stores either flat or pixel transitions, in the table of that kind: the env's static
+// spec says which (options.kind), or else the kind of the first batch; batches of the other kind
+// are refused. Actions are stored as the env's action width of floats
 // and are otherwise opaque to the replay; an optional check (from the env's static spec: width,
 // integer indices, bounds) refuses a whole batch with a bad action. Sampling is uniform, or
 // proportional to priority (Schaul et al. 2016) with importance weights whose exponent beta is
@@ -46,6 +47,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -56,6 +58,7 @@
 #include "replay/pixel_table.h"
 #include "replay/rate_limiter.h"
 #include "replay/replay_table.h"
+#include "replay/table.h"
 #include "rlmsg/flow_control_t.hpp"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
@@ -69,8 +72,13 @@ namespace rl::replay {
 inline constexpr int kMaxActorsLimit = 1024;
 
 struct ReplayServiceOptions {
-  // Storage: capacity and observation size.
+  // Storage: capacity, and the observation size of flat transitions (0: from the first batch).
   ReplayTableOptions table;
+  // The kind of table, from the env's static spec (flat, or pixels when the env gives frames);
+  // none: the kind of the first batch.
+  std::optional<TableKind> kind;
+  // Pixel tables: the frames' height, width and stack (0: from the first batch).
+  ObservationShape frames;
   // Samples-per-insert ratio, minimum size and tolerance.
   RateLimiterOptions limiter;
   // Seed of the sampler's random generator.
@@ -115,6 +123,8 @@ struct ReplayServiceOptions {
 
   /// Throws std::invalid_argument naming the field when a value is out of range.
   void Validate() const;
+  /// The options of the pixel table: capacity, frame capacity, geometry, action width.
+  PixelTableOptions pixel_table() const;
 };
 
 /// What the service refused or dropped itself (the bus counts the rest).
@@ -126,6 +136,9 @@ struct ServiceCounters {
   int64_t priorities_applied = 0;  // priority updates applied
   int64_t priorities_stale = 0;    // priority updates for transitions overwritten since
 };
+
+/// The batch of a transition_batch_t, as views of its arrays.
+TransitionBatchView ViewOf(const rlmsg::transition_batch_t& m);
 
 class ReplayService {
  public:
@@ -150,22 +163,13 @@ class ReplayService {
   /// a flow_control_t and a stats_replay_t before returning.
   void Run(const std::function<bool()>& should_stop);
 
-  /// The flat table (empty when the run stores pixels).
-  const ReplayTable& table() const { return table_; }
-  /// The pixel table, or nullptr before the first pixel batch.
-  const PixelTable* pixel_table() const { return pixels_.get(); }
-  /// Of whichever table holds the run's transitions.
-  int64_t size() const { return pixels_ ? pixels_->size() : table_.size(); }
-  int64_t total_inserts() const {
-    return pixels_ ? pixels_->total_inserts() : table_.total_inserts();
-  }
-  int64_t total_samples() const {
-    return pixels_ ? pixels_->total_samples() : table_.total_samples();
-  }
-  /// Bytes held by both tables and their samplers (the flat table holds little in a pixel run).
-  int64_t memory_bytes() const {
-    return table_.memory_bytes() + (pixels_ ? pixels_->memory_bytes() : 0);
-  }
+  /// The table that holds the run's transitions.
+  const Table& table() const { return *table_; }
+  int64_t size() const { return table_->size(); }
+  int64_t total_inserts() const { return table_->total_inserts(); }
+  int64_t total_samples() const { return table_->total_samples(); }
+  /// Bytes held by the table and its sampler.
+  int64_t memory_bytes() const { return table_->memory_bytes(); }
   /// Importance-sampling exponent for the next batch (1 when sampling is uniform).
   double beta() const;
   const RateLimiter& limiter() const { return limiter_; }
@@ -201,21 +205,22 @@ class ReplayService {
   };
 
   void OnTransitions(const rlmsg::transition_batch_t& m);
-  // Stores a flat or a pixel batch; the reason it was refused, or nullptr.
-  const char* InsertFlat(const rlmsg::transition_batch_t& m);
-  const char* InsertPixels(const rlmsg::transition_batch_t& m);
+  // Stores the batch; the reason it was refused, or nullptr.
+  const char* Insert(const rlmsg::transition_batch_t& m);
   void OnSampleRequest(const rlmsg::sample_request_t& m);
   void OnPriorities(const rlmsg::priority_update_t& m);
   std::unique_ptr<Sampler> MakeSampler() const;
-  std::unique_ptr<PixelTable> MakePixelTable() const;
+  // An empty table of `kind`, as the options configure it.
+  std::unique_ptr<Table> MakeTable(TableKind kind) const;
   void CheckFresh() const;
   void Restore(const StateView& in);
+  // The table's part of Restore(): a table of the snapshot's kind, unless the env says another.
+  void RestoreTable(const StateView& in);
   std::string Summary() const;
   // Draws and publishes the reply to one request.
   void Answer(const PendingRequest& request);
   // Why a request can never be answered, or nullptr.
   const char* Unanswerable(const PendingRequest& request);
-  // Publishes flow_control_t when insert_allowed changed (or always, when forced).
   // Publishes flow_control_t when `force`, when insert_allowed changes, or when the credit has
   // grown by a quarter of its range above its lowest since the last publication (so that actors
   // waiting for credit hear of it soon).
@@ -226,8 +231,7 @@ class ReplayService {
 
   Bus& bus_;
   ReplayServiceOptions options_;
-  ReplayTable table_;
-  std::unique_ptr<PixelTable> pixels_;  // created by the first pixel batch
+  std::unique_ptr<Table> table_;
   RateLimiter limiter_;
   std::mt19937_64 rng_;
   std::deque<PendingRequest> pending_;

@@ -2,6 +2,7 @@
 // replay_service.h).
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -17,28 +18,19 @@ constexpr int64_t kMaxCount = int64_t{1} << 62;
 
 }  // namespace
 
-// The pixel table as InsertPixels() creates it at a run's first pixel batch.
-std::unique_ptr<PixelTable> ReplayService::MakePixelTable() const {
-  PixelTableOptions options;
-  options.capacity = options_.table.capacity;
-  options.frame_capacity = options_.frame_capacity;
-  options.action_width = options_.table.action_width;
-  return std::make_unique<PixelTable>(options, MakeSampler());
-}
-
 std::string ReplayService::Summary() const {
-  std::string s = "size " + std::to_string(size()) + " of " + std::to_string(table_.capacity()) +
+  std::string s = "size " + std::to_string(size()) + " of " + std::to_string(table_->capacity()) +
                   ", inserts " + std::to_string(total_inserts()) + ", samples " +
                   std::to_string(total_samples());
-  if (pixels_ != nullptr) s += ", frames " + std::to_string(pixels_->total_frames());
+  if (table_->frame_capacity() > 0) s += ", frames " + std::to_string(table_->total_frames());
   return s;
 }
 
 std::string ReplayService::SaveSnapshot(StateStream* out) const {
   out->PutInt("run_id", bus_.config().run_id);
-  out->PutText("table", pixels_ != nullptr           ? "pixels"
-                        : table_.total_inserts() > 0 ? "flat"
-                                                     : "empty");
+  // The table's kind names it and prefixes its sections: "flat." or "pixels.".
+  const std::string kind = TableKindName(table_->kind());
+  out->PutText("table", kind);
   const int64_t limiter[] = {limiter_.inserts(), limiter_.samples()};
   out->PutInts("limiter", limiter);
   std::ostringstream rng;
@@ -51,11 +43,7 @@ std::string ReplayService::SaveSnapshot(StateStream* out) const {
   std::vector<int64_t> actors;
   for (const auto& [id, n] : actor_inserts_) actors.insert(actors.end(), {int64_t{id}, n});
   out->PutInts("actor_inserts", actors);
-  if (pixels_ != nullptr) {
-    pixels_->Save("pixels.", out);
-  } else {
-    table_.Save("flat.", out);
-  }
+  table_->Save(kind + ".", out);
   // The last message heard from each sender, so that a restarted replay refuses recorded traffic
   // that this state already holds (common/lcm_bus.h).
   out->PutText("bus_positions", bus_.SavePositions());
@@ -68,15 +56,7 @@ void ReplayService::Restore(const StateView& in) {
     throw std::runtime_error("a snapshot of run " + std::to_string(run_id) + ", this is run " +
                              std::to_string(bus_.config().run_id));
   }
-  const std::string table = in.Text("table");
-  if (table == "pixels") {
-    pixels_ = MakePixelTable();
-    pixels_->Restore("pixels.", in);
-  } else if (table == "flat" || table == "empty") {
-    table_.Restore("flat.", in);
-  } else {
-    throw std::runtime_error("unknown table kind '" + table + "'");
-  }
+  RestoreTable(in);
   int64_t limiter[2] = {};
   in.Copy<int64_t>("limiter", limiter);
   if (limiter[0] > kMaxCount || limiter[1] > kMaxCount) {
@@ -114,9 +94,28 @@ void ReplayService::Restore(const StateView& in) {
   if (in.Has("bus_positions")) bus_.LoadPositions(in.Text("bus_positions"));
 }
 
+void ReplayService::RestoreTable(const StateView& in) {
+  const std::string name = in.Text("table");
+  // Replays that chose their table at the first batch wrote "empty" (with an empty flat table's
+  // sections) before any: the fresh table stays as it is.
+  if (name == "empty") return;
+  std::optional<TableKind> kind;
+  for (const TableKind k : {TableKind::kFlat, TableKind::kPixels}) {
+    if (name == TableKindName(k)) kind = k;
+  }
+  if (!kind) throw std::runtime_error("unknown table kind '" + name + "'");
+  if (*kind != table_->kind()) {
+    if (options_.kind) {
+      throw std::runtime_error("the snapshot's table holds " + name + " transitions, this env's " +
+                               TableKindName(table_->kind()));
+    }
+    table_ = MakeTable(*kind);
+  }
+  table_->Restore(name + ".", in);
+}
+
 void ReplayService::CheckFresh() const {
-  if (total_inserts() != 0 || total_samples() != 0 || !pending_.empty() ||
-      limiter_.inserts() != 0 || pixels_ != nullptr) {
+  if (!table_->unused() || total_samples() != 0 || !pending_.empty() || limiter_.inserts() != 0) {
     throw std::logic_error("a snapshot can only be restored into a fresh replay service");
   }
 }

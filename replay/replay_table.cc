@@ -8,8 +8,6 @@
 
 #include "common/check.h"
 #include "common/state_file.h"
-#include "replay/priorities.h"
-#include "replay/uniform_sampler.h"
 
 namespace rl::replay {
 namespace {
@@ -21,6 +19,12 @@ constexpr int kMaxObsSize = 1 << 24;
 template <class T>
 void CopyN(const T* from, size_t n, T* to) {
   std::copy(from, from + n, to);
+}
+
+// Validated options, so that the base is built from a checked capacity.
+ReplayTableOptions Checked(ReplayTableOptions options) {
+  options.Validate();
+  return options;
 }
 
 }  // namespace
@@ -60,13 +64,11 @@ void SampleBatch::Resize(int new_count, int new_obs_size, int new_action_width) 
 }
 
 SampleSpans SampleBatch::spans() {
-  return SampleSpans{obs, next_obs, {action, reward, discount, index, weight, episode_id}};
+  return SampleSpans{obs, next_obs, {action, reward, discount, index, weight, episode_id}, {}, {}};
 }
 
 ReplayTable::ReplayTable(ReplayTableOptions options, std::unique_ptr<Sampler> sampler)
-    : options_(options), sampler_(std::move(sampler)) {
-  options_.Validate();
-  if (sampler_ == nullptr) sampler_ = std::make_unique<UniformSampler>(options_.capacity);
+    : Table(Checked(options).capacity, std::move(sampler)), options_(options) {
   obs_size_ = options_.obs_size;
   if (options_.obs_size > 0 && options_.action_width > 0) {
     Allocate(options_.obs_size, options_.action_width);
@@ -85,8 +87,9 @@ void ReplayTable::Allocate(int obs_size, int action_width) {
 
 const char* ReplayTable::Insert(const TransitionBatchView& batch) {
   // Check the whole batch before storing any of it.
+  if (batch.obs_size == 0) return "a pixel batch (obs_size 0); this run stores flat transitions";
   if (batch.count <= 0) return "empty batch";
-  if (batch.obs_size <= 0 || batch.obs_size > kMaxObsSize) return "obs_size out of range";
+  if (batch.obs_size < 0 || batch.obs_size > kMaxObsSize) return "obs_size out of range";
   if (obs_size_ != 0 && batch.obs_size != obs_size_) return "obs_size differs from the table's";
   const auto n = static_cast<size_t>(batch.count);
   const size_t values = n * static_cast<size_t>(batch.obs_size);
@@ -100,15 +103,10 @@ const char* ReplayTable::Insert(const TransitionBatchView& batch) {
   // Write each transition into the slot after the newest one, wrapping around.
   const auto obs_size = static_cast<size_t>(obs_size_);
   for (size_t i = 0; i < n; ++i) {
-    const int64_t slot = total_inserts_ % options_.capacity;
-    const auto s = static_cast<size_t>(slot);
+    const size_t s = Append(batch.columns, i);
     CopyN(batch.obs.data() + i * obs_size, obs_size, obs_.data() + s * obs_size);
     CopyN(batch.next_obs.data() + i * obs_size, obs_size, next_obs_.data() + s * obs_size);
-    columns_.Store(s, batch.columns, i, total_inserts_);
-    sampler_->Insert(slot, batch.columns.priority.empty() ? 0.0 : batch.columns.priority[i]);
-    ++total_inserts_;
   }
-  size_ = std::min(total_inserts_, options_.capacity);
   return nullptr;
 }
 
@@ -119,40 +117,18 @@ bool ReplayTable::Sample(int batch_size, std::mt19937_64* rng, const SampleSpans
   const auto obs_size = static_cast<size_t>(obs_size_);
   RL_CHECK(out.obs.size() == n * obs_size && out.next_obs.size() == n * obs_size)
       << "obs and next_obs must hold batch_size * obs_size = " << n * obs_size << " floats";
-  RL_CHECK(columns_.Fits(out.columns, n))
-      << "action must hold batch_size * action_width floats, reward, discount, index and weight "
-         "batch_size = "
-      << n << " values, episode_id none or batch_size";
-
   // Let the sampler choose the slots, then gather their fields.
-  if (items_.size() < n) items_.resize(n);
-  const std::span<SampledItem> items(items_.data(), n);
-  sampler_->Sample(rng, items);
+  const std::span<SampledItem> items = Draw(n, rng, out);
   const double min_probability = sampler_->MinProbability();
   for (size_t i = 0; i < n; ++i) {
     const auto s = static_cast<size_t>(items[i].slot);
     RL_DCHECK(items[i].slot >= 0 && items[i].slot < size_) << "sampler chose an empty slot";
     CopyN(obs_.data() + s * obs_size, obs_size, out.obs.data() + i * obs_size);
     CopyN(next_obs_.data() + s * obs_size, obs_size, out.next_obs.data() + i * obs_size);
-    columns_.Gather(s, i, out.columns);
-    out.columns.weight[i] = ImportanceWeight(items[i].probability, min_probability, beta_);
+    Gather(items[i], i, min_probability, out);
   }
   total_samples_ += batch_size;
   return true;
-}
-
-void ReplayTable::set_importance_exponent(double beta) {
-  if (!(beta >= 0.0 && beta <= 1.0)) {
-    throw std::invalid_argument("replay table: importance exponent must be in [0, 1], got " +
-                                std::to_string(beta));
-  }
-  beta_ = beta;
-}
-
-int64_t ReplayTable::UpdatePriorities(std::span<const int64_t> index,
-                                      std::span<const float> priority) {
-  return ApplyPriorities(index, priority, columns_.insert_numbers(), total_inserts_,
-                         sampler_.get());
 }
 
 void ReplayTable::Save(const std::string& prefix, StateStream* out) const {
@@ -232,9 +208,8 @@ void ReplayTable::Restore(const std::string& prefix, const StateView& in) {
 }
 
 int64_t ReplayTable::memory_bytes() const {
-  const size_t bytes = (obs_.capacity() + next_obs_.capacity()) * sizeof(float) +
-                       items_.capacity() * sizeof(SampledItem);
-  return static_cast<int64_t>(bytes) + columns_.memory_bytes() + sampler_->memory_bytes();
+  const size_t bytes = (obs_.capacity() + next_obs_.capacity()) * sizeof(float);
+  return static_cast<int64_t>(bytes) + common_memory_bytes();
 }
 
 }  // namespace rl::replay

@@ -55,18 +55,20 @@ struct OwnedPixelBatch {
   std::vector<float> action;
   std::vector<float> reward, discount, priority;
 
-  PixelBatchView view() const {
-    return {actor_id,
-            height,
-            width,
-            stack,
-            static_cast<int>(frame_id.size()),
-            frame_id,
-            frames,
-            static_cast<int>(reward.size()),
-            obs_frames,
-            next_obs_frames,
-            ColumnsView{1, action, reward, discount, episode_id, priority}};
+  TransitionBatchView view() const {
+    TransitionBatchView v;
+    v.count = static_cast<int>(reward.size());
+    v.columns = ColumnsView{1, action, reward, discount, episode_id, priority};
+    v.actor_id = actor_id;
+    v.height = height;
+    v.width = width;
+    v.stack = stack;
+    v.num_frames = static_cast<int>(frame_id.size());
+    v.frame_id = frame_id;
+    v.frames = frames;
+    v.obs_frames = obs_frames;
+    v.next_obs_frames = next_obs_frames;
+    return v;
   }
   void AddFrame(int64_t id) {
     frame_id.push_back(id);
@@ -516,7 +518,7 @@ TEST(PixelTableTest, RefusesBadBatchesAndStoresNoneOfThem) {
   ASSERT_EQ(table.Insert(good.view()), nullptr);
   const int64_t frames = table.total_frames();
 
-  auto refused = [&](const PixelBatchView& view, const char* what) {
+  auto refused = [&](const TransitionBatchView& view, const char* what) {
     const char* why = table.Insert(view);
     EXPECT_NE(why, nullptr) << what;
     if (why != nullptr) {
@@ -528,7 +530,7 @@ TEST(PixelTableTest, RefusesBadBatchesAndStoresNoneOfThem) {
   OwnedPixelBatch next = actor.NewBatch();
   actor.Step(&next);
 
-  PixelBatchView v = next.view();
+  TransitionBatchView v = next.view();
   v.height = kHeight + 1;
   refused(v, "height");
   v = next.view();
@@ -567,7 +569,7 @@ TEST(PixelTableTest, RefusesBadBatchesAndStoresNoneOfThem) {
   refused(v, "actor -1");
   v.actor_id = 65536;
   refused(v, "actor 65536");
-  refused(PixelBatchView{}, "empty");
+  refused(TransitionBatchView{}, "empty");
   OwnedPixelBatch repeated = actor.NewBatch();
   repeated.AddFrame(10);
   repeated.AddFrame(10);

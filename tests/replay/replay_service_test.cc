@@ -399,6 +399,43 @@ TEST_F(ReplayServiceTest, StoresPixelTransitionsAndAnswersWithRebuiltStacks) {
   EXPECT_EQ(service_->size(), 20);
 }
 
+// The env's spec fixes the table at the start: a first batch of the other kind, or of another
+// frame geometry, is refused, not taken as the run's kind.
+TEST_F(ReplayServiceTest, ThePixelTableOfTheEnvsKindRefusesAFirstFlatBatchOrOtherGeometry) {
+  ReplayServiceOptions o = Options(8, 10, 200);
+  o.kind = TableKind::kPixels;
+  o.frames = {0, 2, 2, 2};
+  Start(o);
+  EXPECT_EQ(service_->table().kind(), TableKind::kPixels);
+  SendTransitions(0, 5);
+  Pump();
+  EXPECT_EQ(service_->counters().batches_refused, 1);
+  // Frames of 4 x 1 pixels: the same bytes, another geometry.
+  rlmsg::transition_batch_t tall = MakePixelBatch(5);
+  tall.height = 4;
+  tall.width = 1;
+  PublishAs(channels::kTransitions, tall, "actor-0");
+  Pump();
+  EXPECT_EQ(service_->counters().batches_refused, 2);
+  PublishAs(channels::kTransitions, MakePixelBatch(20), "actor-0");
+  Pump();
+  EXPECT_EQ(service_->size(), 20);
+  EXPECT_EQ(service_->table().kind(), TableKind::kPixels);
+}
+
+TEST_F(ReplayServiceTest, TheFlatTableOfTheEnvsKindRefusesAFirstPixelBatch) {
+  ReplayServiceOptions flat = Options(8, 10, 200);
+  flat.kind = TableKind::kFlat;
+  Start(flat);
+  PublishAs(channels::kTransitions, MakePixelBatch(20), "actor-0");
+  Pump();
+  EXPECT_EQ(service_->counters().batches_refused, 1);
+  EXPECT_EQ(service_->table().kind(), TableKind::kFlat);
+  SendTransitions(0, 5);
+  Pump();
+  EXPECT_EQ(service_->size(), 5);
+}
+
 // Continuous actions: three floats per transition go in and come back whole; a batch of another
 // width, or with an action the env's check refuses, is refused and counted, and nothing of it
 // is stored.

@@ -241,19 +241,17 @@ TEST_F(ReplaySnapshotTest, ARestoredPixelReplayKeepsFramesAndActorWindows) {
   const std::string summary = restored.service().RestoreSnapshot(saved.Snapshot());
   EXPECT_NE(summary.find("frames"), std::string::npos) << summary;
   ExpectSameState(saved.service(), restored.service());
-  ASSERT_NE(restored.service().pixel_table(), nullptr);
-  EXPECT_EQ(restored.service().pixel_table()->total_frames(),
-            saved.service().pixel_table()->total_frames());
-  EXPECT_EQ(restored.service().pixel_table()->stale_draws(),
-            saved.service().pixel_table()->stale_draws());
+  ASSERT_EQ(restored.service().table().kind(), TableKind::kPixels);
+  EXPECT_EQ(restored.service().table().total_frames(), saved.service().table().total_frames());
+  EXPECT_EQ(restored.service().table().stale_draws(), saved.service().table().stale_draws());
   ExpectSameReplies(&saved, &restored, 4);
   // A next batch that names a frame of the previous one resolves through the restored window.
   rlmsg::transition_batch_t next = PixelBatch(160, 10, 0);
   next.obs_frames[0] = 159;
   saved.Publish(channels::kTransitions, next, "actor-0");
   restored.Publish(channels::kTransitions, next, "actor-0");
-  EXPECT_EQ(restored.service().pixel_table()->transitions_missing_frames(),
-            saved.service().pixel_table()->transitions_missing_frames());
+  EXPECT_EQ(restored.service().table().transitions_missing_frames(),
+            saved.service().table().transitions_missing_frames());
   EXPECT_EQ(restored.service().total_inserts(), saved.service().total_inserts());
   ExpectSameReplies(&saved, &restored, 3);
 }
@@ -265,6 +263,58 @@ TEST_F(ReplaySnapshotTest, AnEmptyReplayRoundTrips) {
             "size 0 of 200, inserts 0, samples 0");
   restored.Publish(channels::kTransitions, FlatBatch(0, 30), "actor-0");
   EXPECT_EQ(restored.service().size(), 30);
+}
+
+// The options of a replay whose table kind the env's spec gave.
+ReplayServiceOptions OptionsOfKind(TableKind kind) {
+  ReplayServiceOptions o = Options(false);
+  o.kind = kind;
+  return o;
+}
+
+TEST_F(ReplaySnapshotTest, LoadsAnEmptyReplayOfTheFormerFormatIntoEitherKind) {
+  // Replays that chose their table at the first batch saved one that had stored nothing as
+  // table "empty", with an empty flat table's sections: the same file with that one text.
+  Replica saved(Options(false));
+  std::string bytes = saved.Snapshot();
+  const uint64_t flat_length = 4;
+  const uint64_t empty_length = 5;
+  const std::string table =
+      std::string("table") + std::string(reinterpret_cast<const char*>(&flat_length), 8) + "flat";
+  const size_t at = bytes.find(table);
+  ASSERT_NE(at, std::string::npos);
+  bytes.replace(at, table.size(),
+                std::string("table") +
+                    std::string(reinterpret_cast<const char*>(&empty_length), 8) + "empty");
+  const uint32_t crc = Crc32(bytes.data(), bytes.size() - 4);
+  std::memcpy(bytes.data() + bytes.size() - 4, &crc, 4);
+
+  Replica flat(OptionsOfKind(TableKind::kFlat));
+  EXPECT_EQ(flat.service().RestoreSnapshot(bytes), "size 0 of 200, inserts 0, samples 0");
+  flat.Publish(channels::kTransitions, FlatBatch(0, 30), "actor-0");
+  EXPECT_EQ(flat.service().size(), 30);
+  Replica pixels(OptionsOfKind(TableKind::kPixels));
+  EXPECT_EQ(pixels.service().RestoreSnapshot(bytes),
+            "size 0 of 200, inserts 0, samples 0, frames 0");
+  pixels.Publish(channels::kTransitions, PixelBatch(0, 30, 0), "actor-0");
+  EXPECT_EQ(pixels.service().size(), 30);
+}
+
+TEST_F(ReplaySnapshotTest, RefusesATableOfTheOtherKindThanTheEnvs) {
+  Replica flat(OptionsOfKind(TableKind::kFlat));
+  flat.Publish(channels::kTransitions, FlatBatch(0, 30), "actor-0");
+  EXPECT_NE(LoadError(flat.Snapshot(), OptionsOfKind(TableKind::kPixels))
+                .find("the snapshot's table holds flat transitions, this env's pixels"),
+            std::string::npos);
+  Replica pixels(OptionsOfKind(TableKind::kPixels));
+  pixels.Publish(channels::kTransitions, PixelBatch(0, 30, 0), "actor-0");
+  EXPECT_NE(LoadError(pixels.Snapshot(), OptionsOfKind(TableKind::kFlat))
+                .find("the snapshot's table holds pixels transitions, this env's flat"),
+            std::string::npos);
+  // Without a kind from the env, the snapshot's kind is taken.
+  Replica any(Options(false));
+  EXPECT_NE(any.service().RestoreSnapshot(pixels.Snapshot()).find("size 30"), std::string::npos);
+  EXPECT_EQ(any.service().table().kind(), TableKind::kPixels);
 }
 
 TEST_F(ReplaySnapshotTest, RefusesTornFlippedForeignAndOtherRunFiles) {

@@ -29,8 +29,13 @@ struct OwnedBatch {
   std::vector<int64_t> episode_id;
 
   TransitionBatchView view() const {
-    return {obs_size, count, obs, next_obs,
-            ColumnsView{action_width, action, reward, discount, episode_id, priority}};
+    TransitionBatchView v;
+    v.obs_size = obs_size;
+    v.count = count;
+    v.obs = obs;
+    v.next_obs = next_obs;
+    v.columns = ColumnsView{action_width, action, reward, discount, episode_id, priority};
+    return v;
   }
 };
 
