@@ -72,7 +72,7 @@ rlmsg::transition_batch_t PixelTransitions(int first, int count, int height, int
   m.num_frames = count + 1;
   for (int f = first; f <= first + count; ++f) {
     m.frame_id.push_back(f);
-    m.frames.insert(m.frames.end(), static_cast<size_t>(height * width),
+    m.frames.insert(m.frames.end(), static_cast<size_t>(height) * static_cast<size_t>(width),
                     static_cast<uint8_t>(f + actor));
   }
   m.num_bytes = static_cast<int32_t>(m.frames.size());

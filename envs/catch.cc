@@ -66,8 +66,10 @@ StepResult Catch::OnStep(std::span<const float> action) {
 
 void Catch::UpdateObservation() {
   std::fill(observation_.begin(), observation_.end(), 0.0f);
-  observation_[static_cast<std::size_t>(ball_row_ * kColumns + ball_column_)] = 1.0f;
-  observation_[static_cast<std::size_t>((kRows - 1) * kColumns + paddle_column_)] = 1.0f;
+  const int ball = ball_row_ * kColumns + ball_column_;
+  const int paddle = (kRows - 1) * kColumns + paddle_column_;
+  observation_[static_cast<std::size_t>(ball)] = 1.0f;
+  observation_[static_cast<std::size_t>(paddle)] = 1.0f;
 }
 
 void Catch::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {

@@ -18,9 +18,10 @@ namespace {
 // Drawing geometry of the reference, in pixels of its 500 x 500 surface before the vertical flip
 // (so y grows upwards from the bottom edge and angles turn counter-clockwise).
 constexpr double kSurface = Pendulum::kScreenSize;
-constexpr double kBound = 2.2;                         // World units from the axle to each edge.
-constexpr double kScale = kSurface / (kBound * 2);     // 113.6 px per world unit.
-constexpr double kOffset = Pendulum::kScreenSize / 2;  // The axle's pixel (integer, as `// 2`).
+constexpr double kBound = 2.2;                      // World units from the axle to each edge.
+constexpr double kScale = kSurface / (kBound * 2);  // 113.6 px per world unit.
+constexpr int kAxle = Pendulum::kScreenSize / 2;    // The axle's pixel (integer, as `// 2`).
+constexpr double kOffset = kAxle;
 constexpr double kRodLength = 1 * kScale;
 constexpr double kRodWidth = 0.2 * kScale;
 // Circle radii truncated by int() as in the reference: 11 px for the caps, 5 px for the axle.

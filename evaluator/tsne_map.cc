@@ -263,7 +263,8 @@ Layout MakeLayout(int frame_height, int frame_width) {
 // The title, shrunk to end before the colour bar's label.
 void DrawTitle(RasterCanvas* canvas, const Layout& l, const std::string& title) {
   double size = kTitleSize;
-  const double room = l.bar_x - kColumnGap / 2 - kMargin;
+  constexpr int kHalfGap = kColumnGap / 2;
+  const double room = l.bar_x - kHalfGap - kMargin;
   while (size > 0.3 * RasterCanvas::kPixelsPerScale + 1e-9 &&
          canvas->TextWidth(title, size) > room) {
     size -= 0.05 * RasterCanvas::kPixelsPerScale;
@@ -304,8 +305,9 @@ void DrawThumbnails(RasterCanvas* canvas, const Layout& l, const StateSamples& s
       const double slot = static_cast<double>(kPlotSide) / static_cast<double>(column.size());
       const int centre_y = l.plot_y + static_cast<int>((static_cast<double>(k) + 0.5) * slot);
       const int top = centre_y - (l.thumb_h + kLabelHeight) / 2;
+      const int middle = top + l.thumb_h / 2;
       const plot::Point anchor{static_cast<double>(side == 0 ? x + l.thumb_w + 2 : x - 3),
-                               static_cast<double>(top + l.thumb_h / 2)};
+                               static_cast<double>(middle)};
       canvas->Line(anchor, scatter.at[i], plot::Paint::Stroke(kLine));
       canvas->Circle(scatter.at[i], std::lround(scatter.radius[i]) + 4,
                      plot::Paint::Stroke(kInk, 2));

@@ -52,7 +52,7 @@ std::string SetUp() {
   fs::create_symlink("/dev/zero", run / "checkpoints/zero.bin");
   fs::create_symlink(run / "outside.bin", run / "checkpoints/outside.bin");
   fs::create_directory_symlink(run, run / "checkpoints/up");
-  const std::string file = fs::canonical(run / "checkpoints").string() + "/ckpt.bin";
+  std::string file = fs::canonical(run / "checkpoints").string() + "/ckpt.bin";
   // Removed at exit; a crash leaves it for the reproducer's inspection.
   static const fs::path removed = run;
   std::atexit([] {

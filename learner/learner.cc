@@ -229,7 +229,7 @@ std::string Learner::Checkpoint() {
   char name[64];
   std::snprintf(name, sizeof(name), "ckpt-%09lld.bin",
                 static_cast<long long>(algorithm_->updates()));
-  const std::string path = (std::filesystem::path(config_.out_dir) / "checkpoints" / name).string();
+  std::string path = (std::filesystem::path(config_.out_dir) / "checkpoints" / name).string();
   nn::Checkpoint ckpt;
   ckpt.architecture = algorithm_->policy().Architecture();
   ckpt.meta.update = algorithm_->updates();

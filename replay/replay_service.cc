@@ -363,8 +363,8 @@ void ReplayService::PrintProgress(double now) {
       static_cast<long long>(total_inserts()), inserts_per_second,
       static_cast<long long>(total_samples()), samples_per_second, limiter_.samples_per_insert(),
       insert_allowed_ ? 1 : 0, pending_requests(),
-      static_cast<long long>(bus.dropped() + counters_.batches_refused +
-                             counters_.requests_refused + counters_.requests_dropped),
+      static_cast<long long>(bus.dropped()) + counters_.batches_refused +
+          counters_.requests_refused + counters_.requests_dropped,
       static_cast<long long>(bus.lost), static_cast<double>(memory_bytes()) / 1e6);
   if (options_.prioritized) {
     std::printf(" beta %.3f priorities %lld stale %lld", beta(),

@@ -217,7 +217,7 @@ void CarRacing::NewEpisode() {
     fixture.friction = 0.2f;
     fixture.density = 0;
     fixture.isSensor = true;
-    fixture.userData.pointer = static_cast<uintptr_t>(i + 1);
+    fixture.userData.pointer = static_cast<uintptr_t>(i) + 1;
     body->CreateFixture(&fixture);
   }
 

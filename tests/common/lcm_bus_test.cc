@@ -558,14 +558,14 @@ TEST(MessageTableTest, ListsEveryTypeOnceAndEachExampleCrossesTheBus) {
   Bus bus(MemqConfig(5, "test"));
   std::vector<std::string> got;
   int index = 0;
-#define RL_CHECK_LINE(type, constant, name, on_port)                                      \
-  EXPECT_EQ(MessageIndex(rlmsg::type::getTypeName()), index++);                           \
-  EXPECT_EQ(FindChannel(channels::constant)->port, Port::on_port);                        \
-  bus.Subscribe<rlmsg::type>(name, [&got](const rlmsg::type&) { got.push_back(#type); }); \
-  {                                                                                       \
-    rlmsg::type m = examples::Example<rlmsg::type>();                                     \
-    EXPECT_EQ(Validate(m), nullptr) << #type;                                             \
-    EXPECT_TRUE(bus.Publish(name, &m));                                                   \
+#define RL_CHECK_LINE(type, constant, name, on_port)                                         \
+  EXPECT_EQ(MessageIndex(rlmsg::type::getTypeName()), index++);                              \
+  EXPECT_EQ(FindChannel(channels::constant)->port, Port::on_port);                           \
+  bus.Subscribe<rlmsg::type>(name, [&got](const rlmsg::type&) { got.emplace_back(#type); }); \
+  {                                                                                          \
+    rlmsg::type m = examples::Example<rlmsg::type>();                                        \
+    EXPECT_EQ(Validate(m), nullptr) << #type;                                                \
+    EXPECT_TRUE(bus.Publish(name, &m));                                                      \
   }
   RL_MESSAGES(RL_CHECK_LINE)
 #undef RL_CHECK_LINE

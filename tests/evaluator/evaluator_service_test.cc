@@ -86,13 +86,13 @@ class EvaluatorServiceTest : public ::testing::Test {
   }
 
   std::string WriteCheckpoint(int64_t update) {
-    const std::string path = checkpoints_ + "/ckpt_" + std::to_string(update) + ".bin";
+    std::string path = checkpoints_ + "/ckpt_" + std::to_string(update) + ".bin";
     nn::SaveCheckpoint(path, AlwaysLeftCheckpoint(update));
     return path;
   }
 
   std::string WriteBalancingCheckpoint(int64_t update) {
-    const std::string path = checkpoints_ + "/ckpt_" + std::to_string(update) + ".bin";
+    std::string path = checkpoints_ + "/ckpt_" + std::to_string(update) + ".bin";
     nn::SaveCheckpoint(path, BalancingCheckpoint(update));
     return path;
   }
@@ -255,7 +255,7 @@ std::string WriteCatchCheckpoint(const std::string& folder, int64_t update) {
   net.GetFlat(&ckpt.params);
   ckpt.meta.update = update;
   ckpt.meta.run_id = 77;
-  const std::string path = folder + "/ckpt_" + std::to_string(update) + ".bin";
+  std::string path = folder + "/ckpt_" + std::to_string(update) + ".bin";
   nn::SaveCheckpoint(path, ckpt);
   return path;
 }

@@ -116,12 +116,12 @@ class FakeActor {
     b->AddFrame(f);
     std::vector<int64_t> next(current_.begin() + 1, current_.end());
     next.push_back(f);
-    const Expected e{key_,
-                     current_,
-                     next,
-                     static_cast<float>(f % 4),
-                     0.5f * static_cast<float>(f),
-                     terminal ? 0.0f : 0.99f};
+    Expected e{key_,
+               current_,
+               next,
+               static_cast<float>(f % 4),
+               0.5f * static_cast<float>(f),
+               terminal ? 0.0f : 0.99f};
     AddTransition(b, e, priority);
     current_ = next;
     return e;
@@ -309,7 +309,7 @@ TEST(PixelTableTest, AStackOfTheRepeatedFirstFrameReadsBackAsThatFrame) {
   ASSERT_TRUE(table.Sample(4, &rng, s.spans()));
   for (size_t i = 0; i < 4; ++i) ExpectTransition(s, i, e);
   // The three frames of obs are the same bytes.
-  const auto frame = static_cast<std::ptrdiff_t>(kHeight * kWidth);
+  const auto frame = static_cast<std::ptrdiff_t>(kHeight) * kWidth;
   EXPECT_TRUE(std::equal(s.obs.begin(), s.obs.begin() + frame, s.obs.begin() + 2 * frame));
 }
 

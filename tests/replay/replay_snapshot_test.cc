@@ -188,7 +188,7 @@ class ReplaySnapshotTest : public ::testing::Test {
   ~ReplaySnapshotTest() override { fs::remove_all(dir_); }
 
   std::string Write(const std::string& name, const std::string& bytes) const {
-    const std::string path = (dir_ / name).string();
+    std::string path = (dir_ / name).string();
     std::ofstream(path, std::ios::binary) << bytes;
     return path;
   }
@@ -197,7 +197,7 @@ class ReplaySnapshotTest : public ::testing::Test {
                         int64_t run_id = kRunId) {
     const std::string path = Write("bad.bin", bytes);
     Replica fresh(options, run_id);
-    const std::string error = ErrorOf([&] { fresh.service().LoadSnapshot(path); });
+    std::string error = ErrorOf([&] { fresh.service().LoadSnapshot(path); });
     EXPECT_NE(error.find(path), std::string::npos) << "the error does not name the file: " << error;
     return error;
   }

@@ -94,7 +94,7 @@ TEST(LunarLanderRenderTest, LanderPixelsMoveWithTheLander) {
   EXPECT_NEAR(right.mean_y, a.mean_y, 0.5);
   EXPECT_NEAR(up.mean_y - a.mean_y, -60, 0.5);
   EXPECT_NEAR(up.mean_x, a.mean_x, 0.5);
-  EXPECT_NEAR(right.count, a.count, a.count / 20);
+  EXPECT_NEAR(right.count, a.count, a.count / 20.0);
 
   // Tilting by 90 degrees turns the wide hull upright: the pixels spread vertically.
   const Image tilted = RenderAt(env, LanderKinematics{.x = 6, .y = 9, .angle = 1.5707963});

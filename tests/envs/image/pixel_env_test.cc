@@ -227,11 +227,12 @@ std::vector<std::pair<int, int>> CellPixels(int cell, int width,
                                             const std::vector<std::pair<int, int>>& cells) {
   std::vector<bool> lit;
   const int height = Catch::kRows * cell;
-  lit.assign(static_cast<std::size_t>(width * height), false);
+  lit.assign(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), false);
   for (const auto& [row, column] : cells) {
     for (int y = row * cell; y < (row + 1) * cell; ++y) {
       for (int x = column * cell; x < (column + 1) * cell; ++x) {
-        lit[static_cast<std::size_t>(y * width + x)] = true;
+        const int at = y * width + x;
+        lit[static_cast<std::size_t>(at)] = true;
       }
     }
   }
