@@ -249,7 +249,6 @@ constexpr int64_t kCapacity = 100'000;    // transitions kept by the pixel repla
 constexpr int64_t kMemoryFill = 100'000;  // transitions put in the table of the memory figure
 constexpr int kSampleInFlight = 4;        // the learner's default requests_in_flight
 
-
 // What the pixel replay service's thread exposes to the main thread.
 struct ServiceProbe {
   std::atomic<bool> stop{false};

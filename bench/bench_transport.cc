@@ -128,10 +128,9 @@ int Main(int argc, char** argv) {
       ("seconds", rl::po::value(&seconds)->default_value(seconds), "seconds of publishing")  //
       ("start-at", rl::po::value(&start_at)->default_value(start_at),
        "wall-clock time to start publishing, seconds since the epoch (0: at once)")  //
-      (
-          "settle", rl::po::value(&settle)->default_value(settle),
-          "seconds of flow messages without a new stored transition that end the wait for the "
-          "replay")  //
+      ("settle", rl::po::value(&settle)->default_value(settle),
+       "seconds of flow messages without a new stored transition that end the wait for the "
+       "replay")  //
       ("window", rl::po::value(&window)->default_value(window),
        "transitions published and not yet stored at most (0: only the replay's flow control)")  //
       ("ready-timeout", rl::po::value(&ready_timeout)->default_value(ready_timeout),
