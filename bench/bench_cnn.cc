@@ -364,10 +364,10 @@ Peaks MeasurePeaks(int threads, int repeats, double seconds) {
         name, "GFLOP/s", peak, repeats,
         "\"threads\": " + std::to_string(threads) + ", \"threads_used\": " +
             std::to_string(threads) + ", \"cores\": " + std::to_string(threads) +
-            ", \"per_core\": " + Num(peak.median / threads) +
-            ", \"vector_bits\": " + std::to_string(bits) + ", \"method\": \"16 " +
-            "independent chains of " + std::to_string(bits) + "-bit " + method + " on each of " +
-            std::to_string(threads) + " threads at once\"" +
+            ", \"per_core\": " + Num(peak.median / threads) + ", \"vector_bits\": " +
+            std::to_string(bits) + ", \"method\": \"" + std::to_string(bits == 512 ? 16 : 12) +
+            " " + "independent chains of " + std::to_string(bits) + "-bit " + method +
+            " on each of " + std::to_string(threads) + " threads at once\"" +
             (narrow.empty() ? ""
                             : ", \"gflops_256bit\": " + Num(rl::bench::Summarize(narrow).median)));
     return peak.median;
