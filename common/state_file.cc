@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <type_traits>
 
 #include "common/atomic_file.h"
 #include "common/crc32.h"
@@ -25,22 +26,14 @@ void Append(std::string* out, T value) {
   out->append(reinterpret_cast<const char*>(&value), sizeof(T));
 }
 
+// The section type of an array of T.
 template <class T>
-constexpr uint8_t TypeOf();
-template <>
-constexpr uint8_t TypeOf<float>() {
-  return kFloats;
-}
-template <>
-constexpr uint8_t TypeOf<int64_t>() {
-  return kInts;
-}
-template <>
-constexpr uint8_t TypeOf<uint8_t>() {
-  return kBytes;
-}
-template <>
-constexpr uint8_t TypeOf<double>() {
+constexpr uint8_t TypeOf() {
+  static_assert(std::is_same_v<T, float> || std::is_same_v<T, int64_t> ||
+                std::is_same_v<T, uint8_t> || std::is_same_v<T, double>);
+  if constexpr (std::is_same_v<T, float>) return kFloats;
+  if constexpr (std::is_same_v<T, int64_t>) return kInts;
+  if constexpr (std::is_same_v<T, uint8_t>) return kBytes;
   return kDoubles;
 }
 
