@@ -77,6 +77,19 @@ class Cursor {
   size_t at_ = 0;
 };
 
+// The section `name` of a map of sections by name (StateFile's or StateView's); throws
+// std::runtime_error if there is none or it holds another type.
+template <class Sections>
+const typename Sections::mapped_type& SectionOfType(const Sections& sections,
+                                                    const std::string& name, uint8_t type) {
+  const auto it = sections.find(name);
+  if (it == sections.end()) throw std::runtime_error("state has no section '" + name + "'");
+  if (it->second.type != type) {
+    throw std::runtime_error("state section '" + name + "' has another type");
+  }
+  return it->second;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------- StateFile
@@ -103,12 +116,7 @@ void StateFile::PutText(const std::string& name, std::string_view text) {
 }
 
 const StateFile::Section& StateFile::Get(const std::string& name, uint8_t type) const {
-  const auto it = sections_.find(name);
-  if (it == sections_.end()) throw std::runtime_error("state has no section '" + name + "'");
-  if (it->second.type != type) {
-    throw std::runtime_error("state section '" + name + "' has another type");
-  }
-  return it->second;
+  return SectionOfType(sections_, name, type);
 }
 
 std::span<const float> StateFile::Floats(const std::string& name, int64_t expected) const {
@@ -412,12 +420,7 @@ StateView StateView::Map(const std::string& path, const std::string& kind) {
 }
 
 const StateView::Section& StateView::Get(const std::string& name, uint8_t type) const {
-  const auto it = sections_.find(name);
-  if (it == sections_.end()) throw std::runtime_error("state has no section '" + name + "'");
-  if (it->second.type != type) {
-    throw std::runtime_error("state section '" + name + "' has another type");
-  }
-  return it->second;
+  return SectionOfType(sections_, name, type);
 }
 
 template <class T>
