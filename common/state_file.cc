@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstring>
 #include <stdexcept>
+#include <type_traits>
 
 #include "common/atomic_file.h"
 #include "common/crc32.h"
@@ -25,22 +26,14 @@ void Append(std::string* out, T value) {
   out->append(reinterpret_cast<const char*>(&value), sizeof(T));
 }
 
+// The section type of an array of T.
 template <class T>
-constexpr uint8_t TypeOf();
-template <>
-constexpr uint8_t TypeOf<float>() {
-  return kFloats;
-}
-template <>
-constexpr uint8_t TypeOf<int64_t>() {
-  return kInts;
-}
-template <>
-constexpr uint8_t TypeOf<uint8_t>() {
-  return kBytes;
-}
-template <>
-constexpr uint8_t TypeOf<double>() {
+constexpr uint8_t TypeOf() {
+  static_assert(std::is_same_v<T, float> || std::is_same_v<T, int64_t> ||
+                std::is_same_v<T, uint8_t> || std::is_same_v<T, double>);
+  if constexpr (std::is_same_v<T, float>) return kFloats;
+  if constexpr (std::is_same_v<T, int64_t>) return kInts;
+  if constexpr (std::is_same_v<T, uint8_t>) return kBytes;
   return kDoubles;
 }
 
@@ -84,6 +77,19 @@ class Cursor {
   size_t at_ = 0;
 };
 
+// The section `name` of a map of sections by name (StateFile's or StateView's); throws
+// std::runtime_error if there is none or it holds another type.
+template <class Sections>
+const typename Sections::mapped_type& SectionOfType(const Sections& sections,
+                                                    const std::string& name, uint8_t type) {
+  const auto it = sections.find(name);
+  if (it == sections.end()) throw std::runtime_error("state has no section '" + name + "'");
+  if (it->second.type != type) {
+    throw std::runtime_error("state section '" + name + "' has another type");
+  }
+  return it->second;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------- StateFile
@@ -110,12 +116,7 @@ void StateFile::PutText(const std::string& name, std::string_view text) {
 }
 
 const StateFile::Section& StateFile::Get(const std::string& name, uint8_t type) const {
-  const auto it = sections_.find(name);
-  if (it == sections_.end()) throw std::runtime_error("state has no section '" + name + "'");
-  if (it->second.type != type) {
-    throw std::runtime_error("state section '" + name + "' has another type");
-  }
-  return it->second;
+  return SectionOfType(sections_, name, type);
 }
 
 std::span<const float> StateFile::Floats(const std::string& name, int64_t expected) const {
@@ -419,12 +420,7 @@ StateView StateView::Map(const std::string& path, const std::string& kind) {
 }
 
 const StateView::Section& StateView::Get(const std::string& name, uint8_t type) const {
-  const auto it = sections_.find(name);
-  if (it == sections_.end()) throw std::runtime_error("state has no section '" + name + "'");
-  if (it->second.type != type) {
-    throw std::runtime_error("state section '" + name + "' has another type");
-  }
-  return it->second;
+  return SectionOfType(sections_, name, type);
 }
 
 template <class T>

@@ -15,10 +15,7 @@
 #include <span>
 #include <string>
 
-namespace rl {
-class StateStream;
-class StateView;
-}  // namespace rl
+#include "common/state_fwd.h"
 
 namespace rl::replay {
 

@@ -12,10 +12,7 @@
 #include <string>
 #include <vector>
 
-namespace rl {
-class StateStream;
-class StateView;
-}  // namespace rl
+#include "common/state_fwd.h"
 
 namespace rl::replay {
 

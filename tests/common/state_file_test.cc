@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "common/atomic_file.h"
+#include "tests/common/error_of.h"
 
 #include <filesystem>
 #include <fstream>
@@ -24,17 +25,6 @@ StateFile Sample() {
   s.PutInt("updates", 42);
   s.PutText("net.arch", "linear(3,1)");
   return s;
-}
-
-// The message of the exception `f` throws (empty if it throws none).
-template <class F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
 }
 
 TEST(StateFileTest, RoundTripsEverySectionThroughAFile) {

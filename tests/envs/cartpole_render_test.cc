@@ -21,9 +21,7 @@ constexpr Rgb kAxle{129, 132, 203};
 Image RenderState(const std::array<double, 4>& state) {
   CartPole env;
   env.set_state(state);
-  Image image;
-  env.Render(&image.rgb, &image.width, &image.height);
-  return image;
+  return Rendered(env);
 }
 
 // In the 600x400 image (y down) the track is row 400 - 1 - 100 = 299; the cart is centred on
@@ -121,21 +119,20 @@ TEST(CartPoleRenderTest, PositiveThetaLeansThePoleTowardsPositiveX) {
 TEST(CartPoleRenderTest, RenderSizedScalesTheSamePicture) {
   CartPole env;
   env.set_state({0.8, 0, 0, 0});  // Cart centre at column 400 of 600.
-  std::vector<uint8_t> rgb;
-  env.RenderSized(300, 200, &rgb);
-  ASSERT_EQ(rgb.size(), 300u * 200u * 3u);
-  Image small{rgb, 300, 200};
+  const Image small = RenderedSized(env, 300, 200);
+  ASSERT_EQ(small.rgb.size(), 300u * 200u * 3u);
   EXPECT_EQ(small.at(0, 0), kWhite);
   EXPECT_EQ(small.at(200, 155), kBlack);  // Cart at half scale: centre (200, 150).
   EXPECT_EQ(small.at(150, 155), kWhite);
   EXPECT_GT(FindColor(small, kPole).count, 200);
   EXPECT_GT(FindColor(small, kAxle).count, 10);
   // The track stays at least one pixel thick when shrinking a lot.
-  env.RenderSized(60, 40, &rgb);
-  Image tiny{rgb, 60, 40};
+  const Image tiny = RenderedSized(env, 60, 40);
+  ASSERT_EQ(tiny.rgb.size(), 60u * 40u * 3u);
   int black_rows = 0;
   for (int y = 0; y < 40; ++y) black_rows += tiny.at(1, y) == kBlack;
   EXPECT_EQ(black_rows, 1);
+  std::vector<uint8_t> rgb;
   EXPECT_THROW(env.RenderSized(0, 10, &rgb), std::invalid_argument);
 }
 
@@ -152,8 +149,7 @@ TEST(CartPoleRenderTest, RunawayStatesRenderWithoutCrashing) {
 TEST(CartPoleRenderTest, RenderThroughTheRegistryDrawsThePole) {
   auto env = MakeEnv("CartPole-v1");
   env->Reset(0);
-  Image image;
-  env->Render(&image.rgb, &image.width, &image.height);
+  const Image image = Rendered(*env);
   EXPECT_GT(FindColor(image, kPole).count, 1000);
 }
 

@@ -193,8 +193,7 @@ TEST(CatchTest, RenderIs40By80WithWhiteBallAndPaddleCellsOnBlack) {
   EXPECT_THROW(env.Render(&rgb, &width, &height), std::logic_error);
   env.Reset(5);
   env.Step(DiscreteAction(0));  // Paddle to column 1, ball to row 1.
-  Image image;
-  env.Render(&image.rgb, &image.width, &image.height);
+  const Image image = Rendered(env);
   ASSERT_EQ(image.width, 40);
   ASSERT_EQ(image.height, 80);
   ASSERT_EQ(image.rgb.size(), 40u * 80u * 3u);
@@ -218,8 +217,7 @@ TEST(CatchTest, RenderSizedPutsCellBoundariesAtFloorOfTheScaledGrid) {
   // 13 x 23: column c spans [floor(13c / 5), floor(13(c + 1) / 5)), i.e. the column edges are
   // 0, 2, 5, 7, 10, 13; the row edges are floor(23r / 10): 0, 2, 4, 6, 9, 11, 13, 16, 18, 20, 23.
   constexpr std::array<int, 6> kColumnEdges = {0, 2, 5, 7, 10, 13};
-  Image image{.rgb = {}, .width = 13, .height = 23};
-  env.RenderSized(13, 23, &image.rgb);
+  const Image image = RenderedSized(env, 13, 23);
   ASSERT_EQ(image.rgb.size(), 13u * 23u * 3u);
   for (int y = 0; y < 23; ++y) {
     for (int x = 0; x < 13; ++x) {
@@ -230,14 +228,9 @@ TEST(CatchTest, RenderSizedPutsCellBoundariesAtFloorOfTheScaledGrid) {
     }
   }
   // At the native size RenderSized is Render.
-  std::vector<uint8_t> native;
-  int width = 0;
-  int height = 0;
-  env.Render(&native, &width, &height);
-  std::vector<uint8_t> sized;
-  env.RenderSized(40, 80, &sized);
-  EXPECT_EQ(sized, native);
-  EXPECT_THROW(env.RenderSized(0, 10, &sized), std::invalid_argument);
+  EXPECT_EQ(RenderedSized(env, 40, 80).rgb, Rendered(env).rgb);
+  std::vector<uint8_t> rgb;
+  EXPECT_THROW(env.RenderSized(0, 10, &rgb), std::invalid_argument);
 }
 
 TEST(CatchTest, RegistryWrapsCatchInANineStepTimeLimit) {

@@ -1,5 +1,5 @@
-// Helpers of the rendering tests: a rendered RGB image with pixel access, and where the pixels
-// of one colour are.
+// Helpers of the rendering tests: a rendered RGB image with pixel access, an env's picture as one,
+// and where the pixels of one colour are.
 #pragma once
 
 #include <cstddef>
@@ -21,6 +21,24 @@ struct Image {
     return Rgb{rgb[i], rgb[i + 1], rgb[i + 2]};
   }
 };
+
+// The picture of `env` (any env with Render) at its native size.
+template <class E>
+Image Rendered(E& env) {
+  Image image;
+  env.Render(&image.rgb, &image.width, &image.height);
+  return image;
+}
+
+// The picture of `env` (any env with RenderSized) at width x height.
+template <class E>
+Image RenderedSized(E& env, int width, int height) {
+  Image image;
+  image.width = width;
+  image.height = height;
+  env.RenderSized(width, height, &image.rgb);
+  return image;
+}
 
 // Count and mean position of the pixels of one colour.
 struct Blob {

@@ -24,9 +24,7 @@ constexpr double kAxleY = 249.5;
 Image RenderState(double theta, double theta_dot = 0) {
   Pendulum env;
   env.SetState(theta, theta_dot);
-  Image image;
-  env.Render(&image.rgb, &image.width, &image.height);
-  return image;
+  return Rendered(env);
 }
 
 // Renders after one step with torque u from (theta, 0).
@@ -35,9 +33,7 @@ Image RenderAfterTorque(double theta, float u) {
   env.SetState(theta, 0);
   const float action[] = {u};
   env.Step(action);
-  Image image;
-  env.Render(&image.rgb, &image.width, &image.height);
-  return image;
+  return Rendered(env);
 }
 
 TEST(PendulumRenderTest, ImageIs500By500RgbOnWhite) {
@@ -160,20 +156,16 @@ TEST(PendulumRenderTest, TorqueArrowScalesWithTheClippedTorque) {
   env.Reset(4);
   const float action[] = {2.0f};
   env.Step(action);
-  Image image;
-  env.Render(&image.rgb, &image.width, &image.height);
-  EXPECT_GT(FindColor(image, kArrow).count, 0);
+  EXPECT_GT(FindColor(Rendered(env), kArrow).count, 0);
   env.Reset(4);
-  env.Render(&image.rgb, &image.width, &image.height);
-  EXPECT_EQ(FindColor(image, kArrow).count, 0);
+  EXPECT_EQ(FindColor(Rendered(env), kArrow).count, 0);
 }
 
 TEST(PendulumRenderTest, RenderSizedDrawsAtTheRequestedSize) {
   Pendulum env;
   env.SetState(0, 0);
   // At the native size it is Render's image.
-  Image native;
-  env.Render(&native.rgb, &native.width, &native.height);
+  const Image native = Rendered(env);
   std::vector<uint8_t> same;
   env.RenderSized(500, 500, &same);
   EXPECT_EQ(same, native.rgb);

@@ -4,12 +4,7 @@
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
-set +e
-launch cartpole --out "$dir/run" --actors 4 --seed 1 --time-budget 240 > "$dir/launch.log" 2>&1
-status=$?
-set -e
-cat "$dir/launch.log" | tail -20
-[ "$status" -eq 0 ] || fail "launch exited with $status"
+launch_to_goal "$dir/launch.log" cartpole --out "$dir/run" --actors 4 --seed 1 --time-budget 240
 best=$(expect_best_mean "$dir/run" 475 --at-least)
 grep -q '<img' "$dir/run/report/index.html" || fail "the report has no learning curve"
 ls "$dir/run/checkpoints"/ckpt-*.bin >/dev/null || fail "no checkpoints"

@@ -11,14 +11,9 @@ precision=${1:-}
 learner_args=()
 [ -z "$precision" ] || learner_args=(--learner-args "--precision $precision")
 scratch
-set +e
-launch catch --out "$dir/run" --seed 1 --time-budget 240 "${learner_args[@]}" > "$dir/launch.log" 2>&1
-status=$?
-set -e
-tail -6 "$dir/launch.log"
-[ "$status" -eq 0 ] || fail "launch exited with $status"
-best=$(best_mean "$dir/run/eval.jsonl")
-awk -v b="$best" 'BEGIN{exit !(b >= 0.8)}' || fail "best evaluation mean $best < 0.8"
+launch_to_goal "$dir/launch.log" catch --out "$dir/run" --seed 1 --time-budget 240 \
+  "${learner_args[@]}"
+best=$(expect_best_mean "$dir/run" 0.8 --at-least)
 # The replay stored pixel frames, applied the learner's priorities, and lost nothing.
 expect_clean_pixel_replay "$dir/run"
 [ "$(replay_field priorities)" -gt 0 ] || fail "the replay applied no priorities"

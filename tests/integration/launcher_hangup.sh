@@ -16,8 +16,7 @@ SHELL=/bin/sh script -qfec "$cmd" /dev/null > "$dir/first.log" 2>&1 &
 terminal=$!
 disown "$terminal"  # (no job notice when it is killed)
 wait_line "$dir/first.log" "running; logs in" 60
-timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$dir/run/checkpoints/learner-state.bin" ||
-  fail "no learner state after 60 s"
+wait_learner_state "$dir/run"
 read -r launcher _ < "$dir/run/launch.pid"
 kill -KILL "$terminal"  # the terminal's other end closes
 echo "closed the launcher's terminal (launcher pid $launcher)"

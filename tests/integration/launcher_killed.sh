@@ -12,8 +12,7 @@ scratch
 launcher=$!
 disown "$launcher"  # (no job notice when it is killed)
 wait_line "$dir/first.log" "running; logs in" 60
-timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$dir/run/checkpoints/learner-state.bin" ||
-  fail "no learner state after 60 s"
+wait_learner_state "$dir/run"
 kill -KILL "$launcher"
 echo "killed the launcher (pid $launcher)"
 expect_all_ended "$dir/run" 15

@@ -79,6 +79,13 @@ wait_line() {  # wait_line FILE PATTERN TIMEOUT_SECONDS
     fail "no line matching '$pattern' in $file within $limit s"
 }
 
+# Waits (bounded) until the learner of the run in RUN_DIR has saved its state (it does with its
+# first checkpoint).
+wait_learner_state() {  # wait_learner_state RUN_DIR
+  timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$1/checkpoints/learner-state.bin" ||
+    fail "no learner state after 60 s"
+}
+
 # Fails when a process of the run was restarted: a restart hides a crash (a learner that
 # segfaults mid-run still reaches the goal), so a test that kills nothing calls this at its end.
 # Names each restarted process and how it died (from RUN/restarts: "TIME ROLE status CODE
@@ -135,11 +142,7 @@ expect_resumable_after_launcher_death() {  # expect_resumable_after_launcher_dea
   "$root/scripts/launch.sh" --stop "$run" > "$run/../stop.log" 2>&1 || status=$?
   [ "$status" -eq 1 ] && grep -q "is not going" "$run/../stop.log" ||
     fail "--stop after the launcher's end (status $status): $(cat "$run/../stop.log")"
-  status=0
-  "$root/scripts/launch.sh" --resume "$run" --no-setup --build-dir "$build_dir" --time-budget 240 \
-    > "$run/../resumed.log" 2>&1 || status=$?
-  tail -4 "$run/../resumed.log"
-  [ "$status" -eq 0 ] || fail "the resumed run exited with $status"
+  resume_to_goal "$run" "$run/../resumed.log"
   grep -q "resumed at update [1-9]" "$run/logs/learner.log" || fail "the learner did not resume"
   expect_no_restarts "$run"
 }
@@ -157,6 +160,26 @@ fake_root() {  # fake_root DIR
 run_setting() { sed -n "s/^# $2 = //p" "$1/config.ini"; }
 
 launch() { "$root/scripts/launch.sh" "$@" --no-setup --build-dir "$build_dir"; }
+
+# Runs `launch ARGS...` to its end, its output to LOG; shows the last lines and fails unless it
+# exited 0 (the goal reached).
+launch_to_goal() {  # launch_to_goal LOG PRESET [LAUNCH OPTIONS...]
+  local log=$1 status=0
+  shift
+  launch "$@" > "$log" 2>&1 || status=$?
+  tail -20 "$log"
+  [ "$status" -eq 0 ] || fail "launch exited with $status"
+}
+
+# Continues the run in RUN_DIR with `launch.sh --resume` (time budget 240 s), its output to LOG;
+# shows the last lines and fails unless it exited 0 (the goal reached).
+resume_to_goal() {  # resume_to_goal RUN_DIR LOG
+  local status=0
+  "$root/scripts/launch.sh" --resume "$1" --no-setup --build-dir "$build_dir" --time-budget 240 \
+    > "$2" 2>&1 || status=$?
+  tail -5 "$2"
+  [ "$status" -eq 0 ] || fail "the resumed run exited with $status"
+}
 
 # The last value of FIELD in ROLE's rows of a run's metrics.jsonl (empty when it has none).
 last_metric() {  # last_metric RUN_DIR ROLE FIELD

@@ -5,12 +5,7 @@
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
-set +e
-launch pendulum --out "$dir/run" --seed 1 --goal -250 --time-budget 300 > "$dir/launch.log" 2>&1
-status=$?
-set -e
-tail -20 "$dir/launch.log"
-[ "$status" -eq 0 ] || fail "launch exited with $status"
+launch_to_goal "$dir/launch.log" pendulum --out "$dir/run" --seed 1 --goal -250 --time-budget 300
 best=$(expect_best_mean "$dir/run" -250)
 grep -q "TD3" "$dir/run/logs/learner.log" || fail "the learner did not run TD3"
 grep -q "without noise" "$dir/run/report/index.html" || fail "the report does not say how it scored"

@@ -10,8 +10,7 @@ launch cartpole --out "$dir/run" --actors 2 --seed 3 --time-budget 240 > "$dir/l
 launch_pid=$!
 # Mid-run: the learner has written its state with its first checkpoint.
 wait_line "$dir/launch.log" "running; logs in" 60
-timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$dir/run/checkpoints/learner-state.bin" ||
-  fail "no learner state after 60 s"
+wait_learner_state "$dir/run"
 for role in learner replay evaluator actor-1; do
   victim=$(awk -v r="$role" '$1 == r {p = $2} END {print p}' "$dir/run/pids")
   [ -n "$victim" ] || fail "no pid for $role"

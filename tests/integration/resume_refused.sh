@@ -9,8 +9,7 @@ scratch
 launch cartpole --out "$dir/run" --actors 2 --seed 6 --goal 100000 --time-budget 240 \
   > "$dir/first.log" 2>&1 &
 wait_line "$dir/first.log" "running; logs in" 60
-timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$dir/run/checkpoints/learner-state.bin" ||
-  fail "no learner state after 60 s"
+wait_learner_state "$dir/run"
 "$root/scripts/launch.sh" --stop "$dir/run" > "$dir/stop.log" 2>&1 || fail "--stop: $(cat "$dir/stop.log")"
 wait
 [ -s "$dir/run/replay-snapshot.bin" ] || fail "no replay snapshot after the stop"

@@ -13,8 +13,7 @@ scratch
 launch_pid=$!
 wait_line "$dir/first.log" "running; logs in" 60
 wait_line "$dir/run/eval.jsonl" '"update"' 120
-timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$dir/run/checkpoints/learner-state.bin" ||
-  fail "no learner state after 60 s"
+wait_learner_state "$dir/run"
 kill -TERM "$launch_pid"
 status=0
 wait "$launch_pid" || status=$?
@@ -23,11 +22,7 @@ run_id=$(run_setting "$dir/run" run-id)
 evals_before=$(wc -l < "$dir/run/eval.jsonl")
 last_update_before=$(sed -n 's/.*"update": \([0-9]*\).*/\1/p' "$dir/run/eval.jsonl" | tail -1)
 # Second part: resumed, with the preset's goal.
-status=0
-"$root/scripts/launch.sh" --resume "$dir/run" --no-setup --build-dir "$build_dir" --time-budget 240 \
-  > "$dir/second.log" 2>&1 || status=$?
-tail -5 "$dir/second.log"
-[ "$status" -eq 0 ] || fail "the resumed run exited with $status"
+resume_to_goal "$dir/run" "$dir/second.log"
 grep -q "run $run_id of 'cartpole'" "$dir/second.log" || fail "the resumed run has another id"
 grep -q '^# resumed ' "$dir/run/config.ini" || fail "config.ini does not record the resumption"
 resumed=$(sed -n 's/.*resumed at update \([0-9]*\).*/\1/p' "$dir/run/logs/learner.log" | tail -1)

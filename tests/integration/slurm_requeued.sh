@@ -18,8 +18,7 @@ scratch
 slurm_cartpole_submit --goal 100000 --time-budget 150
 slurm_wait_steps
 wait_line "$run/eval.jsonl" '"update"' 120
-timeout 60 bash -c 'until [ -s "$0" ]; do sleep 0.05; done' "$run/checkpoints/learner-state.bin" ||
-  fail "no learner state after 60 s"
+wait_learner_state "$run"
 if [ "$mode" = timelimit ]; then
   wait_line "$out" "^slurm.sbatch: the time limit is near: stopping the run to requeue the job" 90
 else

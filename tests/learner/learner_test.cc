@@ -42,6 +42,18 @@ class LearnerTest : public ::testing::Test {
     return c;
   }
 
+  // ShortRun of a TD3 with two hidden layers of 16 on Pendulum-v1; the replies become
+  // 3-float observations and one-float torques.
+  LearnerConfig ShortTd3PendulumRun(int batch_size, int max_updates, int checkpoint_every) {
+    obs_size_ = 3;
+    continuous_ = true;
+    LearnerConfig c = ShortRun(batch_size, max_updates, checkpoint_every);
+    c.env_id = "Pendulum-v1";
+    c.algorithm = "td3";
+    c.td3.hidden = {16, 16};
+    return c;
+  }
+
   LearnerTest() : dir_(fs::temp_directory_path() / ("learner_test_" + std::to_string(getpid()))) {
     fs::remove_all(dir_);
     bus_ = std::make_unique<Bus>(InProcessBusConfig(9, "learner"));
@@ -298,12 +310,7 @@ TEST_F(LearnerTest, RefusesRandomShiftsForAnEnvWithoutPixels) {
 // TD3 on Pendulum-v1: trains on replies of one-float torques and broadcasts and checkpoints its
 // actor (3 inputs, 1 output in [-2, 2]), not a critic.
 TEST_F(LearnerTest, TrainsTd3AndPublishesItsActor) {
-  obs_size_ = 3;
-  continuous_ = true;
-  LearnerConfig c = ShortRun(16, 20, 10);
-  c.env_id = "Pendulum-v1";
-  c.algorithm = "td3";
-  c.td3.hidden = {16, 16};
+  const LearnerConfig c = ShortTd3PendulumRun(16, 20, 10);
   Learner learner(c, bus_.get());
   learner.Run();
   bus_->Handle(0);
@@ -382,12 +389,7 @@ TEST_F(LearnerTest, DqnResumesFromItsSavedStateAndNeverGoesBack) {
 }
 
 TEST_F(LearnerTest, Td3ResumesFromItsSavedStateAndNeverGoesBack) {
-  obs_size_ = 3;
-  continuous_ = true;
-  LearnerConfig c = ShortRun(16, 30, 10);
-  c.env_id = "Pendulum-v1";
-  c.algorithm = "td3";
-  c.td3.hidden = {16, 16};
+  const LearnerConfig c = ShortTd3PendulumRun(16, 30, 10);
   ExpectResumes(c, bus_.get(), &versions_, &announced_);
 }
 

@@ -1,7 +1,9 @@
 #include "nn/sequential.h"
 
+#include <array>
 #include <memory>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -23,6 +25,20 @@ std::vector<float> Flat(const Sequential& net) {
   std::vector<float> flat;
   net.GetFlat(&flat);
   return flat;
+}
+
+// Expects BuildFromArchitecture to throw std::invalid_argument for each architecture string,
+// with a message that contains the case's text.
+void ExpectRefused(std::span<const std::pair<std::string, std::string>> cases, std::mt19937* rng) {
+  for (const auto& [arch, message] : cases) {
+    try {
+      BuildFromArchitecture(arch, rng);
+      ADD_FAILURE() << "no exception for '" << arch << "'";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos)
+          << "'" << arch << "' gave: " << e.what();
+    }
+  }
 }
 
 TEST(SequentialTest, MakeMlpBuildsTheCartPoleNetwork) {
@@ -76,15 +92,7 @@ TEST(SequentialTest, MalformedArchitecturesThrowWithTheOffendingLayer) {
       {"linear(4,8)x", "text after ')'"},
       {"linear(4,8),relu,linear(7,2)", "expects 7 inputs but the previous layer produces 8"},
   };
-  for (const auto& [arch, message] : cases) {
-    try {
-      BuildFromArchitecture(arch, &rng);
-      ADD_FAILURE() << "no exception for '" << arch << "'";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find(message), std::string::npos)
-          << "'" << arch << "' gave: " << e.what();
-    }
-  }
+  ExpectRefused(cases, &rng);
 }
 
 // Strings from checkpoint files and weight messages: sizes that would overflow an int or
@@ -92,7 +100,7 @@ TEST(SequentialTest, MalformedArchitecturesThrowWithTheOffendingLayer) {
 // 16 GB allocation). Found by fuzz/fuzz_checkpoint.
 TEST(SequentialTest, BuildFromArchitectureRefusesSizesBeyondItsLimits) {
   std::mt19937 rng(1);
-  const std::pair<const char*, const char*> cases[] = {
+  const std::pair<std::string, std::string> cases[] = {
       {"linear(65535,65535)", "more than 67108864 parameters"},
       {"linear(4,8),relu,linear(8,70000)", "70000 is above the limit of 65536"},
       {"conv2d(1,1,1,1,60000,4,4)", "an image of more than 67108864 values"},
@@ -100,15 +108,7 @@ TEST(SequentialTest, BuildFromArchitectureRefusesSizesBeyondItsLimits) {
       {"batchnorm2d(1,50000,50000)", "an image of more than 67108864 values"},
       {"maxpool2d(1,1,50000,50000),flatten,linear(1,1)", "an image of more than 67108864 values"},
   };
-  for (const auto& [arch, message] : cases) {
-    try {
-      BuildFromArchitecture(arch, &rng);
-      ADD_FAILURE() << "no exception for '" << arch << "'";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find(message), std::string::npos)
-          << "'" << arch << "' gave: " << e.what();
-    }
-  }
+  ExpectRefused(cases, &rng);
   // The largest network of ours is far below the limits.
   EXPECT_NO_THROW(BuildFromArchitecture(
       "conv2d(4,32,8,4,0,84,84),relu,conv2d(32,64,4,2,0,20,20),relu,conv2d(64,64,3,1,0,9,9),relu,"
@@ -255,36 +255,45 @@ TEST(SequentialTest, AddRejectsMismatchedLayerSizes) {
   EXPECT_THROW(net.Add(std::make_unique<Linear>(7, 2, &rng)), std::invalid_argument);
 }
 
-// Back-propagates the gathered-action loss of DQN through an MLP: the loss only sees Q(s_j, a_j).
-void CheckEndToEndGradients(bool huber) {
-  std::mt19937 rng(13);
-  Sequential net = MakeMlp(3, {8, 6}, 2, &rng);
-  const int batch = 5;
-  Matrix x = RandomMatrix(3, batch, &rng, 2.0f);
-  const int actions[batch] = {0, 1, 1, 0, 1};
-  const Vector target = RandomMatrix(batch, 1, &rng, 2.0f);
-  const Vector weights = RandomMatrix(batch, 1, &rng, 0.5f).array() + 1.0f;
+// Back-propagates the gathered-action loss of DQN (the loss only sees Q(s_j, a_j)) through `net`
+// on a random batch of 5 and expects the gradients of the input and of every parameter to match
+// finite differences. Huber (delta 1) or mean squared error, with random sample weights in
+// [0.5, 1.5] or none.
+void ExpectGatheredLossGradientsMatch(Sequential* net, const std::array<int, 5>& actions,
+                                      bool huber, bool weighted, std::mt19937* rng) {
+  const int batch = static_cast<int>(actions.size());
+  Matrix x = RandomMatrix(net->InputSize(), batch, rng, 2.0f);
+  const Vector target = RandomMatrix(batch, 1, rng, 2.0f);
+  Vector weights;
+  if (weighted) weights = RandomMatrix(batch, 1, rng, 0.5f).array() + 1.0f;
+  const Vector* w = weighted ? &weights : nullptr;
   Vector pred(batch);
   auto loss_with_grad = [&](Vector* grad) {
-    const Matrix& q = net.Forward(x);
+    const Matrix& q = net->Forward(x);
     for (int j = 0; j < batch; ++j) pred[j] = q(actions[j], j);
-    return huber ? HuberLoss(pred, target, grad, 1.0f, &weights)
-                 : MseLoss(pred, target, grad, &weights);
+    return huber ? HuberLoss(pred, target, grad, 1.0f, w) : MseLoss(pred, target, grad, w);
   };
   auto loss = [&] { return static_cast<double>(loss_with_grad(nullptr)); };
 
   Vector grad;
   loss_with_grad(&grad);
-  Matrix grad_q = Matrix::Zero(2, batch);
+  Matrix grad_q = Matrix::Zero(net->OutputSize(), batch);
   for (int j = 0; j < batch; ++j) grad_q(actions[j], j) = grad[j];
-  net.ZeroGrad();
-  const Matrix dx = net.Backward(grad_q);
+  net->ZeroGrad();
+  const Matrix dx = net->Backward(grad_q);
 
   ExpectGradientsClose(dx, NumericalGradient(loss, &x), "input");
-  for (const Param& p : net.Params()) {
+  for (const Param& p : net->Params()) {
     const Matrix analytic = *p.grad;
     ExpectGradientsClose(analytic, NumericalGradient(loss, p.value), p.name);
   }
+}
+
+// Through an MLP, with weighted samples.
+void CheckEndToEndGradients(bool huber) {
+  std::mt19937 rng(13);
+  Sequential net = MakeMlp(3, {8, 6}, 2, &rng);
+  ExpectGatheredLossGradientsMatch(&net, {0, 1, 1, 0, 1}, huber, /*weighted=*/true, &rng);
 }
 
 TEST(SequentialTest, MlpGradientsThroughWeightedHuberMatchFiniteDifferences) {
@@ -401,15 +410,7 @@ TEST(SequentialTest, MalformedConvolutionalArchitecturesThrowWithTheOffendingLay
        "expects 16x40x20 images but the previous layers produce 32x20x20"},
       {"maxpool(2)", "unknown layer 0 'maxpool' (known: linear(in,out), conv2d("},
   };
-  for (const auto& [arch, message] : cases) {
-    try {
-      BuildFromArchitecture(arch, &rng);
-      ADD_FAILURE() << "no exception for '" << arch << "'";
-    } catch (const std::invalid_argument& e) {
-      EXPECT_NE(std::string(e.what()).find(message), std::string::npos)
-          << "'" << arch << "' gave: " << e.what();
-    }
-  }
+  ExpectRefused(cases, &rng);
 }
 
 TEST(SequentialTest, BuffersFollowTheParametersInGetFlat) {
@@ -497,30 +498,7 @@ TEST(SequentialTest, EvalModeUsesRunningStatisticsAndPredictAlwaysDoes) {
 TEST(SequentialTest, ConvNetGradientsThroughHuberMatchFiniteDifferences) {
   std::mt19937 rng(34);
   Sequential net = BuildFromArchitecture(kConvArch, &rng);
-  const int batch = 5;
-  Matrix x = RandomMatrix(net.InputSize(), batch, &rng, 2.0f);
-  const int actions[batch] = {0, 2, 1, 1, 2};
-  const Vector target = RandomMatrix(batch, 1, &rng, 2.0f);
-  Vector pred(batch);
-  auto loss_with_grad = [&](Vector* grad) {
-    const Matrix& q = net.Forward(x);
-    for (int j = 0; j < batch; ++j) pred[j] = q(actions[j], j);
-    return HuberLoss(pred, target, grad);
-  };
-  auto loss = [&] { return static_cast<double>(loss_with_grad(nullptr)); };
-
-  Vector grad;
-  loss_with_grad(&grad);
-  Matrix grad_q = Matrix::Zero(3, batch);
-  for (int j = 0; j < batch; ++j) grad_q(actions[j], j) = grad[j];
-  net.ZeroGrad();
-  const Matrix dx = net.Backward(grad_q);
-
-  ExpectGradientsClose(dx, NumericalGradient(loss, &x), "input");
-  for (const Param& p : net.Params()) {
-    const Matrix analytic = *p.grad;
-    ExpectGradientsClose(analytic, NumericalGradient(loss, p.value), p.name);
-  }
+  ExpectGatheredLossGradientsMatch(&net, {0, 2, 1, 1, 2}, /*huber=*/true, /*weighted=*/false, &rng);
 }
 
 // ReLUs fused into convolutions, batch normalisation and the dueling head give the same results

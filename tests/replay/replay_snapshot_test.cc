@@ -25,6 +25,7 @@
 #include "common/state_file.h"
 #include "replay/replay_service.h"
 #include "replay/snapshotter.h"
+#include "tests/common/error_of.h"
 
 namespace rl::replay {
 namespace {
@@ -165,17 +166,6 @@ void ExpectSameState(ReplayService& a, ReplayService& b) {
   EXPECT_EQ(a.counters().priorities_applied, b.counters().priorities_applied);
   EXPECT_EQ(a.counters().requests_answered, b.counters().requests_answered);
   EXPECT_EQ(a.insert_allowed(), b.insert_allowed());
-}
-
-// The message of the exception `f` throws (empty if it throws none).
-template <class F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
 }
 
 class ReplaySnapshotTest : public ::testing::Test {

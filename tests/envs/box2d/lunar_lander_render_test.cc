@@ -19,9 +19,7 @@ constexpr Rgb kFlag{204, 204, 0};
 
 Image RenderAt(LunarLander& env, const LanderKinematics& k) {
   env.SetLanderKinematics(k);
-  Image image;
-  env.Render(&image.rgb, &image.width, &image.height);
-  return image;
+  return Rendered(env);
 }
 
 TEST(LunarLanderRenderTest, ImageIs600By400WithBlackSkyAndWhiteGround) {
@@ -115,10 +113,7 @@ TEST(LunarLanderRenderTest, RenderSizedScalesThePicture) {
   LunarLander env;
   env.Reset(1);
   env.SetLanderKinematics(LanderKinematics{.x = 10, .y = 10});
-  Image small;
-  small.width = 300;
-  small.height = 200;
-  env.RenderSized(300, 200, &small.rgb);
+  const Image small = RenderedSized(env, 300, 200);
   ASSERT_EQ(small.rgb.size(), 300u * 200u * 3u);
   EXPECT_EQ(small.at(0, 0), kBlack);
   EXPECT_EQ(small.at(150, 199), kWhite);
@@ -126,23 +121,20 @@ TEST(LunarLanderRenderTest, RenderSizedScalesThePicture) {
   EXPECT_NEAR(FindColor(small, kLanderFill).count,
               FindColor(RenderAt(env, {.x = 10, .y = 10}), kLanderFill).count / 4.0, 80);
   // A tiny image still shows both flag poles.
-  Image tiny;
-  tiny.width = 60;
-  tiny.height = 40;
-  env.RenderSized(60, 40, &tiny.rgb);
+  const Image tiny = RenderedSized(env, 60, 40);
   ASSERT_EQ(tiny.rgb.size(), 60u * 40u * 3u);
   EXPECT_EQ(tiny.at(24, 28), kWhite);
   EXPECT_EQ(tiny.at(36, 28), kWhite);
-  EXPECT_THROW(env.RenderSized(0, 10, &tiny.rgb), std::invalid_argument);
-  EXPECT_THROW(env.RenderSized(10, -1, &tiny.rgb), std::invalid_argument);
+  std::vector<uint8_t> rgb;
+  EXPECT_THROW(env.RenderSized(0, 10, &rgb), std::invalid_argument);
+  EXPECT_THROW(env.RenderSized(10, -1, &rgb), std::invalid_argument);
 }
 
 // (Render before Reset and the native size of every id: specs_test.cc.)
 TEST(LunarLanderRenderTest, RenderThroughTheRegistryDrawsTheLander) {
   auto env = MakeEnv("LunarLanderContinuous-v3");
   env->Reset(0);
-  Image image;
-  env->Render(&image.rgb, &image.width, &image.height);
+  const Image image = Rendered(*env);
   // The lander starts at the top edge (y = H), so the upper part of its hull is cut off.
   EXPECT_GT(FindColor(image, kLanderFill).count, 200);
   EXPECT_EQ(image.at(300, 5), kLanderFill);
