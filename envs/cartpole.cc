@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/check.h"
+#include "envs/env_list.h"
 #include "envs/raster.h"
 #include "envs/rng.h"
 #include "envs/specs.h"
@@ -172,5 +173,8 @@ void CartPole::RenderSized(int width, int height, std::vector<uint8_t>* rgb) con
       std::max(row_begin + 1, static_cast<int>(std::floor((kScreenHeight - kCartY) * sy + 0.5)));
   canvas.FillPixelRect(0, row_begin, width, row_end, kBlack);
 }
+
+// Registered as CartPole-v1 (env_list.inc).
+std::unique_ptr<Env> MakeCartPoleV1(const EnvIdParts&) { return std::make_unique<CartPole>(); }
 
 }  // namespace rl::envs

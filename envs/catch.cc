@@ -6,6 +6,7 @@
 #include <string>
 
 #include "common/check.h"
+#include "envs/env_list.h"
 #include "envs/raster.h"
 #include "envs/rng.h"
 #include "envs/specs.h"
@@ -93,5 +94,10 @@ void Catch::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const 
   PaintCell(canvas, ball_row_, ball_column_);
   PaintCell(canvas, kRows - 1, paddle_column_);
 }
+
+// Registered as Catch-v0 (env_list.inc). Every episode ends after 9 steps, so the time limit
+// never cuts one short: it only marks the terminating step truncated as well (terminated still
+// means no bootstrapping).
+std::unique_ptr<Env> MakeCatchV0(const EnvIdParts&) { return std::make_unique<Catch>(); }
 
 }  // namespace rl::envs

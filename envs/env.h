@@ -29,7 +29,9 @@ struct StepResult {
 /// travels and is stored as action_width() floats: a discrete action is one value holding the
 /// index (Env::Step and CheckAction() accept only an integer in range).
 struct EnvSpec {
-  std::string id;               // Registered id, e.g. "CartPole-v1".
+  // Registered id, e.g. "CartPole-v1". "= {}" lets a designated initializer leave it out
+  // without a warning (env_list.inc's entries give it apart).
+  std::string id = {};
   int observation_size = 0;     // Number of float32 values in observation().
   int num_actions = 0;          // Discrete actions are 0 .. num_actions - 1; 0 for continuous envs.
   int max_episode_steps = 0;    // Time limit applied by the registry (TimeLimit).

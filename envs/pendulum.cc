@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/check.h"
+#include "envs/env_list.h"
 #include "envs/raster.h"
 #include "envs/rng.h"
 #include "envs/specs.h"
@@ -190,5 +191,8 @@ void Pendulum::RenderSized(int width, int height, std::vector<uint8_t>* rgb) con
   // Axle: a black disc drawn last.
   canvas.FillEllipse(pixel_centre(kOffset, kOffset), kAxleRadius * sx, kAxleRadius * sy, kBlack);
 }
+
+// Registered as Pendulum-v1 (env_list.inc).
+std::unique_ptr<Env> MakePendulumV1(const EnvIdParts&) { return std::make_unique<Pendulum>(); }
 
 }  // namespace rl::envs

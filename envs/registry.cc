@@ -5,13 +5,8 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "envs/box2d/car_racing.h"
-#include "envs/box2d/lunar_lander.h"
-#include "envs/cartpole.h"
-#include "envs/catch.h"
+#include "envs/env_list.h"
 #include "envs/image/pixel_env.h"
-#include "envs/kuka/kuka_diverse_object_env.h"
-#include "envs/pendulum.h"
 #include "envs/pixel_spec.h"
 #include "envs/specs.h"
 #include "envs/time_limit.h"
@@ -19,82 +14,32 @@
 namespace rl::envs {
 namespace {
 
-// What an id's pixels keys change in the env under the pipeline: CarRacing's rules.
-struct BaseOptions {
-  bool lap_ends = true;
-  bool off_track = false;
-  int off_track_after = 0;  // The no-op frames after every reset, which the rule skips.
-};
-
-CarRacingConfig CarRacingRules(bool continuous, const BaseOptions& o) {
-  return CarRacingConfig{.continuous = continuous,
-                         .lap_ends = o.lap_ends,
-                         .off_track = o.off_track,
-                         .off_track_after = o.off_track_after};
-}
-
-// One registered id and how to build the env under its TimeLimit (MakeBase), whose default
-// limit is the id's spec's (envs/specs.h: one table of the limits).
+// One registered id and the factory of its env (env_list.inc, the one list of the envs).
 struct Registration {
   std::string_view id;
-  std::unique_ptr<Env> (*make)(const BaseOptions&);
+  EnvFactory make;
 };
 
 constexpr std::array kRegistrations = {
-    Registration{
-        "CartPole-v1",
-        [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<CartPole>(); }},
-    Registration{
-        "LunarLander-v3",
-        [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<LunarLander>(); }},
-    Registration{"LunarLanderContinuous-v3",
-                 [](const BaseOptions&) -> std::unique_ptr<Env> {
-                   return std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true});
-                 }},
-    // CarRacing: 1,000 frames; an episode also ends when every tile is visited (unless lap_ends
-    // is off), the car leaves the playfield, or (off_track) the track.
-    Registration{"CarRacing-v3",
-                 [](const BaseOptions& o) -> std::unique_ptr<Env> {
-                   return std::make_unique<CarRacing>(CarRacingRules(true, o));
-                 }},
-    Registration{"CarRacingDiscrete-v3",
-                 [](const BaseOptions& o) -> std::unique_ptr<Env> {
-                   return std::make_unique<CarRacing>(CarRacingRules(false, o));
-                 }},
-    Registration{
-        "Pendulum-v1",
-        [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<Pendulum>(); }},
-    // Every Catch episode ends after 9 steps, so the limit never cuts one short: it only marks
-    // the terminating step truncated as well (terminated still means no bootstrapping).
-    Registration{
-        "Catch-v0",
-        [](const BaseOptions&) -> std::unique_ptr<Env> { return std::make_unique<Catch>(); }},
-    // KUKA grasping from a camera: 15 steps on the training objects; the held-out test objects
-    // with the 20 steps of evaluation. An episode also ends at its grasp attempt.
-    Registration{"KukaDiverseObjectGrasping-v0",
-                 [](const BaseOptions&) -> std::unique_ptr<Env> {
-                   return std::make_unique<KukaDiverseObjectEnv>();
-                 }},
-    Registration{"KukaDiverseObjectGraspingTest-v0",
-                 [](const BaseOptions&) -> std::unique_ptr<Env> {
-                   return std::make_unique<KukaDiverseObjectEnv>(
-                       KukaDiverseObjectConfig{.is_test = true, .max_steps = 20});
-                 }},
+#define RL_ENV(env_id, factory, ...) Registration{env_id, factory},
+#include "envs/env_list.inc"
+#undef RL_ENV
 };
 
-// A registered env with its time limit: `time_limit` when positive, else its spec's.
-std::unique_ptr<Env> MakeBase(const std::string& id, int time_limit, const BaseOptions& options) {
+// The registered env of `parts.base` with its time limit: `time_limit` when positive, else its
+// spec's.
+std::unique_ptr<Env> MakeBase(const EnvIdParts& parts, int time_limit) {
   for (const Registration& r : kRegistrations) {
-    if (r.id == id) {
+    if (r.id == parts.base) {
       return std::make_unique<TimeLimit>(
-          r.make(options), time_limit > 0 ? time_limit : LookupSpec(id).max_episode_steps);
+          r.make(parts), time_limit > 0 ? time_limit : LookupSpec(parts.base).max_episode_steps);
     }
   }
   std::string known;
   for (const std::string& name : RegisteredEnvs()) {
     known += known.empty() ? name : ", " + name;
   }
-  throw std::invalid_argument("MakeEnv: unknown environment id \"" + id +
+  throw std::invalid_argument("MakeEnv: unknown environment id \"" + parts.base +
                               "\"; known ids: " + known);
 }
 
@@ -102,11 +47,8 @@ std::unique_ptr<Env> MakeBase(const std::string& id, int time_limit, const BaseO
 
 std::unique_ptr<Env> MakeEnv(const std::string& id) {
   const EnvIdParts parts = ParseEnvId(id);
-  if (!parts.pixels) return MakeBase(id, 0, {});
-  const BaseOptions options{.lap_ends = parts.lap_ends,
-                            .off_track = parts.off_track,
-                            .off_track_after = parts.image.noop_start};
-  return MakePixelEnv(MakeBase(parts.base, parts.image.time_limit, options), parts.image);
+  if (!parts.pixels) return MakeBase(parts, 0);
+  return MakePixelEnv(MakeBase(parts, parts.image.time_limit), parts.image);
 }
 
 std::vector<std::string> RegisteredEnvs() {

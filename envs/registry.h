@@ -1,4 +1,5 @@
 // Creates environments by their Gymnasium id, with the time limit that gymnasium.make applies.
+// The ids, their specs and their factories are the entries of the list of envs (env_list.inc).
 #pragma once
 
 #include <memory>

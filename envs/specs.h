@@ -1,10 +1,11 @@
 // Static env specs: what every registered env id is (sizes, action space, time limit, goal),
 // known without building the env, so that processes that need only sizes (the learner, the
-// replay) link no physics or rendering library. This file is the one source of these numbers:
-// each env class takes its spec from here.
+// replay) link no physics or rendering library. The numbers are written once, in the list of
+// envs (env_list.inc), which the registry reads too; each env class takes its spec from here.
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "envs/env.h"
 
@@ -12,6 +13,8 @@ namespace rl::envs {
 
 struct ImagePipelineConfig;
 
+// Shorthands for LookupSpec of the envs' ids, kept for the code that names them. A new env
+// needs none: its class calls LookupSpec(its id).
 EnvSpec CartPoleSpec();
 EnvSpec CatchSpec();
 /// Pendulum-v1 (environments.md 4b); goal -200 (Gymnasium registers none; the usual bar).
@@ -20,7 +23,9 @@ EnvSpec LunarLanderSpec(bool continuous);
 /// CarRacing-v3 (continuous: steer [-1, 1], gas [0, 1], brake [0, 1]) or its discrete variant
 /// "CarRacingDiscrete-v3" (5 actions); observation 96 x 96 x 3 RGB / 255; native render 96 x 96.
 EnvSpec CarRacingSpec(bool continuous);
-/// The KUKA grasping envs: training objects (15 steps) or held-out test objects (20 steps).
+/// The KUKA grasping envs: training objects or held-out test objects, with `max_steps` as the
+/// time limit and a native render size of width x height (the registered ids: 15 and 20 steps,
+/// 48 x 48).
 EnvSpec KukaDiverseObjectSpec(bool is_test, int max_steps, int width, int height);
 
 /// The spec of `inner` behind the image pipeline `config` (as MakePixelEnv builds it): frame
@@ -31,5 +36,9 @@ EnvSpec PixelSpec(const EnvSpec& inner, const ImagePipelineConfig& config);
 /// The spec MakeEnv(id)->spec() has, time limit included, without building anything. Throws
 /// std::invalid_argument as MakeEnv does for an unknown id or a bad pixels setting.
 EnvSpec LookupSpec(const std::string& id);
+
+/// The ids LookupSpec knows (those of env_list.inc, without pixel pipelines), sorted: the same
+/// list as RegisteredEnvs() (registry.h), which needs the envs linked.
+std::vector<std::string> SpecIds();
 
 }  // namespace rl::envs

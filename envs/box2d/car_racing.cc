@@ -26,6 +26,7 @@
 #include <utility>
 
 #include "common/check.h"
+#include "envs/env_list.h"
 #include "envs/specs.h"
 
 namespace rl::envs {
@@ -561,6 +562,27 @@ std::span<const float> CarRacing::observation() const {
     observation_stale_ = false;
   }
   return observation_;
+}
+
+namespace {
+
+// CarRacing with the rules the id sets (pixel_spec.h): 1,000 frames; an episode also ends when
+// every tile is visited (unless lap-ends is 0), the car leaves the playfield, or (off-track) the
+// track after the no-op start.
+std::unique_ptr<Env> MakeCarRacing(const EnvIdParts& id, bool continuous) {
+  return std::make_unique<CarRacing>(CarRacingConfig{.continuous = continuous,
+                                                     .lap_ends = id.lap_ends,
+                                                     .off_track = id.off_track,
+                                                     .off_track_after = id.image.noop_start});
+}
+
+}  // namespace
+
+// Registered as CarRacing-v3 and CarRacingDiscrete-v3 (env_list.inc).
+std::unique_ptr<Env> MakeCarRacingV3(const EnvIdParts& id) { return MakeCarRacing(id, true); }
+
+std::unique_ptr<Env> MakeCarRacingDiscreteV3(const EnvIdParts& id) {
+  return MakeCarRacing(id, false);
 }
 
 }  // namespace rl::envs

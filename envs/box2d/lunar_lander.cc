@@ -37,12 +37,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
 #include "common/check.h"
+#include "envs/env_list.h"
 #include "envs/rng.h"
 #include "envs/specs.h"
 
@@ -465,6 +467,15 @@ StepResult LunarLander::ApplyTerminationRules(double reward, bool game_over, dou
 double LunarLander::WindMagnitude(int64_t index, double power) {
   const double i = static_cast<double>(index);
   return std::tanh(std::sin(0.02 * i) + std::sin(std::numbers::pi * 0.01 * i)) * power;
+}
+
+// Registered as LunarLander-v3 and LunarLanderContinuous-v3 (env_list.inc).
+std::unique_ptr<Env> MakeLunarLanderV3(const EnvIdParts&) {
+  return std::make_unique<LunarLander>();
+}
+
+std::unique_ptr<Env> MakeLunarLanderContinuousV3(const EnvIdParts&) {
+  return std::make_unique<LunarLander>(LunarLanderConfig{.continuous = true});
 }
 
 }  // namespace rl::envs

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 #include <string>
 
 #include "common/check.h"
+#include "envs/env_list.h"
 #include "envs/kuka/kuka_kinematics.h"
 #include "envs/kuka/kuka_renderer.h"
 #include "envs/rng.h"
@@ -238,6 +240,18 @@ void KukaDiverseObjectEnv::RenderSized(int width, int height, std::vector<uint8_
   if (!renderer_) renderer_ = std::make_unique<kuka::KukaRenderer>();
   scene_->CollectDrawItems(&draw_items_);
   renderer_->Render(camera_, draw_items_, width, height, rgb);
+}
+
+// Registered as KukaDiverseObjectGrasping-v0 (the training objects, 15 steps) and
+// KukaDiverseObjectGraspingTest-v0 (the held-out objects, the 20 steps of evaluation) in
+// env_list.inc. An episode also ends at its grasp attempt.
+std::unique_ptr<Env> MakeKukaDiverseObjectGraspingV0(const EnvIdParts&) {
+  return std::make_unique<KukaDiverseObjectEnv>();
+}
+
+std::unique_ptr<Env> MakeKukaDiverseObjectGraspingTestV0(const EnvIdParts&) {
+  return std::make_unique<KukaDiverseObjectEnv>(
+      KukaDiverseObjectConfig{.is_test = true, .max_steps = 20});
 }
 
 }  // namespace rl::envs

@@ -84,6 +84,15 @@ TEST(SpecsTest, EveryRegisteredIdHasTheSpecOfTheEnvItBuilds) {
   }
 }
 
+// The spec lookup and the registry expand the one list of envs (env_list.inc) separately: every
+// registered id has a spec under its own id, and every id with a spec is registered.
+TEST(SpecsTest, EveryRegisteredIdHasASpecAndEverySpecIdIsRegistered) {
+  const std::vector<std::string> registered = RegisteredEnvs();
+  EXPECT_FALSE(registered.empty());
+  EXPECT_EQ(SpecIds(), registered);
+  for (const std::string& id : registered) EXPECT_EQ(LookupSpec(id).id, id);
+}
+
 TEST(SpecsTest, PixelIdsHaveTheSpecOfTheImagePipeline) {
   for (const std::string id :
        {"Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)",
