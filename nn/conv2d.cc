@@ -20,6 +20,11 @@ namespace {
 // matrix (about 512 KB) stays in the L2 cache while the kernel reads it.
 constexpr int64_t kColsBudget = 128 * 1024;
 
+// How far ahead of the input row being split BuildPlanes() asks for input (floats, 4 KB): a
+// batch's input is mostly read from memory, and the hardware prefetcher starts late on each
+// sample's rows. Measured on AMD Zen 5: twice the speed of the split of uncached 84-float rows.
+constexpr int64_t kPrefetchFloats = 1024;
+
 std::string ConvName(int in_channels, int out_channels, int kernel, int stride, int padding,
                      int in_h, int in_w) {
   return "conv2d(" + std::to_string(in_channels) + "," + std::to_string(out_channels) + "," +
@@ -133,6 +138,10 @@ void Conv2d::BuildPlanes(const Matrix& x, int b0, int count, Scratch* scratch) c
           continue;
         }
         const float* row = channel + static_cast<int64_t>(iy) * w;
+        const int64_t ahead = (row - x.data()) + kPrefetchFloats;
+        if (ahead + w <= x.size()) {
+          for (int i = 0; i < w; i += 16) __builtin_prefetch(x.data() + ahead + i);
+        }
         if (p == 0) {
           kernels.deinterleave(row, w, s, geo_.plane_w, plane_size, dst);
           continue;

@@ -22,6 +22,23 @@ inline void CopyRun(const float* src, int n, float* dst) {
 #endif
 }
 
+#if RL_NN_AVX512
+// The floats p[0, lanes) in the low lanes and 0 in the others, reading only [p - behind,
+// p + lanes). A masked load is several times slower than a plain one on memory not yet in the
+// cache on some CPUs (AMD Zen 4 and 5), so when 16 readable floats end at p + lanes the part
+// is read by a plain load of those and moved down by a permute.
+inline __m512 LoadFirst(const float* p, int lanes, int64_t behind) {
+  if (lanes >= 16) return _mm512_loadu_ps(p);
+  if (lanes <= 0) return _mm512_setzero_ps();
+  const auto mask = static_cast<__mmask16>((1U << lanes) - 1U);
+  if (behind + lanes < 16) return _mm512_maskz_loadu_ps(mask, p);
+  const __m512i up =
+      _mm512_add_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
+                       _mm512_set1_epi32(16 - lanes));
+  return _mm512_maskz_permutexvar_ps(mask, up, _mm512_loadu_ps(p + lanes - 16));
+}
+#endif
+
 // Splits the row `src` of n * s floats, of which the first `valid` are read and the rest taken
 // as 0, into s rows of n: dst[px * plane_size + x] = src[x * s + px]. Unrolled for the common
 // strides so that the compiler vectorises it, and with AVX-512 permutes for strides 2 and 4 (the
@@ -33,7 +50,8 @@ void DeinterleaveFixed(const float* __restrict src, int valid, int n, int64_t pl
   if constexpr (S == 2 || S == 4) {
     // Output px takes lanes px, px + S, ... of 16 S consecutive inputs: for S = 2 one two-source
     // permute; for S = 4 eight lanes from each half of them, then the halves joined. Loads stop
-    // at `valid` (masked lanes read as 0) and the last chunk stores only the lanes it has.
+    // at `valid` (the lanes past it read as 0, see LoadFirst()) and the last chunk stores only
+    // the lanes it has.
     const __m512i stride_idx = _mm512_mullo_epi32(
         _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 0, 1, 2, 3, 4, 5, 6, 7), _mm512_set1_epi32(S));
     const __m512i idx2 =
@@ -44,9 +62,7 @@ void DeinterleaveFixed(const float* __restrict src, int valid, int n, int64_t pl
       __m512 v[S];
 #pragma GCC unroll 4
       for (int i = 0; i < S; ++i) {
-        const int lanes = std::clamp(floats - 16 * i, 0, 16);
-        const auto mask = static_cast<__mmask16>((1U << lanes) - 1U);
-        v[i] = _mm512_maskz_loadu_ps(mask, src + S * x0 + 16 * i);
+        v[i] = LoadFirst(src + S * x0 + 16 * i, floats - 16 * i, S * x0 + 16 * i);
       }
       const auto out_mask = static_cast<__mmask16>((1U << count) - 1U);
 #pragma GCC unroll 4
@@ -59,7 +75,11 @@ void DeinterleaveFixed(const float* __restrict src, int valid, int n, int64_t pl
           out = _mm512_shuffle_f32x4(_mm512_permutex2var_ps(v[0], idx, v[1]),
                                      _mm512_permutex2var_ps(v[2], idx, v[3]), 0x44);
         }
-        _mm512_mask_storeu_ps(dst + px * plane_size + x0, out_mask, out);
+        if (count == 16) {
+          _mm512_storeu_ps(dst + px * plane_size + x0, out);
+        } else {
+          _mm512_mask_storeu_ps(dst + px * plane_size + x0, out_mask, out);
+        }
       }
     }
     return;

@@ -83,5 +83,40 @@ TEST(PixelsTest, AShiftMovesEveryPlaneOfAnObservationTogetherAndRepeatsTheEdges)
   }
 }
 
+TEST(PixelsTest, EveryShiftMatchesTheClampedReadPixelByPixel) {
+  // Shifts from beyond one edge to beyond the other on both axes, against output (c, y, x) =
+  // input (c, clamp(y + dy), clamp(x + dx)) / 255 read pixel by pixel.
+  constexpr int kPlanes = 3, kH = 7, kW = 37, kPlane = kH * kW;
+  std::vector<int> dy, dx;
+  for (int sy = -kH - 1; sy <= kH + 1; sy += 3) {
+    for (int sx = -kW - 2; sx <= kW + 2; ++sx) {
+      dy.push_back(sy);
+      dx.push_back(sx);
+    }
+  }
+  const int batch = static_cast<int>(dy.size());
+  std::vector<uint8_t> bytes(static_cast<size_t>(kPlanes) * kPlane * batch);
+  for (size_t i = 0; i < bytes.size(); ++i) bytes[i] = static_cast<uint8_t>((i * 97 + 13) % 256);
+  Matrix m;
+  ShiftedPixelsToMatrix(bytes.data(), kPlanes, kH, kW, batch, dy.data(), dx.data(), &m);
+  ASSERT_EQ(m.rows(), kPlanes * kPlane);
+  ASSERT_EQ(m.cols(), batch);
+  for (int j = 0; j < batch; ++j) {
+    for (int c = 0; c < kPlanes; ++c) {
+      for (int y = 0; y < kH; ++y) {
+        for (int x = 0; x < kW; ++x) {
+          const int sy = std::clamp(y + dy[static_cast<size_t>(j)], 0, kH - 1);
+          const int sx = std::clamp(x + dx[static_cast<size_t>(j)], 0, kW - 1);
+          const uint8_t byte =
+              bytes[static_cast<size_t>((j * kPlanes + c) * kPlane + sy * kW + sx)];
+          ASSERT_EQ(m(c * kPlane + y * kW + x, j), static_cast<float>(byte) / 255.0f)
+              << "shift (" << dy[static_cast<size_t>(j)] << ", " << dx[static_cast<size_t>(j)]
+              << ") at (" << c << ", " << y << ", " << x << ")";
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rl::nn
