@@ -72,8 +72,8 @@ TEST_F(FrameGridTest, LaysOutOneRowPerEpisodeWithTheNetworksInputFrames) {
   int bright = 0;
   for (int r = 0; r < 10; ++r) {
     for (int c = 0; c < 5; ++c) {
-      const cv::Vec3b px = page.at<cv::Vec3b>(y0 + static_cast<int>((r + 0.5) * block),
-                                              x0 + static_cast<int>((c + 0.5) * block));
+      const cv::Vec3b& px = page.at<cv::Vec3b>(y0 + static_cast<int>((r + 0.5) * block),
+                                               x0 + static_cast<int>((c + 0.5) * block));
       const uint8_t expected = frame[static_cast<size_t>(r) * 5 + c];
       EXPECT_EQ(px[0], expected) << "row " << r << " col " << c;
       EXPECT_EQ(px[1], expected);
