@@ -79,11 +79,11 @@ EnvSpec PixelSpec(const EnvSpec& inner, const ImagePipelineConfig& config) {
 EnvSpec LookupSpec(const std::string& id) {
   const EnvIdParts parts = ParseEnvId(id);
   if (parts.pixels) return PixelSpec(LookupSpec(parts.base), parts.image);
-  std::string known;
   for (const EnvSpec& spec : ListedSpecs()) {
     if (spec.id == id) return spec;
-    known += (known.empty() ? "" : ", ") + spec.id;
   }
+  std::string known;
+  for (const EnvSpec& spec : ListedSpecs()) known += (known.empty() ? "" : ", ") + spec.id;
   throw std::invalid_argument("unknown environment id \"" + id + "\"; known ids: " + known);
 }
 
