@@ -123,12 +123,12 @@ bool ParseOptions(int argc, char** argv, const std::string& role, const std::str
   return true;
 }
 
-void RefuseGiven(const po::variables_map& vm, std::initializer_list<const char*> names,
+void RefuseGiven(const po::variables_map& vm, const std::vector<std::string>& names,
                  const std::string& why) {
-  for (const char* name : names) {
+  for (const std::string& name : names) {
     auto it = vm.find(name);
     if (it != vm.end() && !it->second.defaulted()) {
-      throw std::runtime_error(std::string("option --") + name + " does not apply: " + why);
+      throw std::runtime_error("option --" + name + " does not apply: " + why);
     }
   }
 }

@@ -11,8 +11,8 @@
 #include <boost/program_options.hpp>
 
 #include <cstdint>
-#include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "common/lcm_bus.h"
 
@@ -54,7 +54,7 @@ bool ParseOptions(int argc, char** argv, const std::string& role, const std::str
 /// Throws std::runtime_error("option --NAME does not apply: <why>") for the first of `names`
 /// that was given (on the command line or in the config file) rather than left at its default:
 /// options of the algorithm or exploration a run did not choose are refused, not ignored.
-void RefuseGiven(const po::variables_map& vm, std::initializer_list<const char*> names,
+void RefuseGiven(const po::variables_map& vm, const std::vector<std::string>& names,
                  const std::string& why);
 
 // Runs body() and turns an exception into "<program>: error: <what>" on stderr and exit code 2.

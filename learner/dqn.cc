@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/options.h"
 #include "learner/algorithm_state.h"
 #include "nn/losses.h"
 #include "nn/pixels.h"
@@ -27,6 +28,35 @@ void DqnConfig::Validate() const {
   if (target_update_period < 1) throw std::invalid_argument("target-update-period must be >= 1");
   if (!(tau > 0 && tau <= 1)) throw std::invalid_argument("tau must be in (0, 1]");
   if (!(max_grad_norm >= 0)) throw std::invalid_argument("max-grad-norm must be >= 0");
+}
+
+void DqnConfig::AddOptions(po::options_description* desc) {
+  desc->add_options()  //
+      ("dueling", po::value(&dueling)->default_value(dueling),
+       "dueling value and advantage streams (1/0; mlp, nature, grasp, grasp48)")               //
+      ("optimizer", po::value(&optimizer)->default_value(optimizer), "adam or rmsprop")        //
+      ("learning-rate", po::value(&learning_rate)->default_value(learning_rate), "step size")  //
+      ("rmsprop-alpha", po::value(&rmsprop_alpha)->default_value(rmsprop_alpha),
+       "RMSProp smoothing constant (DeepMind: 0.95)")  //
+      ("rmsprop-eps", po::value(&rmsprop_eps)->default_value(rmsprop_eps),
+       "RMSProp epsilon (DeepMind: 0.01)")  //
+      ("rmsprop-centered", po::value(&rmsprop_centered)->default_value(rmsprop_centered),
+       "centered RMSProp, as DeepMind's (1/0)")                        //
+      ("loss", po::value(&loss)->default_value(loss), "huber or mse")  //
+      ("double-dqn", po::value(&double_dqn)->default_value(double_dqn),
+       "Double DQN targets (1/0)")  //
+      ("target-update-period",
+       po::value(&target_update_period)->default_value(target_update_period),
+       "updates between target network refreshes");
+}
+
+std::unique_ptr<Algorithm> DqnConfig::Make(const envs::EnvSpec& spec) const {
+  if (spec.continuous()) {
+    throw std::invalid_argument(spec.id +
+                                " has continuous actions; DQN needs discrete ones (use "
+                                "algorithm = td3)");
+  }
+  return std::make_unique<Dqn>(spec.observation_size, spec.num_actions, *this);
 }
 
 std::string QNetworkArchitecture(const DqnConfig& config, int obs_size, int num_actions) {

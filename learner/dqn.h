@@ -12,13 +12,23 @@
 #include <string>
 #include <vector>
 
+#include "envs/env.h"
 #include "learner/algorithm.h"
 #include "nn/optimizers.h"
 #include "nn/sequential.h"
 
+namespace boost::program_options {
+class options_description;
+}  // namespace boost::program_options
+
 namespace rl::learner {
 
 struct DqnConfig {
+  static constexpr const char* kName = "dqn";
+  static constexpr const char* kSummary =
+      "for discrete actions (Mnih et al. 2015, with Double DQN, dueling, n-step and prioritized "
+      "replay)";
+
   // The Q network: "mlp" (widths in `hidden`), "nature" (Mnih et al. 2015, 4 x 84 x 84 input),
   // "grasp" (stacks of 40 x 40 frames), or an architecture string as nn::BuildFromArchitecture
   // reads it ("conv2d(2,16,3,1,0,10,5),relu,flatten,...").
@@ -41,6 +51,10 @@ struct DqnConfig {
 
   // Throws std::invalid_argument naming the bad field.
   void Validate() const;
+  // Adds the options only dqn has, bound to these fields (learner/algorithms.h).
+  void AddOptions(boost::program_options::options_description* desc);
+  // The algorithm for `spec`. Throws std::invalid_argument when the env's actions do not fit.
+  std::unique_ptr<Algorithm> Make(const envs::EnvSpec& spec) const;
 };
 
 // The architecture string DqnConfig describes, for observations of obs_size values. Throws

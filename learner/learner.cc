@@ -24,21 +24,16 @@
 namespace rl::learner {
 namespace {
 
+// The chosen algorithm (Validate() has checked its name), in the learner's precision.
 std::unique_ptr<Algorithm> MakeAlgorithm(const LearnerConfig& c, const envs::EnvSpec& spec) {
-  const nn::Precision precision = nn::ParsePrecision(c.precision);
-  if (c.algorithm == "td3") {
-    Td3Config td3 = c.td3;
-    td3.precision = precision;
-    return std::make_unique<Td3>(spec, td3);
-  }
-  if (spec.continuous()) {
-    throw std::invalid_argument(spec.id +
-                                " has continuous actions; DQN needs discrete ones (use "
-                                "algorithm = td3)");
-  }
-  DqnConfig dqn = c.dqn;
-  dqn.precision = precision;
-  return std::make_unique<Dqn>(spec.observation_size, spec.num_actions, dqn);
+  std::unique_ptr<Algorithm> made;
+  ForEachAlgorithm(c.algorithms, [&](const auto& config) {
+    if (c.algorithm != config.kName) return;
+    auto chosen = config;
+    chosen.precision = nn::ParsePrecision(c.precision);
+    made = chosen.Make(spec);
+  });
+  return made;
 }
 
 // The checkpoint files ("ckpt-<update>.bin") in `dir`, by update, oldest first: what earlier
@@ -70,11 +65,16 @@ std::deque<std::string> CheckpointFiles(const std::filesystem::path& dir) {
 }  // namespace
 
 void LearnerConfig::Validate() const {
-  if (algorithm != "dqn" && algorithm != "td3") {
-    throw std::invalid_argument("algorithm must be dqn or td3, not '" + algorithm + "'");
+  bool known = false;
+  ForEachAlgorithm(algorithms, [&](const auto& config) {
+    if (algorithm != config.kName) return;
+    known = true;
+    config.Validate();
+  });
+  if (!known) {
+    throw std::invalid_argument("algorithm must be one of " + AlgorithmNames() + ", not '" +
+                                algorithm + "'");
   }
-  if (algorithm == "dqn") dqn.Validate();
-  if (algorithm == "td3") td3.Validate();
   if (augment_shift < 0) throw std::invalid_argument("augment-shift must be >= 0");
   if (batch_size < 1 || batch_size > 65536) throw std::invalid_argument("batch-size in [1, 65536]");
   if (requests_in_flight < 1) throw std::invalid_argument("requests-in-flight must be >= 1");

@@ -13,14 +13,14 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <tuple>
 
 #include "common/clock.h"
 #include "common/lcm_bus.h"
 #include "envs/env.h"
 #include "learner/algorithm.h"
+#include "learner/algorithms.h"
 #include "learner/batch_decoder.h"
-#include "learner/dqn.h"
-#include "learner/td3.h"
 #include "learner/weights_publisher.h"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
@@ -29,9 +29,8 @@ namespace rl::learner {
 
 struct LearnerConfig {
   std::string env_id = "CartPole-v1";  // environment (gives the network's input and output sizes)
-  std::string algorithm = "dqn";       // "dqn" (discrete actions) or "td3" (continuous)
-  DqnConfig dqn;                       // algorithm = dqn
-  Td3Config td3;                       // algorithm = td3
+  std::string algorithm = "dqn";       // the chosen algorithm's kName (learner/algorithms.h)
+  AlgorithmConfigs algorithms;         // every algorithm's settings; the chosen one's are used
   // Pixel envs: shift every sampled observation by a random offset of up to this many pixels
   // (DrQ's random shift, Kostrikov et al. 2020; they use 4 on 84 x 84 frames). 0: none.
   int augment_shift = 0;
@@ -55,6 +54,15 @@ struct LearnerConfig {
   double stats_hz = 4.0;    // stats messages per second
 
   void Validate() const;
+
+  template <class Config>
+  Config& Get() {
+    return std::get<Config>(algorithms);
+  }
+  template <class Config>
+  const Config& Get() const {
+    return std::get<Config>(algorithms);
+  }
 };
 
 class Learner {

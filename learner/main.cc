@@ -1,8 +1,10 @@
 // The learner process: see learner/learner.h and learner/README.md.
 #include <cstdio>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/options.h"
 #include "common/shutdown.h"
@@ -31,13 +33,16 @@ std::vector<int> ParseWidths(const std::string& text) {
 int Main(int argc, char** argv) {
   rl::CommonOptions common;
   rl::learner::LearnerConfig c;
-  rl::learner::DqnConfig& d = c.dqn;
-  rl::learner::Td3Config& t = c.td3;
-  // Options both algorithms have but with different defaults are left without one here and set
-  // on the chosen algorithm's config only when given.
+  // Settings every algorithm has but with defaults of its own are left without one here and set
+  // on the chosen algorithm's config only when given (learner/algorithms.h).
   std::string network, hidden;
   float tau = 0, adam_eps = 0, max_grad_norm = 0;
   uint64_t seed = 0;
+  std::string algorithms;  // the --algorithm help: a sentence per algorithm
+  rl::learner::ForEachAlgorithm(c.algorithms, [&](const auto& config) {
+    algorithms +=
+        (algorithms.empty() ? "" : ". ") + std::string(config.kName) + ": " + config.kSummary;
+  });
   rl::po::options_description desc("Options");
   rl::AddCommonOptions(&desc, &common);
   desc.add_options()                                                                //
@@ -45,8 +50,7 @@ int Main(int argc, char** argv) {
       ("out", rl::po::value(&c.out_dir)->default_value(c.out_dir),
        "run folder; checkpoints go to <out>/checkpoints")  //
       ("algorithm", rl::po::value(&c.algorithm)->default_value(c.algorithm),
-       "dqn (discrete actions: Double DQN, dueling, n-step, prioritized) or td3 (continuous "
-       "actions: Fujimoto et al. 2018)")  //
+       algorithms.c_str())  //
       ("network", rl::po::value(&network),
        "dqn: the Q network, mlp (default), nature (Mnih et al. 2015, 4x84x84 frames), grasp "
        "(stacks of 40x40 frames), grasp48 (stacks of 48x48 frames) or an architecture string; "
@@ -70,39 +74,6 @@ int Main(int argc, char** argv) {
       ("augment-shift", rl::po::value(&c.augment_shift)->default_value(c.augment_shift),
        "pixel envs: shift every sampled observation by a random offset of up to this many "
        "pixels, edges repeated (DrQ, Kostrikov et al. 2020); 0: none")  //
-      // DQN only.
-      ("dueling", rl::po::value(&d.dueling)->default_value(d.dueling),
-       "dqn: dueling value and advantage streams (1/0; mlp, nature, grasp, grasp48)")  //
-      ("optimizer", rl::po::value(&d.optimizer)->default_value(d.optimizer),
-       "dqn: adam or rmsprop")  //
-      ("learning-rate", rl::po::value(&d.learning_rate)->default_value(d.learning_rate),
-       "dqn: step size")  //
-      ("rmsprop-alpha", rl::po::value(&d.rmsprop_alpha)->default_value(d.rmsprop_alpha),
-       "dqn: RMSProp smoothing constant (DeepMind: 0.95)")  //
-      ("rmsprop-eps", rl::po::value(&d.rmsprop_eps)->default_value(d.rmsprop_eps),
-       "dqn: RMSProp epsilon (DeepMind: 0.01)")  //
-      ("rmsprop-centered", rl::po::value(&d.rmsprop_centered)->default_value(d.rmsprop_centered),
-       "dqn: centered RMSProp, as DeepMind's (1/0)")                                //
-      ("loss", rl::po::value(&d.loss)->default_value(d.loss), "dqn: huber or mse")  //
-      ("double-dqn", rl::po::value(&d.double_dqn)->default_value(d.double_dqn),
-       "dqn: Double DQN targets (1/0)")  //
-      ("target-update-period",
-       rl::po::value(&d.target_update_period)->default_value(d.target_update_period),
-       "dqn: updates between target network refreshes")  //
-      // TD3 only.
-      ("actor-learning-rate",
-       rl::po::value(&t.actor_learning_rate)->default_value(t.actor_learning_rate),
-       "td3: the actor's Adam step size")  //
-      ("critic-learning-rate",
-       rl::po::value(&t.critic_learning_rate)->default_value(t.critic_learning_rate),
-       "td3: the critics' Adam step size")  //
-      ("policy-delay", rl::po::value(&t.policy_delay)->default_value(t.policy_delay),
-       "td3: critic updates per actor and target update")  //
-      ("target-noise", rl::po::value(&t.target_noise)->default_value(t.target_noise),
-       "td3: target policy smoothing noise, relative to each action dimension's half-range")  //
-      ("target-noise-clip", rl::po::value(&t.target_noise_clip)->default_value(t.target_noise_clip),
-       "td3: clip of that noise, relative to the half-range")  //
-      // Both.
       ("requests-in-flight",
        rl::po::value(&c.requests_in_flight)->default_value(c.requests_in_flight),
        "sample requests outstanding at once")  //
@@ -131,6 +102,16 @@ int Main(int argc, char** argv) {
        "stop after this many updates (0: until stopped)")  //
       ("stats-hz", rl::po::value(&c.stats_hz)->default_value(c.stats_hz),
        "stats messages per second");
+  // Each algorithm's own options, in a section of the help of their own.
+  std::map<std::string, std::vector<std::string>> own_options;
+  rl::learner::ForEachAlgorithm(c.algorithms, [&](auto& config) {
+    rl::po::options_description own(std::string("Options of ") + config.kName);
+    config.AddOptions(&own);
+    for (const auto& option : own.options()) {
+      own_options[config.kName].push_back(option->long_name());
+    }
+    desc.add(own);
+  });
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "learner",
                         "Usage: learner [options]\n"
@@ -139,29 +120,25 @@ int Main(int argc, char** argv) {
                         desc, &vm)) {
     return 0;
   }
-  if (c.algorithm == "td3") {
-    rl::RefuseGiven(vm,
-                    {"dueling", "optimizer", "learning-rate", "rmsprop-alpha", "rmsprop-eps",
-                     "rmsprop-centered", "loss", "double-dqn", "target-update-period"},
-                    "algorithm is td3, and it is a dqn option");
-    if (vm.count("network")) t.network = network;
-    if (vm.count("hidden")) t.hidden = ParseWidths(hidden);
-    if (vm.count("tau")) t.tau = tau;
-    if (vm.count("adam-eps")) t.adam_eps = adam_eps;
-    if (vm.count("max-grad-norm")) t.max_grad_norm = max_grad_norm;
-    t.seed = seed;
-  } else {
-    rl::RefuseGiven(vm,
-                    {"actor-learning-rate", "critic-learning-rate", "policy-delay", "target-noise",
-                     "target-noise-clip"},
-                    "algorithm is " + c.algorithm + ", and it is a td3 option");
-    if (vm.count("network")) d.network = network;
-    if (vm.count("hidden")) d.hidden = ParseWidths(hidden);
-    if (vm.count("tau")) d.tau = tau;
-    if (vm.count("adam-eps")) d.adam_eps = adam_eps;
-    if (vm.count("max-grad-norm")) d.max_grad_norm = max_grad_norm;
-    d.seed = seed;
+  if (!own_options.contains(c.algorithm)) {
+    throw std::invalid_argument("algorithm must be one of " + rl::learner::AlgorithmNames() +
+                                ", not '" + c.algorithm + "'");
   }
+  for (const auto& [name, options] : own_options) {
+    if (name != c.algorithm) {
+      rl::RefuseGiven(vm, options,
+                      "algorithm is " + c.algorithm + ", and it is an option of " + name);
+    }
+  }
+  rl::learner::ForEachAlgorithm(c.algorithms, [&](auto& config) {
+    if (c.algorithm != config.kName) return;
+    if (vm.count("network")) config.network = network;
+    if (vm.count("hidden")) config.hidden = ParseWidths(hidden);
+    if (vm.count("tau")) config.tau = tau;
+    if (vm.count("adam-eps")) config.adam_eps = adam_eps;
+    if (vm.count("max-grad-norm")) config.max_grad_norm = max_grad_norm;
+    config.seed = seed;
+  });
   c.seed = seed;
   // The kernels the networks will run on (throws, naming the reason, when RL_KERNELS asks for a
   // path this CPU cannot run).

@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/options.h"
 #include "learner/algorithm_state.h"
 #include "nn/losses.h"
 #include "nn/presets.h"
@@ -51,6 +52,25 @@ void Td3Config::Validate() const {
     throw std::invalid_argument("target-noise-clip must be >= 0");
   }
   if (!(max_grad_norm >= 0)) throw std::invalid_argument("max-grad-norm must be >= 0");
+}
+
+void Td3Config::AddOptions(po::options_description* desc) {
+  desc->add_options()  //
+      ("actor-learning-rate", po::value(&actor_learning_rate)->default_value(actor_learning_rate),
+       "the actor's Adam step size")  //
+      ("critic-learning-rate",
+       po::value(&critic_learning_rate)->default_value(critic_learning_rate),
+       "the critics' Adam step size")  //
+      ("policy-delay", po::value(&policy_delay)->default_value(policy_delay),
+       "critic updates per actor and target update")  //
+      ("target-noise", po::value(&target_noise)->default_value(target_noise),
+       "target policy smoothing noise, relative to each action dimension's half-range")  //
+      ("target-noise-clip", po::value(&target_noise_clip)->default_value(target_noise_clip),
+       "clip of that noise, relative to the half-range");
+}
+
+std::unique_ptr<Algorithm> Td3Config::Make(const envs::EnvSpec& spec) const {
+  return std::make_unique<Td3>(spec, *this);
 }
 
 namespace {

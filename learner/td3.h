@@ -33,9 +33,17 @@
 #include "nn/optimizers.h"
 #include "nn/sequential.h"
 
+namespace boost::program_options {
+class options_description;
+}  // namespace boost::program_options
+
 namespace rl::learner {
 
 struct Td3Config {
+  static constexpr const char* kName = "td3";
+  static constexpr const char* kSummary =
+      "for continuous actions (Twin Delayed DDPG, Fujimoto et al. 2018)";
+
   // The networks: "mlp" (actor obs -> hidden... -> action, critics [obs, action] -> hidden... ->
   // 1; the author's 256-256), "car" (the TD3 CarRacing article's networks on 4 x 84 x 84 stacks:
   // a CNN encoder of its own in the actor and in each critic) or "drq" (the article's encoder,
@@ -55,6 +63,10 @@ struct Td3Config {
 
   // Throws std::invalid_argument naming the bad field.
   void Validate() const;
+  // Adds the options only td3 has, bound to these fields (learner/algorithms.h).
+  void AddOptions(boost::program_options::options_description* desc);
+  // The algorithm for `spec`. Throws std::invalid_argument when the env's actions do not fit.
+  std::unique_ptr<Algorithm> Make(const envs::EnvSpec& spec) const;
 };
 
 /// The actor's architecture string for `spec` (nn::BuildFromArchitecture), and the critics'

@@ -3,7 +3,7 @@
 # folder. Numbers that are none or out of range, a run folder in a place that cannot hold one,
 # and presets with a misspelled section or key; every preset of the checkout passes the same
 # checks. And a preset's inline '# comment' after actors or goal is no part of the value (the
-# processes read it so too).
+# processes read it so too). The learner's command line follows its list of algorithms.
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
@@ -58,6 +58,33 @@ for ini in "$root"/configs/*.ini; do
 done
 [ ! -e "$dir/dry" ] || fail "a dry run made its run folder"
 
+# The learner's options come from its list of algorithms (learner/algorithms.h): each has a
+# section of the help, an unknown one is refused naming the known ones, and an option of an
+# algorithm the run did not choose is refused, not ignored (exit 2, one line, before any bus).
+learner_refuses() {  # learner_refuses PATTERN ARGS...
+  local pattern=$1 status
+  shift
+  set +e
+  timeout 20 "$build_dir/bin/learner" "$@" > "$dir/learner.log" 2>&1
+  status=$?
+  set -e
+  echo "learner $* -> $status: $(cat "$dir/learner.log")"
+  [ "$status" -eq 2 ] || fail "learner $* exited with $status, not 2"
+  grep -q -- "$pattern" "$dir/learner.log" || fail "learner $* did not say '$pattern'"
+  [ "$(wc -l < "$dir/learner.log")" -eq 1 ] || fail "learner $* said more than one line"
+}
+learner_refuses "^learner: error: algorithm must be one of dqn, td3, not 'sac'$" --algorithm sac
+learner_refuses "^learner: error: option --learning-rate does not apply: algorithm is td3, and it is an option of dqn$" \
+  --algorithm td3 --learning-rate 0.01
+learner_refuses "^learner: error: option --policy-delay does not apply: algorithm is dqn, and it is an option of td3$" \
+  --policy-delay 3
+"$build_dir/bin/learner" --help > "$dir/learner-help.log"
+for section in "Options of dqn" "Options of td3"; do
+  grep -q "^$section" "$dir/learner-help.log" || fail "the learner's help has no '$section'"
+done
+grep -q "^  --algorithm .*dqn: for discrete" "$dir/learner-help.log" ||
+  fail "the learner's help does not list dqn under --algorithm"
+
 # Inline comments after actors and goal: the run starts with 1 actor and the goal 1000000.
 sed -e 's/^\[actor\]$/actors = 1   # one actor\n[actor]/' \
     -e 's/^goal = 475$/goal = 1000000  # out of reach/' "$root/configs/cartpole.ini" > "$dir/root/configs/commented.ini"
@@ -73,4 +100,4 @@ grep -q '^# actors = 1 (of 1), seed = 1, goal = 1000000, ' "$dir/commented/confi
   fail "the run did not read actors and goal: $(grep '^# actors' "$dir/commented/config.ini")"
 grep -q "goal of 1000000 not reached" "$dir/commented.log" || fail "no goal line"
 expect_no_restarts "$dir/commented"
-echo "PASS: bad launch input refused before anything started; inline comments read as the processes do"
+echo "PASS: bad launch input refused before anything started; inline comments read as the processes do; the learner's options follow its algorithms"

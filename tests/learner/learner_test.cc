@@ -50,7 +50,7 @@ class LearnerTest : public ::testing::Test {
     LearnerConfig c = ShortRun(batch_size, max_updates, checkpoint_every);
     c.env_id = "Pendulum-v1";
     c.algorithm = "td3";
-    c.td3.hidden = {16, 16};
+    c.Get<Td3Config>().hidden = {16, 16};
     return c;
   }
 
@@ -205,7 +205,7 @@ TEST_F(LearnerTest, TrainsOnPixelBatchesAndSendsTheirTdErrorsAsPriorities) {
       [&updates](const rlmsg::priority_update_t& m) { updates.push_back(m); });
   LearnerConfig c = ShortRun(16, 20, 100);
   c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)";
-  c.dqn.network = "conv2d(2,4,3,1,1,10,5),relu,flatten,linear(200,3)";
+  c.Get<DqnConfig>().network = "conv2d(2,4,3,1,1,10,5),relu,flatten,linear(200,3)";
   // Random shifts need the frame size, which comes from the env's static spec.
   c.augment_shift = 2;
   c.prioritized = true;
@@ -237,7 +237,7 @@ TEST_F(LearnerTest, TrainsOnTwoComputeThreads) {
   LearnerConfig c = ShortRun(256, 5, 100);
   c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)";
   // 256 x 64 x 2 x 9 x 50 = 14.7M multiply-adds per convolution: enough to be split.
-  c.dqn.network = "conv2d(2,64,3,1,1,10,5),relu,flatten,linear(3200,3)";
+  c.Get<DqnConfig>().network = "conv2d(2,64,3,1,1,10,5),relu,flatten,linear(3200,3)";
   c.threads = 2;
   const int64_t sections = nn::internal::ParallelSections();
   {
