@@ -10,6 +10,7 @@
 #include "common/check.h"
 #include "envs/env_list.h"
 #include "envs/raster.h"
+#include "envs/render_args.h"
 #include "envs/rng.h"
 #include "envs/specs.h"
 
@@ -110,19 +111,11 @@ void CartPole::UpdateObservation() {
 }
 
 void CartPole::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
-  RL_CHECK(width != nullptr && height != nullptr) << "Render needs width and height outputs";
-  RenderSized(kScreenWidth, kScreenHeight, rgb);
-  *width = kScreenWidth;
-  *height = kScreenHeight;
+  RenderNative(*this, kScreenWidth, kScreenHeight, rgb, width, height);
 }
 
 void CartPole::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
-  RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
-  if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("CartPole: render size must be positive, got " +
-                                std::to_string(width) + "x" + std::to_string(height));
-  }
-  if (!started()) throw std::logic_error("CartPole: call Reset() before Render()");
+  CheckRenderArgs(*this, "CartPole", width, height, rgb);
 
   // The reference draws on a y-up 600x400 surface and flips it; map that surface to the output
   // image (y down), scaling each axis.

@@ -8,6 +8,7 @@
 #include "common/check.h"
 #include "envs/env_list.h"
 #include "envs/raster.h"
+#include "envs/render_args.h"
 #include "envs/rng.h"
 #include "envs/specs.h"
 
@@ -74,19 +75,11 @@ void Catch::UpdateObservation() {
 }
 
 void Catch::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
-  RL_CHECK(width != nullptr && height != nullptr) << "Render needs width and height outputs";
-  RenderSized(kScreenWidth, kScreenHeight, rgb);
-  *width = kScreenWidth;
-  *height = kScreenHeight;
+  RenderNative(*this, kScreenWidth, kScreenHeight, rgb, width, height);
 }
 
 void Catch::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
-  RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
-  if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("Catch: render size must be positive, got " +
-                                std::to_string(width) + "x" + std::to_string(height));
-  }
-  if (!started()) throw std::logic_error("Catch: call Reset() before Render()");
+  CheckRenderArgs(*this, "Catch", width, height, rgb);
 
   // Black board with the ball's and the paddle's cells in white.
   Canvas canvas(width, height, rgb);

@@ -10,6 +10,7 @@
 #include "common/check.h"
 #include "envs/env_list.h"
 #include "envs/raster.h"
+#include "envs/render_args.h"
 #include "envs/rng.h"
 #include "envs/specs.h"
 
@@ -105,19 +106,11 @@ StepResult Pendulum::OnStep(std::span<const float> action) {
 }
 
 void Pendulum::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
-  RL_CHECK(width != nullptr && height != nullptr) << "Render needs width and height outputs";
-  RenderSized(kScreenSize, kScreenSize, rgb);
-  *width = kScreenSize;
-  *height = kScreenSize;
+  RenderNative(*this, kScreenSize, kScreenSize, rgb, width, height);
 }
 
 void Pendulum::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
-  RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
-  if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("Pendulum: render size must be positive, got " +
-                                std::to_string(width) + "x" + std::to_string(height));
-  }
-  if (!started()) throw std::logic_error("Pendulum: call Reset() before Render()");
+  CheckRenderArgs(*this, "Pendulum", width, height, rgb);
 
   // The reference draws on a 500 x 500 surface and flips it vertically; map that surface (taken
   // as y up) to the output image (y down), scaling each axis. Its shapes have integer pixel

@@ -27,6 +27,7 @@
 
 #include "common/check.h"
 #include "envs/env_list.h"
+#include "envs/render_args.h"
 #include "envs/specs.h"
 
 namespace rl::envs {
@@ -527,11 +528,7 @@ int CarRacing::SupersampleFor(int width, int height) const {
 
 void CarRacing::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
   RequireReset("RenderSized");
-  RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
-  if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("CarRacing: render size must be positive, got " +
-                                std::to_string(width) + "x" + std::to_string(height));
-  }
+  CheckRenderArgs(*this, "CarRacing", width, height, rgb);
   UpdateScene();
   DrawCarRacing(scene_, width, height, SupersampleFor(width, height), rgb);
 }

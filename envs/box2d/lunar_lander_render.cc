@@ -12,6 +12,7 @@
 #include "common/check.h"
 #include "envs/box2d/lunar_lander.h"
 #include "envs/raster.h"
+#include "envs/render_args.h"
 
 namespace rl::envs {
 namespace {
@@ -46,19 +47,11 @@ int FirstCentreAtOrAfter(double v) { return static_cast<int>(std::ceil(v - 0.5))
 }  // namespace
 
 void LunarLander::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
-  RL_CHECK(width != nullptr && height != nullptr) << "Render needs width and height outputs";
-  RenderSized(kViewportW, kViewportH, rgb);
-  *width = kViewportW;
-  *height = kViewportH;
+  RenderNative(*this, kViewportW, kViewportH, rgb, width, height);
 }
 
 void LunarLander::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
-  RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
-  if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("LunarLander: render size must be positive, got " +
-                                std::to_string(width) + "x" + std::to_string(height));
-  }
-  RequireReset("Render()");
+  CheckRenderArgs(*this, "LunarLander", width, height, rgb);
 
   // The reference draws on a y-up 600x400 surface (world metres times kScale) and flips it; map
   // that surface to the output image (y down), scaling each axis.

@@ -11,6 +11,7 @@
 #include "envs/env_list.h"
 #include "envs/kuka/kuka_kinematics.h"
 #include "envs/kuka/kuka_renderer.h"
+#include "envs/render_args.h"
 #include "envs/rng.h"
 #include "envs/specs.h"
 
@@ -224,19 +225,11 @@ void KukaDiverseObjectEnv::UpdateObservation() {
 }
 
 void KukaDiverseObjectEnv::Render(std::vector<uint8_t>* rgb, int* width, int* height) const {
-  RL_CHECK(width != nullptr && height != nullptr) << "Render needs width and height outputs";
-  RenderSized(config_.width, config_.height, rgb);
-  *width = config_.width;
-  *height = config_.height;
+  RenderNative(*this, config_.width, config_.height, rgb, width, height);
 }
 
 void KukaDiverseObjectEnv::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
-  RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
-  if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("RenderSized: width and height must be positive, got " +
-                                std::to_string(width) + "x" + std::to_string(height));
-  }
-  if (!started()) throw std::logic_error("KukaDiverseObjectEnv::Render before Reset");
+  CheckRenderArgs(*this, "KukaDiverseObjectEnv", width, height, rgb);
   if (!renderer_) renderer_ = std::make_unique<kuka::KukaRenderer>();
   scene_->CollectDrawItems(&draw_items_);
   renderer_->Render(camera_, draw_items_, width, height, rgb);
