@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "nn/gemm.h"
 #include "nn/kernels.h"
 #include "nn/layer.h"
 #include "nn/precision.h"
@@ -91,8 +92,8 @@ class Conv2d : public Layer {
     Vector group_out;   // (group * P) x out_channels: a product before it is scattered.
     Vector dcols;       // Gradient of cols, after dcols_front_ floats of slack.
     std::vector<internal::GradientRun> runs;  // (kernel / stride, rounded up)^2 entries.
-    Vector channel_grad;  // The gradient of the stride^2 phase planes of one channel.
-    Vector workspace;     // Scratch space of the product kernel.
+    Vector channel_grad;                // The gradient of the stride^2 phase planes of one channel.
+    internal::GemmWorkspace workspace;  // Scratch space of the products.
     // Tasks after the first: the parameter gradients of their samples, added to weight_grad_ and
     // bias_grad_ (in task order) once all tasks are done. The first task adds into those directly.
     Matrix weight_grad;
@@ -147,11 +148,11 @@ class Conv2d : public Layer {
   Matrix bias_;    // out_channels x 1.
   Matrix weight_grad_;
   Matrix bias_grad_;
-  Matrix output_;                  // out_.size() x batch.
-  Matrix grad_input_;              // in_.size() x batch.
-  const Matrix* input_ = nullptr;  // The x of the last Forward().
-  std::vector<Scratch> scratch_;   // One per task; one until threads are used.
-  Vector workspace_;               // Scratch space of the product kernel in the dense case.
+  Matrix output_;                      // out_.size() x batch.
+  Matrix grad_input_;                  // in_.size() x batch.
+  const Matrix* input_ = nullptr;      // The x of the last Forward().
+  std::vector<Scratch> scratch_;       // One per task; one until threads are used.
+  internal::GemmWorkspace workspace_;  // Scratch space of the products in the dense case.
   bool fused_output_relu_ = false;
   bool fused_input_relu_grad_ = false;
 };

@@ -33,8 +33,8 @@ Epilogue ShiftEpilogue(Epilogue e, const MutView& c, int i0, int j0) {
 // a product of a shape has run, the next one of that shape allocates nothing however the threads
 // share the tasks (buffers per running thread would grow again whenever a thread first ran a
 // task of a larger block).
-std::vector<Vector>* CallerTaskWorkspaces() {
-  thread_local std::vector<Vector> workspaces;
+std::vector<GemmWorkspace>* CallerTaskWorkspaces() {
+  thread_local std::vector<GemmWorkspace> workspaces;
   return &workspaces;
 }
 
@@ -60,20 +60,20 @@ Product ProductFor(const KernelSet& set, Precision precision) {
 // same panels and the same order of operations per element as the whole product, so the results
 // do not depend on the split. A single piece runs directly with `workspace`.
 template <class F>
-void SplitResult(const Product& kernel, int m, int n, int64_t work, Vector* workspace,
+void SplitResult(const Product& kernel, int m, int n, int64_t work, GemmWorkspace* workspace,
                  const F& piece) {
   const int full_panels = m / kernel.panel_rows;
   const bool by_rows = full_panels >= 2;
   const int units = by_rows ? full_panels : n / kernel.nr;
   const int tasks = TasksFor(work, units);
-  if (tasks <= 1) return piece(0, m, 0, n, workspace);
-  std::vector<Vector>* task_workspaces = CallerTaskWorkspaces();
+  if (tasks <= 1) return piece(0, m, 0, n, &workspace->kernel);
+  std::vector<GemmWorkspace>* task_workspaces = CallerTaskWorkspaces();
   if (static_cast<int>(task_workspaces->size()) < tasks) task_workspaces->resize(tasks);
   ParallelFor(tasks, [&](int task) {
     const int u0 = units * task / tasks;
     const int u1 = units * (task + 1) / tasks;
     const bool last = task == tasks - 1;
-    Vector* ws = task == 0 ? workspace : &(*task_workspaces)[task];
+    Vector* ws = task == 0 ? &workspace->kernel : &(*task_workspaces)[task].kernel;
     if (by_rows) {
       const int i0 = u0 * kernel.panel_rows;
       piece(i0, (last ? m : u1 * kernel.panel_rows) - i0, 0, n, ws);
@@ -85,16 +85,9 @@ void SplitResult(const Product& kernel, int m, int n, int64_t work, Vector* work
 }
 
 // bf16 without the CPU's instructions: copies of the operands rounded to bfloat16, which the
-// fp32 kernels then multiply. Each copy is column-major; the buffers are the calling thread's.
-struct RoundedCopies {
-  Vector a;
-  Vector b;
-};
-RoundedCopies* EmulationBuffers() {
-  thread_local RoundedCopies buffers;
-  return &buffers;
-}
-
+// fp32 kernels then multiply. Each copy is column-major, in the workspace's rounded_a and
+// rounded_b (not in buffers of the running thread: which thread of the pool runs a task varies,
+// and a thread that first met a larger product after the others would allocate).
 ConstView RoundedCopy(const ConstView& v, Vector* buffer) {
   const int64_t size = static_cast<int64_t>(v.rows) * v.cols;
   if (buffer->size() < size) buffer->resize(size);
@@ -126,16 +119,15 @@ bool PreferGemm(int m, int n, int k) {
 int PackedPanelRows(Precision precision) { return ProductFor(Kernels(), precision).panel_rows; }
 
 void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& epilogue,
-          Vector* workspace, Precision precision) {
+          GemmWorkspace* workspace, Precision precision) {
   RL_CHECK(a.cols == b.rows && a.rows == c.rows && b.cols == c.cols)
       << "Gemm shapes: (" << a.rows << "x" << a.cols << ") * (" << b.rows << "x" << b.cols
       << ") -> (" << c.rows << "x" << c.cols << ")";
   const KernelSet& set = Kernels();
   if (precision == Precision::kBf16 && !Bf16Applies(a, b, c)) precision = Precision::kFp32;
   if (precision == Precision::kBf16 && set.gemm_bf16 == nullptr) {
-    RoundedCopies* copies = EmulationBuffers();
-    return Gemm(RoundedCopy(a, &copies->a), RoundedCopy(b, &copies->b), c, accumulate, epilogue,
-                workspace, Precision::kFp32);
+    return Gemm(RoundedCopy(a, &workspace->rounded_a), RoundedCopy(b, &workspace->rounded_b), c,
+                accumulate, epilogue, workspace, Precision::kFp32);
   }
   const Product kernel = ProductFor(set, precision);
   const int m = c.rows;
@@ -143,7 +135,7 @@ void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& 
   const int k = a.cols;
   // Products with fewer rows than a panel take other paths than the panels; they are not split.
   if (m < kernel.panel_rows || n == 0 || k == 0) {
-    return kernel.gemm(a, b, c, accumulate, epilogue, workspace);
+    return kernel.gemm(a, b, c, accumulate, epilogue, &workspace->kernel);
   }
   SplitResult(kernel, m, n, static_cast<int64_t>(m) * n * k, workspace,
               [&](int i0, int rows, int j0, int cols, Vector* ws) {
@@ -153,7 +145,7 @@ void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& 
 }
 
 void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, bool accumulate,
-                const Epilogue& epilogue, Vector* workspace, Precision precision) {
+                const Epilogue& epilogue, GemmWorkspace* workspace, Precision precision) {
   RL_CHECK(k == b.rows && m == c.rows && b.cols == c.cols)
       << "GemmPacked shapes: (" << m << "x" << k << ") * (" << b.rows << "x" << b.cols << ") -> ("
       << c.rows << "x" << c.cols << ")";
@@ -167,16 +159,16 @@ void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, boo
   }
   if (precision == Precision::kBf16 && set.gemm_bf16 == nullptr) {
     // The packed operand rounded whole (its padding rows too), then the fp32 kernel.
-    RoundedCopies* copies = EmulationBuffers();
+    Vector& rounded_a = workspace->rounded_a;
     const int64_t size =
         static_cast<int64_t>((m + rows_per_panel - 1) / rows_per_panel) * rows_per_panel * k;
-    if (copies->a.size() < size) copies->a.resize(size);
-    std::transform(a_packed, a_packed + size, copies->a.data(), RoundToBf16);
-    return GemmPacked(copies->a.data(), m, k, RoundedCopy(b, &copies->b), c, accumulate, epilogue,
-                      workspace, Precision::kFp32);
+    if (rounded_a.size() < size) rounded_a.resize(size);
+    std::transform(a_packed, a_packed + size, rounded_a.data(), RoundToBf16);
+    return GemmPacked(rounded_a.data(), m, k, RoundedCopy(b, &workspace->rounded_b), c, accumulate,
+                      epilogue, workspace, Precision::kFp32);
   }
   if (m < rows_per_panel) {
-    return kernel.gemm_packed(a_packed, m, k, b, c, accumulate, epilogue, workspace);
+    return kernel.gemm_packed(a_packed, m, k, b, c, accumulate, epilogue, &workspace->kernel);
   }
   // A block of rows starting at i0 (a whole number of panels) starts at panel i0 / R.
   SplitResult(kernel, m, n, static_cast<int64_t>(m) * n * k, workspace,
@@ -193,7 +185,7 @@ int64_t PackedPairs(int m, int k) {
 }
 
 void GemmPackedPairs(const uint32_t* a_pairs, int m, int k, ConstView b, MutView c, bool accumulate,
-                     const Epilogue& epilogue, Vector* workspace) {
+                     const Epilogue& epilogue, GemmWorkspace* workspace) {
   RL_CHECK(k == b.rows && m == c.rows && b.cols == c.cols && k > 0)
       << "GemmPackedPairs shapes: (" << m << "x" << k << ") * (" << b.rows << "x" << b.cols
       << ") -> (" << c.rows << "x" << c.cols << ")";

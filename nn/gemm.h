@@ -69,14 +69,24 @@ struct Epilogue {
 /// (see GemmPacked()).
 int PackedPanelRows(Precision precision);
 
+/// Scratch space of a product: the kernel's (packed panels), and the operands rounded to bfloat16
+/// where the CPU has no bf16 instructions and the products are emulated. It only grows, so
+/// repeated calls with the same shapes and the same workspace do not allocate, whichever thread
+/// runs them.
+struct GemmWorkspace {
+  Vector kernel;
+  Vector rounded_a;
+  Vector rounded_b;
+};
+
 /// c = a * b (accumulate == false) or c += a * b (accumulate == true), followed by `epilogue`,
 /// the products in `precision`. `c` must not overlap `a`, `b` or the mask. `workspace` is scratch
-/// space; it only grows, so repeated calls with the same shapes do not allocate. O(m n k). With
+/// space (GemmWorkspace). O(m n k). With
 /// SetNumThreads(n > 1) (nn/parallel.h) a large product (at least one panel of rows and 8M
 /// multiply-adds) is split into blocks of whole panels of rows (or of columns) over the threads,
 /// with the same result bit for bit; the other threads use their own scratch space.
 void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& epilogue,
-          Vector* workspace, Precision precision = Precision::kFp32);
+          GemmWorkspace* workspace, Precision precision = Precision::kFp32);
 
 /// As Gemm() for an m x k left operand that the caller has already packed (e.g. unfolded into
 /// place by a convolution), in panels of R = PackedPanelRows(precision) rows: rows
@@ -84,7 +94,7 @@ void Gemm(ConstView a, ConstView b, MutView c, bool accumulate, const Epilogue& 
 /// step p is a_packed[q * R * k + p * R + i]). Rows past m in the last panel are read but do not
 /// affect c. O(m n k). Split over threads as Gemm().
 void GemmPacked(const float* a_packed, int m, int k, ConstView b, MutView c, bool accumulate,
-                const Epilogue& epilogue, Vector* workspace,
+                const Epilogue& epilogue, GemmWorkspace* workspace,
                 Precision precision = Precision::kFp32);
 
 /// The layout GemmPackedPairs() reads: the rows of an m x k left operand in panels of
@@ -96,7 +106,7 @@ int64_t PackedPairs(int m, int k);
 /// As GemmPacked() in bf16 for a left operand already rounded and packed as bf16 pairs (e.g.
 /// unfolded so by a convolution). Only where NativeBf16() (nn/precision.h); aborts elsewhere.
 void GemmPackedPairs(const uint32_t* a_pairs, int m, int k, ConstView b, MutView c, bool accumulate,
-                     const Epilogue& epilogue, Vector* workspace);
+                     const Epilogue& epilogue, GemmWorkspace* workspace);
 
 /// out[i] += sum_j g(i, j) for a column-major g (the bias gradient of a batch). O(rows cols).
 void AddRowSums(const Matrix& g, float* out);

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "nn/gemm.h"
 #include "nn/layer.h"
 #include "nn/tensor.h"
 
@@ -61,14 +62,14 @@ class Linear : public Layer {
   // Adds dW and db for `grad_out` and the input of the last Forward().
   void AccumulateParamGrads(const Matrix& grad_out);
 
-  Matrix weight_;                  // out x in
-  Matrix bias_;                    // out x 1
-  Matrix weight_grad_;             // out x in
-  Matrix bias_grad_;               // out x 1
-  Matrix output_;                  // out x batch
-  Matrix grad_input_;              // in x batch
-  const Matrix* input_ = nullptr;  // The x of the last Forward().
-  Vector workspace_;               // Scratch space of the product kernel.
+  Matrix weight_;                      // out x in
+  Matrix bias_;                        // out x 1
+  Matrix weight_grad_;                 // out x in
+  Matrix bias_grad_;                   // out x 1
+  Matrix output_;                      // out x batch
+  Matrix grad_input_;                  // in x batch
+  const Matrix* input_ = nullptr;      // The x of the last Forward().
+  internal::GemmWorkspace workspace_;  // Scratch space of the products.
   bool fused_output_relu_ = false;
   bool fused_input_relu_grad_ = false;
   Precision precision_ = Precision::kFp32;

@@ -3,10 +3,12 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "nn/gemm.h"
 #include "nn/losses.h"
 #include "nn/optimizers.h"
 #include "nn/parallel.h"
@@ -207,6 +209,35 @@ TEST(AllocationTest, Bf16NetworksDoNotAllocateOnEveryPath) {
     }
   }
   SetNumThreads(1);
+  SetKernelPath("auto");
+}
+
+// Emulated bf16 products (a path without bf16 instructions) keep their operands' rounded copies
+// in the workspace, not in buffers of the running thread: with a warm workspace, a thread that
+// never ran a product allocates nothing. (Which of the pool's threads runs a task varies, so a
+// worker may first run one after the warm-up; with per-thread buffers it allocated then.)
+TEST(AllocationTest, EmulatedBf16ProductsAllocateNothingOnAThreadNewToThem) {
+  ASSERT_TRUE(AllocationCountingAvailable()) << "this test needs glibc without a sanitizer";
+  SetKernelPath("avx2");
+  SetNumThreads(1);
+  std::mt19937 rng(0);
+  const Matrix a = RandomMatrix(64, 96, &rng);
+  const Matrix b = RandomMatrix(96, 48, &rng);
+  Matrix c(64, 48);
+  internal::GemmWorkspace workspace;
+  const auto product = [&] {
+    internal::Gemm(internal::View(a), internal::View(b), internal::View(&c), /*accumulate=*/false,
+                   {}, &workspace, Precision::kBf16);
+  };
+  product();  // the warm-up sizes the workspace
+  int64_t allocations = -1;
+  std::thread other([&] {
+    const int64_t before = AllocationCount();
+    product();
+    allocations = AllocationCount() - before;
+  });
+  other.join();
+  EXPECT_EQ(allocations, 0);
   SetKernelPath("auto");
 }
 

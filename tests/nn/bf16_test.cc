@@ -157,7 +157,7 @@ TEST_P(Bf16GemmTest, MatchesTheReferenceOnEveryLayout) {
 TEST_P(Bf16GemmTest, AppliesReluAndMask) {
   for (const auto& [m, n, k] : {std::array<int, 3>{48, 16, 300}, std::array<int, 3>{30, 17, 40}}) {
     std::mt19937 rng(static_cast<unsigned>(m + n + k));
-    Vector workspace;
+    internal::GemmWorkspace workspace;
     const Matrix a = RandomMatrix(m, k, &rng);
     const Matrix b = RandomMatrix(k, n, &rng);
     const Matrix mask = RandomMatrix(m, n, &rng);
@@ -191,7 +191,7 @@ TEST_P(Bf16GemmTest, RoundsItsInputsExactlyAsRoundToBf16) {
   }
   const Matrix identity = Matrix::Identity(size, size);
   const Matrix rounded = RoundedToBf16(values);
-  Vector workspace;
+  internal::GemmWorkspace workspace;
   for (int mode = 0; mode < 4; ++mode) {
     const bool values_left = (mode & 1) != 0;
     const bool transposed = (mode & 2) != 0;
@@ -219,7 +219,7 @@ TEST_P(Bf16GemmTest, PrepackedLeftOperandMatchesTheReference) {
        {std::array<int, 3>{1, 5, 3}, std::array<int, 3>{49, 64, 576},
         std::array<int, 3>{400, 32, 256}, std::array<int, 3>{30, 13, 301}}) {
     std::mt19937 rng(static_cast<unsigned>(m * 31 + n * 7 + k));
-    Vector workspace;
+    internal::GemmWorkspace workspace;
     const Matrix a = RandomMatrix(m, k, &rng);
     const Matrix b = RandomMatrix(k, n, &rng);
     const Matrix col_bias = RandomMatrix(n, 1, &rng);
@@ -250,7 +250,7 @@ TEST_P(Bf16GemmTest, LeftOperandInBf16PairsMatchesTheReference) {
   for (const auto& [m, n, k] : {std::array<int, 3>{1, 5, 3}, std::array<int, 3>{400, 32, 256},
                                 std::array<int, 3>{81, 64, 513}}) {
     std::mt19937 rng(static_cast<unsigned>(m * 31 + n * 7 + k));
-    Vector workspace;
+    internal::GemmWorkspace workspace;
     const Matrix a = RandomMatrix(m, k, &rng);
     const Matrix b = RandomMatrix(k, n, &rng);
     const int rows = internal::PackedPanelRows(Precision::kBf16);
@@ -274,7 +274,7 @@ TEST_P(Bf16GemmTest, LeftOperandInBf16PairsMatchesTheReference) {
 // Products the kernel leaves in fp32 (a few rows): as exact as the fp32 kernel's.
 TEST_P(Bf16GemmTest, SmallProductsStayFp32) {
   std::mt19937 rng(9);
-  Vector workspace;
+  internal::GemmWorkspace workspace;
   const Matrix a = RandomMatrix(3, 200, &rng);
   const Matrix b = RandomMatrix(200, 64, &rng);
   Matrix c(3, 64);

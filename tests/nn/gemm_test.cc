@@ -55,7 +55,7 @@ TEST_P(GemmTest, EpilogueAppliesReluAndMask) {
   for (const auto& [m, n, k] : {std::array<int, 3>{2, 16, 9}, std::array<int, 3>{30, 17, 40},
                                 std::array<int, 3>{5, 40, 7}, std::array<int, 3>{12, 9, 300}}) {
     std::mt19937 rng(static_cast<unsigned>(m + n + k));
-    Vector workspace;
+    GemmWorkspace workspace;
     const Matrix a = RandomMatrix(m, k, &rng);
     const Matrix b = RandomMatrix(k, n, &rng);
     const Matrix bias = RandomMatrix(m, 1, &rng);
@@ -81,7 +81,7 @@ TEST_P(GemmTest, EpilogueAppliesReluAndMask) {
 }
 
 TEST_P(GemmTest, EmptySharedDimensionGivesBiasOrKeepsTheAccumulator) {
-  Vector workspace;
+  GemmWorkspace workspace;
   const Matrix a(3, 0);
   const Matrix b(0, 2);
   Matrix c = Matrix::Constant(3, 2, 7.0f);
@@ -101,7 +101,7 @@ TEST_P(GemmTest, PrepackedLeftOperandMatchesEigen) {
        {std::array<int, 3>{1, 5, 3}, std::array<int, 3>{24, 8, 9}, std::array<int, 3>{49, 64, 576},
         std::array<int, 3>{400, 32, 256}, std::array<int, 3>{30, 13, 300}}) {
     std::mt19937 rng(static_cast<unsigned>(m * 31 + n * 7 + k));
-    Vector workspace;
+    GemmWorkspace workspace;
     const Matrix a = RandomMatrix(m, k, &rng);
     const Matrix b = RandomMatrix(k, n, &rng);
     const Matrix col_bias = RandomMatrix(n, 1, &rng);

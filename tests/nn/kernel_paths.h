@@ -58,8 +58,8 @@ struct GemmOperands {
 /// transposed, the result transposed, accumulation into `start`, the row bias, the column bias),
 /// and in `offset` what the biases and the start add to a * b, in `offset_scale` the sum of
 /// their magnitudes.
-inline Matrix GemmInMode(const GemmOperands& o, int mode, Precision precision, Vector* workspace,
-                         Matrix* offset, Matrix* offset_scale) {
+inline Matrix GemmInMode(const GemmOperands& o, int mode, Precision precision,
+                         internal::GemmWorkspace* workspace, Matrix* offset, Matrix* offset_scale) {
   const bool trans_a = (mode & 1) != 0;
   const bool trans_b = (mode & 2) != 0;
   const bool trans_c = (mode & 4) != 0;
@@ -98,7 +98,7 @@ inline Matrix GemmInMode(const GemmOperands& o, int mode, Precision precision, V
 /// of the 64 ways of calling Gemm() on `o` in `precision`, one workspace shared by all.
 template <typename Check>
 void ForEachGemmMode(const GemmOperands& o, Precision precision, Check&& check) {
-  Vector workspace;
+  internal::GemmWorkspace workspace;
   for (int mode = 0; mode < 64; ++mode) {
     Matrix offset, offset_scale;
     const Matrix got = GemmInMode(o, mode, precision, &workspace, &offset, &offset_scale);

@@ -125,7 +125,7 @@ void CheckGemm(const internal::ConstView& a, const internal::ConstView& b, int m
                bool accumulate, const internal::Epilogue& epilogue, const Matrix& start) {
   ASSERT_GE(static_cast<int64_t>(m) * n * a.cols, 2 * internal::kMinTaskWork)
       << "too small to split";
-  Vector workspace;
+  internal::GemmWorkspace workspace;
   for (Precision precision : {Precision::kFp32, Precision::kBf16}) {
     Matrix want = start;
     internal::Gemm(a, b, internal::View(&want), accumulate, epilogue, &workspace, precision);
@@ -206,7 +206,7 @@ TEST_P(ParallelKernelTest, GemmPackedGivesTheSameBitsWithThreads) {
       internal::Epilogue e;
       e.col_bias = col_bias.data();
       e.relu = true;
-      Vector workspace;
+      internal::GemmWorkspace workspace;
       Matrix want(m, n);
       internal::GemmPacked(packed.data(), m, k, internal::View(b), internal::View(&want), false, e,
                            &workspace, precision);
