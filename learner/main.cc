@@ -107,9 +107,8 @@ int Main(int argc, char** argv) {
   rl::learner::ForEachAlgorithm(c.algorithms, [&](auto& config) {
     rl::po::options_description own(std::string("Options of ") + config.kName);
     config.AddOptions(&own);
-    for (const auto& option : own.options()) {
-      own_options[config.kName].push_back(option->long_name());
-    }
+    std::vector<std::string>& names = own_options[config.kName];  // also for one with none
+    for (const auto& option : own.options()) names.push_back(option->long_name());
     desc.add(own);
   });
   rl::po::variables_map vm;
