@@ -19,7 +19,7 @@ BestMedia::BestMedia(BestMediaConfig config) : config_(std::move(config)) {
 }
 
 void BestMedia::RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path,
-                             const EvalRecord& record) {
+                             const EvalRecord& record, const Tick& tick) {
   if (!(record.mean > best_mean_)) return;
   // One network serves the video and the frame grid.
   nn::Sequential net;
@@ -33,7 +33,7 @@ void BestMedia::RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path
   try {
     const VideoResult v = RecordGreedyVideo(
         &net, config_.env_id, config_.seed_base, config_.video_width, config_.video_height,
-        config_.video_fps, (std::filesystem::path(config_.report_dir) / kBestVideo).string());
+        config_.video_fps, (std::filesystem::path(config_.report_dir) / kBestVideo).string(), tick);
     best_mean_ = record.mean;
     char caption[256];
     std::snprintf(caption, sizeof(caption),
@@ -49,7 +49,7 @@ void BestMedia::RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path
   try {
     const FrameGridResult g = WriteFrameGrid(
         &net, config_.env_id, config_.seed_base, kFrameGridEpisodes, kFrameGridColumns,
-        (std::filesystem::path(config_.report_dir) / kFrameGrid).string());
+        (std::filesystem::path(config_.report_dir) / kFrameGrid).string(), tick);
     char caption[384];
     std::snprintf(caption, sizeof(caption),
                   "%d greedy episodes (epsilon 0, seeds %llu to %llu) of %s (update %lld), one row "

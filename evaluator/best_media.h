@@ -8,6 +8,7 @@
 #include <string>
 
 #include "evaluator/eval_history.h"
+#include "evaluator/progress.h"
 #include "evaluator/report.h"
 #include "nn/checkpoint.h"
 
@@ -30,8 +31,10 @@ class BestMedia {
 
   /// When `record` is better than the best recorded so far, records the video of the checkpoint
   /// `ckpt` (read from `path`) and, for a pixel env, its frame grid. Failures are logged (stderr);
-  /// a checkpoint whose video failed stays a candidate for the next one.
-  void RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path, const EvalRecord& record);
+  /// a checkpoint whose video failed stays a candidate for the next one. `tick` as in progress.h:
+  /// what it throws (Interrupted) propagates, and the media are then left as they were.
+  void RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path, const EvalRecord& record,
+                    const Tick& tick = {});
 
   /// Names the written files and their captions in `info`.
   void AddTo(ReportInfo* info) const;

@@ -41,21 +41,20 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
 
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
                                double epsilon, uint64_t first_seed, double gamma,
-                               const Tick& after_episode) {
+                               const Tick& tick) {
   return ScoreCheckpoint(nn::LoadCheckpoint(path), path, env_id, episodes, epsilon, first_seed,
-                         gamma, after_episode);
+                         gamma, tick);
 }
 
 EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
                            const std::string& env_id, int episodes, double epsilon,
-                           uint64_t first_seed, double gamma, const Tick& after_episode) {
+                           uint64_t first_seed, double gamma, const Tick& tick) {
   const nn::CheckpointMeta& meta = ckpt.meta;
   nn::Sequential net = PolicyNetwork(ckpt, path, env_id);
 
   // Score.
   const double start = MonoSeconds();
-  const EvalScore score =
-      ScorePolicy(&net, env_id, episodes, epsilon, first_seed, gamma, after_episode);
+  const EvalScore score = ScorePolicy(&net, env_id, episodes, epsilon, first_seed, gamma, tick);
   EvalRecord r;
   r.checkpoint = std::filesystem::path(path).filename().string();
   r.update = meta.update;

@@ -282,7 +282,13 @@ bool EvaluatorService::ScorePending() {
   } catch (const std::exception& e) {
     LogError(e.what());
   }
-  if (config_.videos && !report_dir_.empty()) media_.RecordIfBest(ckpt, announced->path, *record);
+  if (config_.videos && !report_dir_.empty()) {
+    try {
+      media_.RecordIfBest(ckpt, announced->path, *record, [this] { Tick(); });
+    } catch (const Interrupted&) {
+      // A stop during the video: the result is still announced and reported, without it.
+    }
+  }
   tsne_.OfferBest(ckpt, announced->path, *record);
   // At the goal the run may end as soon as the result is out: a quick map goes first.
   if (reached && tsne_.due() && tsne_.quick()) MakeTsneMap();

@@ -66,7 +66,8 @@ cv::Mat MakeCell(const envs::Env& env, const std::string& label) {
 }  // namespace
 
 FrameGridResult WriteFrameGrid(nn::Sequential* net, const std::string& env_id, uint64_t seed,
-                               int episodes, int max_columns, const std::string& path) {
+                               int episodes, int max_columns, const std::string& path,
+                               const Tick& tick) {
   if (episodes < 1 || max_columns < 2) {
     throw std::invalid_argument("a frame grid needs at least 1 episode and 2 columns");
   }
@@ -103,6 +104,7 @@ FrameGridResult WriteFrameGrid(nn::Sequential* net, const std::string& env_id, u
       } else if (done) {
         row.back() = MakeCell(*env, label);
       }
+      if (tick) tick();
       if (done) break;
     }
     total_return += episode_return;

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "evaluator/progress.h"
 #include "nn/sequential.h"
 
 namespace rl::evaluator {
@@ -31,7 +32,9 @@ struct FrameGridResult {
 /// network does not fit the env, or episodes or max_columns is below 1 (max_columns below 2);
 /// std::runtime_error when the PNG cannot be encoded or written. Memory: O(episodes x max_columns)
 /// cells of about 25 KB.
+/// `tick` (when set) is called after every step (progress.h).
 FrameGridResult WriteFrameGrid(nn::Sequential* net, const std::string& env_id, uint64_t seed,
-                               int episodes, int max_columns, const std::string& path);
+                               int episodes, int max_columns, const std::string& path,
+                               const Tick& tick = {});
 
 }  // namespace rl::evaluator

@@ -1,5 +1,5 @@
 // What the evaluator's long pieces of work (scoring, the second metric, t-SNE maps) share with the
-// service that runs them: progress lines, and a tick between episodes that keeps the service's
+// service that runs them: progress lines, and a tick after every step that keeps the service's
 // stats flowing and ends the work when a stop is requested.
 #pragma once
 
@@ -13,8 +13,10 @@ namespace rl::evaluator {
 /// Thrown by a Tick when a stop was requested: the work in progress is dropped.
 struct Interrupted {};
 
-/// Called between episodes (and iterations) of long work: publishes the service's stats when
-/// due, and throws Interrupted when a stop was requested. May be empty (no ticks).
+/// Called after every env step (and between iterations) of long work: publishes the service's
+/// stats when due, and throws Interrupted when a stop was requested. May be empty (no ticks).
+/// After every step, not every episode: an evaluator at a low priority on a busy machine can take
+/// longer than the monitor's silence limit over one episode, and would be taken for a dead one.
 using Tick = std::function<void()>;
 
 /// printf-style progress lines to a stream, flushed at once; a null stream drops them.

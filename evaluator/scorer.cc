@@ -124,7 +124,7 @@ std::string CheckNetworkFitsEnv(const nn::Sequential& net, const envs::EnvSpec& 
 }
 
 EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, uint64_t first_seed,
-                double gamma, const std::function<void()>& after_episode) {
+                double gamma, const std::function<void()>& tick) {
   CheckEpisodes(episodes);
   if (!(gamma >= 0.0 && gamma <= 1.0)) {
     throw std::invalid_argument("gamma must be in [0, 1], got " + std::to_string(gamma));
@@ -150,13 +150,13 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
         has_values = true;
         calibration.Step(*value, step.reward);
       }
+      if (tick) tick();
       if (step.terminated || step.truncated) {
         if (has_values) calibration.EndEpisode(step.terminated);
         break;
       }
     }
     returns.push_back(episode_return);
-    if (after_episode) after_episode();
   }
   EvalScore score = Summarize(std::move(returns));
   if (has_values) score.values = calibration.Result();
@@ -164,11 +164,10 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
 }
 
 EvalScore ScorePolicy(nn::Sequential* net, const std::string& env_id, int episodes, double epsilon,
-                      uint64_t first_seed, double gamma,
-                      const std::function<void()>& after_episode) {
+                      uint64_t first_seed, double gamma, const std::function<void()>& tick) {
   std::unique_ptr<actor::Policy> policy =
       EvaluationPolicy(*net, envs::LookupSpec(env_id), epsilon, first_seed);
-  return Score(policy.get(), env_id, episodes, first_seed, gamma, after_episode);
+  return Score(policy.get(), env_id, episodes, first_seed, gamma, tick);
 }
 
 }  // namespace rl::evaluator

@@ -79,18 +79,18 @@ std::unique_ptr<actor::Policy> EvaluationPolicy(const nn::Sequential& net,
 /// gives value estimates (a Q-network), the value of every action taken is compared with the
 /// discounted return (discount `gamma`) that followed it (EvalScore::values). Throws
 /// std::invalid_argument for episodes < 1, gamma outside [0, 1] or an unknown env id.
-/// `after_episode`, when set, is called after every episode (the evaluator publishes its stats
-/// from there, so that a long evaluation does not look like a silent process).
+/// `tick`, when set, is called after every step (the evaluator publishes its stats from there,
+/// so that a long evaluation does not look like a silent process; progress.h).
 EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes,
                 uint64_t first_seed = kDefaultEvalSeedBase, double gamma = kDefaultGamma,
-                const std::function<void()>& after_episode = {});
+                const std::function<void()>& tick = {});
 
 /// Score() with EvaluationPolicy(*net, env's spec, epsilon, first_seed). The network is copied,
 /// not changed.
 EvalScore ScorePolicy(nn::Sequential* net, const std::string& env_id, int episodes,
                       double epsilon = kDefaultEvalEpsilon,
                       uint64_t first_seed = kDefaultEvalSeedBase, double gamma = kDefaultGamma,
-                      const std::function<void()>& after_episode = {});
+                      const std::function<void()>& tick = {});
 
 /// Empty when `net` can drive a policy of `spec` (input size = observation size, output size =
 /// number of actions or action dimension), else a sentence saying what differs.

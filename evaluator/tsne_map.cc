@@ -45,7 +45,7 @@ int LastHiddenLayerIndex(const nn::Sequential& net) {
 
 StateSamples CollectStates(nn::Sequential* net, const std::string& env_id, int states,
                            uint64_t first_seed, double gamma,
-                           const std::function<void(int states)>& after_episode) {
+                           const std::function<void(int states)>& after_step) {
   if (states < kTsneMapMinStates || states > kTsneMapMaxStates) {
     throw std::invalid_argument("a t-SNE map needs " + std::to_string(kTsneMapMinStates) + " to " +
                                 std::to_string(kTsneMapMaxStates) + " states, got " +
@@ -123,10 +123,10 @@ StateSamples CollectStates(nn::Sequential* net, const std::string& env_id, int s
                episode_frames.data() + t * frame_bytes, returns[t]);
         }
       }
+      if (after_step) after_step(n);
       if (done || (!s.value_is_return && n == states)) break;
     }
     ++s.episodes;
-    if (after_episode) after_episode(n);
   }
   if (n < states) {
     throw std::logic_error("only " + std::to_string(n) + " of " + std::to_string(states) +

@@ -48,14 +48,14 @@ struct StateSamples {
 /// Q-network; for a network without value estimates (a TD3 actor) the discounted return
 /// (discount `gamma`) that followed the state in its episode, up to the episode's end or its time
 /// limit (what lies beyond a time limit is unseen: such returns are short of the truth near the
-/// cut). `after_episode` (when set) is called after every episode with the states collected so
-/// far; what it throws propagates (a caller's way to stop). Throws std::invalid_argument for
+/// cut). `after_step` (when set) is called after every step with the states collected so far;
+/// what it throws propagates (a caller's way to stop). Throws std::invalid_argument for
 /// states outside [kTsneMapMinStates, kTsneMapMaxStates], gamma outside [0, 1], an env without
 /// frames, or a network that does not fit the env or has no hidden layer. Memory: N x (D floats +
 /// one frame), plus one episode's worth for a network without value estimates.
 StateSamples CollectStates(nn::Sequential* net, const std::string& env_id, int states,
                            uint64_t first_seed = kDefaultEvalSeedBase, double gamma = kDefaultGamma,
-                           const std::function<void(int states)>& after_episode = {});
+                           const std::function<void(int states)>& after_step = {});
 
 /// Which states get a thumbnail: up to `count` (>= 1) states at evenly spaced quantiles of the
 /// value, lowest and highest included, preferring states whose frames differ from those already

@@ -77,7 +77,7 @@ bool TsneScheduler::Make(const Tick& tick) {
   const EvalRecord record = record_;
   const double start = MonoSeconds();
   double next_line = start + 2.0;  // progress lines only for a map that takes a while
-  // Between episodes and every 50 iterations: the caller's tick, and a line every 5 s.
+  // After every step and every 50 iterations: the caller's tick, and a line every 5 s.
   const auto progress = [&](const std::string& line) {
     if (tick) tick();
     if (MonoSeconds() >= next_line) {

@@ -1,7 +1,9 @@
 #include "evaluator/video.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <stdexcept>
+#include <system_error>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -17,7 +19,8 @@ namespace rl::evaluator {
 std::string VideoTemporaryPath(const std::string& path) { return path + ".tmp.webm"; }
 
 VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, uint64_t seed,
-                              int width, int height, double fps, const std::string& path) {
+                              int width, int height, double fps, const std::string& path,
+                              const Tick& tick) {
   auto env = envs::MakeEnv(env_id);
   // The greedy policy (epsilon 0; no noise): throws when the network does not fit the env.
   const std::unique_ptr<actor::Policy> policy = EvaluationPolicy(*net, env->spec(), 0.0, seed);
@@ -44,15 +47,24 @@ VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, ui
     writer.write(bgr);
     ++result.frames;
   };
-  env->Reset(seed);
-  write_frame();
-  while (true) {
-    const auto obs = env->observation();
-    policy->Act(obs, 0, action);
-    const envs::StepResult r = env->Step(action);
-    result.episode_return += r.reward;
+  try {
+    env->Reset(seed);
     write_frame();
-    if (r.terminated || r.truncated) break;
+    while (true) {
+      const auto obs = env->observation();
+      policy->Act(obs, 0, action);
+      const envs::StepResult r = env->Step(action);
+      result.episode_return += r.reward;
+      write_frame();
+      if (tick) tick();
+      if (r.terminated || r.truncated) break;
+    }
+  } catch (...) {
+    // Interrupted by the tick, or failed: no half-written temporary left behind.
+    writer.release();
+    std::error_code ignored;
+    std::filesystem::remove(tmp, ignored);
+    throw;
   }
   writer.release();
   RenameIntoPlace(tmp, path, "video");

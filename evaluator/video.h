@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 
+#include "evaluator/progress.h"
 #include "nn/sequential.h"
 
 namespace rl::evaluator {
@@ -25,7 +26,9 @@ std::string VideoTemporaryPath(const std::string& path);
 /// second, atomically (a temporary file next to it, then rename). Throws std::runtime_error when
 /// the encoder cannot be opened or the file cannot be written, std::invalid_argument when the
 /// network does not fit the env. O(episode length x frame size).
+/// `tick` (when set) is called after every step (progress.h).
 VideoResult RecordGreedyVideo(nn::Sequential* net, const std::string& env_id, uint64_t seed,
-                              int width, int height, double fps, const std::string& path);
+                              int width, int height, double fps, const std::string& path,
+                              const Tick& tick = {});
 
 }  // namespace rl::evaluator

@@ -40,7 +40,12 @@ TEST(TsneMapTest, TheLastHiddenLayerIsTheInputOfTheLastLinearLayerOrDuelingHead)
 TEST(TsneMapTest, CollectsTheHiddenLayerTheGreedyValueAndTheFrameOfEveryState) {
   nn::Sequential net = Build("linear(100,16),relu,linear(16,3)", 4);
   const uint64_t seed = 500;
-  const StateSamples s = CollectStates(&net, kCatchPixels, 100, seed, 0.99);
+  // The hook comes after every step with the states kept so far (one a step here).
+  std::vector<int> kept;
+  const StateSamples s =
+      CollectStates(&net, kCatchPixels, 100, seed, 0.99, [&](int n) { kept.push_back(n); });
+  ASSERT_EQ(kept.size(), 100U);
+  for (size_t i = 0; i < kept.size(); ++i) EXPECT_EQ(kept[i], static_cast<int>(i) + 1);
   ASSERT_EQ(s.activations.rows(), 16);
   ASSERT_EQ(s.activations.cols(), 100);
   ASSERT_EQ(s.values.size(), 100U);

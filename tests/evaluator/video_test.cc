@@ -14,11 +14,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-TEST(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
-  const fs::path dir = fs::temp_directory_path() / ("video_test_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  const std::string path = (dir / "best.webm").string();
-  // A network that always pushes right: CartPole falls within a few dozen steps.
+// A network that always pushes right: CartPole falls within a few dozen steps.
+nn::Sequential PushesRight() {
   std::mt19937 rng(1);
   nn::Sequential net = nn::MakeMlp(4, {8}, 2, &rng);
   std::vector<float> flat;
@@ -26,7 +23,18 @@ TEST(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
   std::fill(flat.begin(), flat.end(), 0.0f);
   flat.back() = 1.0f;
   net.SetFlat(flat.data(), flat.size());
-  const VideoResult v = RecordGreedyVideo(&net, "CartPole-v1", 7, 120, 81, 30, path);
+  return net;
+}
+
+TEST(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
+  const fs::path dir = fs::temp_directory_path() / ("video_test_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const std::string path = (dir / "best.webm").string();
+  nn::Sequential net = PushesRight();
+  int ticks = 0;
+  const VideoResult v =
+      RecordGreedyVideo(&net, "CartPole-v1", 7, 120, 81, 30, path, [&] { ++ticks; });
+  EXPECT_EQ(ticks, v.frames - 1);  // after every step (the first frame is the reset's)
   EXPECT_EQ(v.width, 120);
   EXPECT_EQ(v.height, 82);  // rounded up to even
   EXPECT_GT(v.frames, 5);
@@ -52,6 +60,24 @@ TEST(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
     ++frames;
   }
   EXPECT_EQ(frames, v.frames);
+  fs::remove_all(dir);
+}
+
+// A stop during the episode (the tick throws) leaves neither the video nor its temporary file.
+TEST(VideoTest, AStopDuringTheEpisodeLeavesNoFile) {
+  const fs::path dir = fs::temp_directory_path() / ("video_stop_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const std::string path = (dir / "best.webm").string();
+  nn::Sequential net = PushesRight();
+  int ticks = 0;
+  EXPECT_THROW(RecordGreedyVideo(&net, "CartPole-v1", 7, 120, 81, 30, path,
+                                 [&] {
+                                   if (++ticks == 3) throw Interrupted{};
+                                 }),
+               Interrupted);
+  EXPECT_EQ(ticks, 3);
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_FALSE(fs::exists(path + ".tmp.webm"));
   fs::remove_all(dir);
 }
 
