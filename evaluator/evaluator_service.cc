@@ -212,9 +212,10 @@ std::optional<EvalRecord> EvaluatorService::Score(const rlmsg::checkpoint_t& ann
   EvalRecord record;
   try {
     *ckpt = ReadAnnouncedCheckpoint(announced.path, CheckpointFolder());
-    // Stats keep flowing during a long evaluation (KUKA: about a second per episode), so the
-    // monitor never mistakes a busy evaluator for a dead one, and a stop request is honoured
-    // after the current episode.
+    // Stats keep flowing during a long evaluation (a tick after every step: at nice 19 on a busy
+    // machine one episode can take longer than the monitor's silence limit), so the monitor
+    // never mistakes a busy evaluator for a dead one, and a stop request is honoured after the
+    // current step.
     if (!PassesScreen(*ckpt, announced)) {
       busy_ = false;
       return std::nullopt;

@@ -31,7 +31,7 @@ class SecondMetric {
   /// When `record` (scored on the standard metric) is a new best, scores the checkpoint `ckpt`
   /// (read from `path`) on the second env into record's second_* fields and prints a progress line;
   /// nothing otherwise or without a second env. A file that fails to score is logged, and a stop
-  /// request (Interrupted from `tick`, between episodes) ends the scoring: both leave the record as
+  /// request (Interrupted from `tick`, after a step) ends the scoring: both leave the record as
   /// it is.
   void ScoreIfBest(const nn::Checkpoint& ckpt, const std::string& path, EvalRecord* record,
                    const Tick& tick);

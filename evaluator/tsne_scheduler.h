@@ -55,7 +55,7 @@ class TsneScheduler {
   double seconds() const { return seconds_; }
 
   /// Makes the due map now: report/tsne.png and its caption, with a progress line every 5 s
-  /// once it has taken 2 s and one when it is written. `tick` is called between episodes and
+  /// once it has taken 2 s and one when it is written. `tick` is called after every step and
   /// every 50 t-SNE iterations; when it throws Interrupted the map stays due. A map that fails
   /// otherwise is logged and dropped. Returns true when the map was written.
   bool Make(const Tick& tick);
