@@ -26,9 +26,15 @@ nn::Sequential PushesRight() {
   return net;
 }
 
-TEST(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
-  const fs::path dir = fs::temp_directory_path() / ("video_test_" + std::to_string(getpid()));
+// A fresh folder of this test process.
+fs::path ScratchDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / (name + "_" + std::to_string(getpid()));
   fs::create_directories(dir);
+  return dir;
+}
+
+TEST(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
+  const fs::path dir = ScratchDir("video_test");
   const std::string path = (dir / "best.webm").string();
   nn::Sequential net = PushesRight();
   int ticks = 0;
@@ -65,8 +71,7 @@ TEST(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
 
 // A stop during the episode (the tick throws) leaves neither the video nor its temporary file.
 TEST(VideoTest, AStopDuringTheEpisodeLeavesNoFile) {
-  const fs::path dir = fs::temp_directory_path() / ("video_stop_" + std::to_string(getpid()));
-  fs::create_directories(dir);
+  const fs::path dir = ScratchDir("video_stop");
   const std::string path = (dir / "best.webm").string();
   nn::Sequential net = PushesRight();
   int ticks = 0;
