@@ -28,7 +28,7 @@ nn::Sequential PushesRight() {
 
 // A fresh folder of this test process.
 fs::path ScratchDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / (name + "_" + std::to_string(getpid()));
+  fs::path dir = fs::temp_directory_path() / (name + "_" + std::to_string(getpid()));
   fs::create_directories(dir);
   return dir;
 }
