@@ -43,17 +43,19 @@ class Line {
   nlohmann::ordered_json fields_;
 };
 
+// The fields every role has: its drops, and the age of the message in tenths of a second.
 template <class Stats>
-Line& AddDrops(Line& line, const Stats& s) {
+Line& AddDrops(Line& line, const Stats& s, double age) {
   return line.Add("lost", static_cast<int64_t>(s.lost))
       .Add("dropped", static_cast<int64_t>(Dropped(s)))
       .Add("replayed", static_cast<int64_t>(s.dropped_replayed))
-      .Add("unauthenticated", static_cast<int64_t>(s.dropped_unauthenticated));
+      .Add("unauthenticated", static_cast<int64_t>(s.dropped_unauthenticated))
+      .Add("age", std::round(age * 10) / 10);
 }
 
 }  // namespace
 
-std::string MetricsLine(double t, const rlmsg::stats_actor_t& s) {
+std::string MetricsLine(double t, const rlmsg::stats_actor_t& s, double age) {
   Line line(t, s.header.sender);
   line.Add("env_steps", static_cast<int64_t>(s.env_steps))
       .Add("episodes", static_cast<int64_t>(s.episodes))
@@ -62,10 +64,10 @@ std::string MetricsLine(double t, const rlmsg::stats_actor_t& s) {
       .Add("steps_per_second", s.steps_per_second)
       .Add("weights_version", static_cast<int64_t>(s.weights_version))
       .Add("paused", static_cast<int64_t>(s.paused));
-  return AddDrops(line, s).Done();
+  return AddDrops(line, s, age).Done();
 }
 
-std::string MetricsLine(double t, const rlmsg::stats_replay_t& s) {
+std::string MetricsLine(double t, const rlmsg::stats_replay_t& s, double age) {
   Line line(t, s.header.sender);
   line.Add("size", static_cast<int64_t>(s.size))
       .Add("capacity", static_cast<int64_t>(s.capacity))
@@ -76,10 +78,10 @@ std::string MetricsLine(double t, const rlmsg::stats_replay_t& s) {
       .Add("samples_per_insert", s.samples_per_insert)
       .Add("insert_allowed", static_cast<int64_t>(s.insert_allowed))
       .Add("memory_bytes", static_cast<int64_t>(s.memory_bytes));
-  return AddDrops(line, s).Done();
+  return AddDrops(line, s, age).Done();
 }
 
-std::string MetricsLine(double t, const rlmsg::stats_learner_t& s) {
+std::string MetricsLine(double t, const rlmsg::stats_learner_t& s, double age) {
   Line line(t, s.header.sender);
   line.Add("updates", static_cast<int64_t>(s.updates))
       .Add("updates_per_second", s.updates_per_second)
@@ -87,16 +89,16 @@ std::string MetricsLine(double t, const rlmsg::stats_learner_t& s) {
       .Add("mean_q", s.mean_q)
       .Add("env_steps", static_cast<int64_t>(s.env_steps))
       .Add("weights_version", static_cast<int64_t>(s.weights_version));
-  return AddDrops(line, s).Done();
+  return AddDrops(line, s, age).Done();
 }
 
-std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s) {
+std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s, double age) {
   Line line(t, s.header.sender);
   line.Add("checkpoints_scored", static_cast<int64_t>(s.checkpoints_scored))
       .Add("last_mean", s.last_mean)
       .Add("best_mean", s.best_mean)
       .Add("busy", static_cast<int64_t>(s.busy));
-  return AddDrops(line, s).Done();
+  return AddDrops(line, s, age).Done();
 }
 
 MetricsLog::MetricsLog(const std::string& path, double dense_seconds, double dense_period,

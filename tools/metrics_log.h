@@ -18,12 +18,14 @@
 
 namespace rl::tools {
 
-/// One JSON line (with its newline) for a stats message seen `t` seconds into the run. The role
-/// is the message's sender ("actor-3", "replay", "learner", "evaluator").
-std::string MetricsLine(double t, const rlmsg::stats_actor_t& s);
-std::string MetricsLine(double t, const rlmsg::stats_replay_t& s);
-std::string MetricsLine(double t, const rlmsg::stats_learner_t& s);
-std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s);
+/// One JSON line (with its newline) for a row `t` seconds into the run of the newest stats message
+/// of a process, received `age` seconds before the row (a row repeats the newest message, so a
+/// process that went silent shows as a growing age, not as fresh figures). The role is the
+/// message's sender ("actor-3", "replay", "learner", "evaluator").
+std::string MetricsLine(double t, const rlmsg::stats_actor_t& s, double age = 0);
+std::string MetricsLine(double t, const rlmsg::stats_replay_t& s, double age = 0);
+std::string MetricsLine(double t, const rlmsg::stats_learner_t& s, double age = 0);
+std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s, double age = 0);
 
 class MetricsLog {
  public:

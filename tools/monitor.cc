@@ -51,12 +51,16 @@ struct View {
 };
 
 // The lines of one metrics row: the newest stats of every role heard from.
-std::string MetricsRow(const View& v, double t) {
+std::string MetricsRow(const View& v, double t, double now) {
   std::string lines;
-  for (const auto& [sender, s] : v.actors) lines += rl::tools::MetricsLine(t, s);
-  if (v.replay_seen > 0) lines += rl::tools::MetricsLine(t, v.replay);
-  if (v.learner_seen > 0) lines += rl::tools::MetricsLine(t, v.learner);
-  if (v.evaluator_seen > 0) lines += rl::tools::MetricsLine(t, v.evaluator);
+  for (const auto& [sender, s] : v.actors) {
+    lines += rl::tools::MetricsLine(t, s, now - v.actor_seen.at(sender));
+  }
+  if (v.replay_seen > 0) lines += rl::tools::MetricsLine(t, v.replay, now - v.replay_seen);
+  if (v.learner_seen > 0) lines += rl::tools::MetricsLine(t, v.learner, now - v.learner_seen);
+  if (v.evaluator_seen > 0) {
+    lines += rl::tools::MetricsLine(t, v.evaluator, now - v.evaluator_seen);
+  }
   return lines;
 }
 
@@ -209,7 +213,7 @@ int Main(int argc, char** argv) {
       break;
     }
     if (metrics != nullptr && metrics->Due(elapsed)) {
-      const std::string row = MetricsRow(v, elapsed);
+      const std::string row = MetricsRow(v, elapsed, now);
       if (!row.empty()) metrics->AppendRow(elapsed, row);
     }
     if (now >= next_print) {

@@ -38,7 +38,10 @@ TEST(MetricsLineTest, WritesOneJsonObjectPerRoleWithTheStatsFields) {
   EXPECT_EQ(MetricsLine(12.5, learner),
             "{\"t\": 12.5, \"role\": \"learner\", \"updates\": 5000, \"updates_per_second\": 0.0, "
             "\"loss\": 0.25, \"mean_q\": null, \"env_steps\": 0, \"weights_version\": 0, "
-            "\"lost\": 2, \"dropped\": 7, \"replayed\": 4, \"unauthenticated\": 0}\n");
+            "\"lost\": 2, \"dropped\": 7, \"replayed\": 4, \"unauthenticated\": 0, "
+            "\"age\": 0.0}\n");
+  // The age of a message the row repeats, in tenths of a second.
+  EXPECT_NE(MetricsLine(12.5, learner, 46.04).find("\"age\": 46.0}"), std::string::npos);
   rlmsg::stats_actor_t actor{};
   actor.header.sender = "actor-3";
   actor.env_steps = 1234567;
