@@ -8,6 +8,7 @@
 
 #include "common/check.h"
 #include "envs/raster.h"
+#include "envs/render_args.h"
 
 namespace rl::envs {
 
@@ -70,11 +71,7 @@ void SeededEnv::OnReset(std::optional<uint64_t> seed) {
 std::span<const uint8_t> Env::frame() const { throw std::logic_error("not a pixel env"); }
 
 void Env::RenderSized(int width, int height, std::vector<uint8_t>* rgb) const {
-  RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
-  if (width <= 0 || height <= 0) {
-    throw std::invalid_argument("RenderSized: width and height must be positive, got " +
-                                std::to_string(width) + "x" + std::to_string(height));
-  }
+  CheckRenderSize("RenderSized", width, height, rgb);
   std::vector<uint8_t> native;
   int native_width = 0;
   int native_height = 0;

@@ -24,16 +24,22 @@ inline void RenderNative(const Env& env, int native_width, int native_height,
   *height = native_height;
 }
 
-/// The checks at the top of every RenderSized: an output buffer (a programming error otherwise),
-/// std::invalid_argument("<name>: render size must be positive, got WxH") and
-/// std::logic_error("<name>: call Reset() before Render()").
-inline void CheckRenderArgs(const Env& env, std::string_view name, int width, int height,
+/// RenderSized's arguments: an output buffer (a programming error otherwise) and
+/// std::invalid_argument("<name>: render size must be positive, got WxH").
+inline void CheckRenderSize(std::string_view name, int width, int height,
                             const std::vector<uint8_t>* rgb) {
   RL_CHECK(rgb != nullptr) << "RenderSized needs an output buffer";
   if (width <= 0 || height <= 0) {
     throw std::invalid_argument(std::string(name) + ": render size must be positive, got " +
                                 std::to_string(width) + "x" + std::to_string(height));
   }
+}
+
+/// The checks at the top of every env's RenderSized: CheckRenderSize, and
+/// std::logic_error("<name>: call Reset() before Render()").
+inline void CheckRenderArgs(const Env& env, std::string_view name, int width, int height,
+                            const std::vector<uint8_t>* rgb) {
+  CheckRenderSize(name, width, height, rgb);
   if (!env.started()) throw std::logic_error(std::string(name) + ": call Reset() before Render()");
 }
 

@@ -14,6 +14,7 @@
 //                          env's actions do not fit it).
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <tuple>
 
@@ -38,6 +39,17 @@ inline std::string AlgorithmNames() {
     names += (names.empty() ? "" : ", ") + std::string(config.kName);
   });
   return names;
+}
+
+/// Throws std::invalid_argument("algorithm must be one of dqn, td3, not '<name>'") unless `name`
+/// is an algorithm's kName.
+inline void CheckAlgorithmName(const std::string& name) {
+  bool known = false;
+  ForEachAlgorithm(AlgorithmConfigs{}, [&](const auto& config) { known |= name == config.kName; });
+  if (!known) {
+    throw std::invalid_argument("algorithm must be one of " + AlgorithmNames() + ", not '" + name +
+                                "'");
+  }
 }
 
 }  // namespace rl::learner

@@ -65,16 +65,10 @@ std::deque<std::string> CheckpointFiles(const std::filesystem::path& dir) {
 }  // namespace
 
 void LearnerConfig::Validate() const {
-  bool known = false;
+  CheckAlgorithmName(algorithm);
   ForEachAlgorithm(algorithms, [&](const auto& config) {
-    if (algorithm != config.kName) return;
-    known = true;
-    config.Validate();
+    if (algorithm == config.kName) config.Validate();
   });
-  if (!known) {
-    throw std::invalid_argument("algorithm must be one of " + AlgorithmNames() + ", not '" +
-                                algorithm + "'");
-  }
   if (augment_shift < 0) throw std::invalid_argument("augment-shift must be >= 0");
   if (batch_size < 1 || batch_size > 65536) throw std::invalid_argument("batch-size in [1, 65536]");
   if (requests_in_flight < 1) throw std::invalid_argument("requests-in-flight must be >= 1");

@@ -119,10 +119,7 @@ int Main(int argc, char** argv) {
                         desc, &vm)) {
     return 0;
   }
-  if (!own_options.contains(c.algorithm)) {
-    throw std::invalid_argument("algorithm must be one of " + rl::learner::AlgorithmNames() +
-                                ", not '" + c.algorithm + "'");
-  }
+  rl::learner::CheckAlgorithmName(c.algorithm);
   for (const auto& [name, options] : own_options) {
     if (name != c.algorithm) {
       rl::RefuseGiven(vm, options,
