@@ -43,16 +43,19 @@ class BusTest : public ::testing::Test {
     bus_.Subscribe<rlmsg::transition_batch_t>(
         channels::kTransitions, [this](const rlmsg::transition_batch_t& m) { got_.push_back(m); });
   }
+  // Publishes `m` twice and handles what arrives: both copies.
+  void PublishTwiceAndReceiveBoth(rlmsg::transition_batch_t m) {
+    ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
+    ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
+    bus_.Handle(100);
+    ASSERT_EQ(got_.size(), 2U);
+  }
   Bus bus_;
   std::vector<rlmsg::transition_batch_t> got_;
 };
 
 TEST_F(BusTest, DeliversAGoodMessageWithItsHeaderFilled) {
-  auto m = MakeBatch(3, 4);
-  ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
-  ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
-  bus_.Handle(100);
-  ASSERT_EQ(got_.size(), 2U);
+  ASSERT_NO_FATAL_FAILURE(PublishTwiceAndReceiveBoth(MakeBatch(3, 4)));
   EXPECT_EQ(got_[0].header.run_id, 42);
   EXPECT_EQ(got_[0].header.sender, "actor-1");
   EXPECT_EQ(got_[0].header.seq, 0);
@@ -187,11 +190,7 @@ class KeyedBusTest : public BusTest {
 };
 
 TEST_F(KeyedBusTest, DeliversItsOwnSignedMessages) {
-  auto m = MakeBatch(2, 4);
-  ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
-  ASSERT_TRUE(bus_.Publish(channels::kTransitions, &m));
-  bus_.Handle(100);
-  ASSERT_EQ(got_.size(), 2U);
+  ASSERT_NO_FATAL_FAILURE(PublishTwiceAndReceiveBoth(MakeBatch(2, 4)));
   EXPECT_EQ(got_[0].header.incarnation, bus_.incarnation());
   EXPECT_EQ(bus_.counters().dropped(), 0);
 }

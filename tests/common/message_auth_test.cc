@@ -19,19 +19,16 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/common/error_of.h"
+#include "tests/common/temp_dir.h"
+
 namespace rl {
 namespace {
 
 namespace fs = std::filesystem;
 
-class KeyFileTest : public ::testing::Test {
+class KeyFileTest : public TempDirTest {
  protected:
-  KeyFileTest() : dir_(fs::temp_directory_path() / ("key_file_" + std::to_string(getpid()))) {
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  ~KeyFileTest() override { fs::remove_all(dir_); }
-
   std::string Write(const std::string& bytes, mode_t mode) {
     const std::string path = (dir_ / "key").string();
     fs::remove(path);
@@ -40,17 +37,11 @@ class KeyFileTest : public ::testing::Test {
     return path;
   }
 
-  // The error ReadKeyFile throws for `path` ("" when it throws none).
-  static std::string ErrorOf(const std::string& path) {
-    try {
-      ReadKeyFile(path);
-    } catch (const std::runtime_error& e) {
-      return e.what();
-    }
-    return "";
+  // The message of the error ReadKeyFile throws for `path`, which must be a std::runtime_error.
+  static std::string ReadError(const std::string& path) {
+    EXPECT_THROW(ReadKeyFile(path), std::runtime_error) << path;
+    return ErrorOf([&] { ReadKeyFile(path); });
   }
-
-  fs::path dir_;
 };
 
 TEST_F(KeyFileTest, ReadsAnOwnerOnlyKeyOfTheRightSize) {
@@ -60,14 +51,14 @@ TEST_F(KeyFileTest, ReadsAnOwnerOnlyKeyOfTheRightSize) {
 }
 
 TEST_F(KeyFileTest, RefusesAKeyOthersMayReadAWrongSizeOrNoFile) {
-  EXPECT_NE(ErrorOf(Write(std::string(kKeyBytes, 'a'), 0644)).find("others than its owner"),
+  EXPECT_NE(ReadError(Write(std::string(kKeyBytes, 'a'), 0644)).find("others than its owner"),
             std::string::npos);
-  EXPECT_NE(ErrorOf(Write(std::string(kKeyBytes - 1, 'a'), 0600)).find("holds 31 bytes"),
+  EXPECT_NE(ReadError(Write(std::string(kKeyBytes - 1, 'a'), 0600)).find("holds 31 bytes"),
             std::string::npos);
-  EXPECT_NE(ErrorOf(Write(std::string(kKeyBytes + 9, 'a'), 0600)).find("holds 33+ bytes"),
+  EXPECT_NE(ReadError(Write(std::string(kKeyBytes + 9, 'a'), 0600)).find("holds 33+ bytes"),
             std::string::npos);
-  EXPECT_NE(ErrorOf((dir_ / "none").string()).find("none"), std::string::npos);
-  EXPECT_NE(ErrorOf(dir_.string()).find("not a regular file"), std::string::npos);
+  EXPECT_NE(ReadError((dir_ / "none").string()).find("none"), std::string::npos);
+  EXPECT_NE(ReadError(dir_.string()).find("not a regular file"), std::string::npos);
 }
 
 // A message laid out as an encoded header_t begins (MacOffset()): fingerprint, run id, the

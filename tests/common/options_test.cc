@@ -13,6 +13,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/common/error_of.h"
+
 namespace rl {
 namespace {
 
@@ -43,6 +45,12 @@ Parsed Parse(const std::string& ini, std::vector<std::string> args = {}) {
   return p;
 }
 
+// The message of the error Parse(ini) throws, which must be a std::runtime_error.
+std::string ParseError(const std::string& ini) {
+  EXPECT_THROW(Parse(ini), std::runtime_error);
+  return ErrorOf([&] { Parse(ini); });
+}
+
 TEST(OptionsTest, TheSectionWinsOverTheTopLevelAndTheCommandLineOverBoth) {
   const std::string ini =
       "env = CarRacing-v3+pixels(skip=5,off-track=1)\nepisodes = 7\nunknown-top = 1\n"
@@ -57,25 +65,15 @@ TEST(OptionsTest, TheSectionWinsOverTheTopLevelAndTheCommandLineOverBoth) {
 }
 
 TEST(OptionsTest, AnUnknownKeyInOurSectionIsRefusedWithItsName) {
-  try {
-    Parse("[evaluator]\nepsiodes = 3\n");
-    FAIL() << "no error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown key 'epsiodes' in section [evaluator]"),
-              std::string::npos)
-        << e.what();
-  }
+  const std::string error = ParseError("[evaluator]\nepsiodes = 3\n");
+  EXPECT_NE(error.find("unknown key 'epsiodes' in section [evaluator]"), std::string::npos)
+      << error;
 }
 
 TEST(OptionsTest, ASectionOfNoProcessIsRefusedWithItsName) {
-  try {
-    Parse("env = CartPole-v1\n[lerner]\nlearning-rate = 0.001\n");
-    FAIL() << "no error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown section [lerner] (key 'learning-rate')"),
-              std::string::npos)
-        << e.what();
-  }
+  const std::string error = ParseError("env = CartPole-v1\n[lerner]\nlearning-rate = 0.001\n");
+  EXPECT_NE(error.find("unknown section [lerner] (key 'learning-rate')"), std::string::npos)
+      << error;
   // The other processes' sections are not ours, but no error.
   EXPECT_EQ(Parse("[replay]\ncapacity = 5\n[learner]\nx = 1\n").episodes, 100);
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 
 namespace rl {
 namespace {
@@ -22,11 +23,9 @@ TEST(TextFormatTest, ScoresKeepTwoDecimalsBelowTenRoundedDown) {
 }
 
 TEST(TextFormatTest, ThousandsAreSeparated) {
-  EXPECT_EQ(Thousands(0), "0");
-  EXPECT_EQ(Thousands(999), "999");
-  EXPECT_EQ(Thousands(1000), "1,000");
-  EXPECT_EQ(Thousands(1234567), "1,234,567");
-  EXPECT_EQ(Thousands(-45678), "-45,678");
+  const std::pair<int64_t, const char*> cases[] = {
+      {0, "0"}, {999, "999"}, {1000, "1,000"}, {1234567, "1,234,567"}, {-45678, "-45,678"}};
+  for (const auto& [n, text] : cases) EXPECT_EQ(Thousands(n), text) << n;
 }
 
 TEST(TextFormatTest, DurationsReadAsSecondsMinutesOrHours) {

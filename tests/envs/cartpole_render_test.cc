@@ -11,6 +11,7 @@
 #include "envs/raster.h"
 #include "envs/registry.h"
 #include "tests/envs/image_testing.h"
+#include "tests/envs/render_checks.h"
 
 namespace rl::envs {
 namespace {
@@ -30,12 +31,8 @@ constexpr int kTrackRow = 299;
 
 TEST(CartPoleRenderTest, ImageIs600By400RgbOnWhite) {
   const Image image = RenderState({0, 0, 0, 0});
-  EXPECT_EQ(image.width, 600);
-  EXPECT_EQ(image.height, 400);
-  EXPECT_EQ(image.rgb.size(), 600u * 400u * 3u);
-  EXPECT_EQ(image.at(0, 0), kWhite);
-  EXPECT_EQ(image.at(599, 399), kWhite);
-  EXPECT_EQ(image.at(100, 150), kWhite);
+  ExpectSize(image, 600, 400);
+  ExpectPixels(image, {{0, 0, kWhite}, {599, 399, kWhite}, {100, 150, kWhite}});
   // Mostly background.
   EXPECT_GT(FindColor(image, kWhite).count, 600 * 400 * 9 / 10);
 }
@@ -49,17 +46,15 @@ TEST(CartPoleRenderTest, TrackIsABlackRowAcrossTheWholeWidth) {
 
 TEST(CartPoleRenderTest, CartIsABlack50By30RectangleAtTheCentre) {
   const Image image = RenderState({0, 0, 0, 0});
-  // Corners of the cart, below the axle and pole.
-  EXPECT_EQ(image.at(275, 285), kBlack);
-  EXPECT_EQ(image.at(324, 285), kBlack);
-  EXPECT_EQ(image.at(275, 314), kBlack);
-  EXPECT_EQ(image.at(324, 314), kBlack);
-  EXPECT_EQ(image.at(280, 310), kBlack);
+  // Corners of the cart, below the axle and pole, and a pixel inside.
+  ExpectPixels(image, {{275, 285, kBlack},
+                       {324, 285, kBlack},
+                       {275, 314, kBlack},
+                       {324, 314, kBlack},
+                       {280, 310, kBlack}});
   // Just outside.
-  EXPECT_EQ(image.at(274, 310), kWhite);
-  EXPECT_EQ(image.at(325, 310), kWhite);
-  EXPECT_EQ(image.at(280, 284), kWhite);
-  EXPECT_EQ(image.at(280, 315), kWhite);
+  ExpectPixels(image,
+               {{274, 310, kWhite}, {325, 310, kWhite}, {280, 284, kWhite}, {280, 315, kWhite}});
   // The black pixels off the track row are the cart minus what the pole and axle cover.
   const Blob cart = FindColor(image, kBlack, kTrackRow);
   EXPECT_GT(cart.count, 50 * 29 - 150);
@@ -70,17 +65,13 @@ TEST(CartPoleRenderTest, CartIsABlack50By30RectangleAtTheCentre) {
 TEST(CartPoleRenderTest, UprightPoleAndAxleSitAboveTheCart) {
   const Image image = RenderState({0, 0, 0, 0});
   // The pole runs from 2.5 px below the axle to 122.5 px above it: rows (172.5, 297.5).
-  EXPECT_EQ(image.at(300, 200), kPole);
-  EXPECT_EQ(image.at(296, 180), kPole);
-  EXPECT_EQ(image.at(300, 170), kWhite);
-  EXPECT_EQ(image.at(290, 200), kWhite);
+  ExpectPixels(image,
+               {{300, 200, kPole}, {296, 180, kPole}, {300, 170, kWhite}, {290, 200, kWhite}});
   const Blob pole = FindColor(image, kPole);
   EXPECT_NEAR(pole.mean_x, 299.5, 0.5);
   EXPECT_NEAR(pole.count, 10 * 125 - 80, 60);  // Minus what the axle covers.
   // Axle: radius-5 disc centred on pixel (300, 292).
-  EXPECT_EQ(image.at(300, 292), kAxle);
-  EXPECT_EQ(image.at(305, 292), kAxle);
-  EXPECT_EQ(image.at(300, 287), kAxle);
+  ExpectPixels(image, {{300, 292, kAxle}, {305, 292, kAxle}, {300, 287, kAxle}});
   const Blob axle = FindColor(image, kAxle);
   EXPECT_NEAR(axle.count, 3.14159 * 25, 12);
   EXPECT_NEAR(axle.mean_x, 300, 0.01);

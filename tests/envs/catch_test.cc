@@ -13,6 +13,7 @@
 #include "envs/registry.h"
 #include "envs/time_limit.h"
 #include "tests/envs/image_testing.h"
+#include "tests/envs/render_checks.h"
 
 namespace rl::envs {
 namespace {
@@ -187,10 +188,7 @@ TEST(CatchTest, BadActionsAndStepsOutsideAnEpisodeThrowWithoutChangingTheState) 
 
 TEST(CatchTest, RenderIs40By80WithWhiteBallAndPaddleCellsOnBlack) {
   Catch env;
-  std::vector<uint8_t> rgb;
-  int width = 0;
-  int height = 0;
-  EXPECT_THROW(env.Render(&rgb, &width, &height), std::logic_error);
+  ExpectRenderRefusedBeforeReset(env);
   env.Reset(5);
   env.Step(DiscreteAction(0));  // Paddle to column 1, ball to row 1.
   const Image image = Rendered(env);

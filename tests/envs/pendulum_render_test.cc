@@ -8,6 +8,7 @@
 #include "envs/pendulum.h"
 #include "envs/raster.h"
 #include "tests/envs/image_testing.h"
+#include "tests/envs/render_checks.h"
 
 namespace rl::envs {
 namespace {
@@ -38,12 +39,8 @@ Image RenderAfterTorque(double theta, float u) {
 
 TEST(PendulumRenderTest, ImageIs500By500RgbOnWhite) {
   const Image image = RenderState(0);
-  EXPECT_EQ(image.width, 500);
-  EXPECT_EQ(image.height, 500);
-  EXPECT_EQ(image.rgb.size(), 500U * 500U * 3U);
-  EXPECT_EQ(image.at(0, 0), kWhite);
-  EXPECT_EQ(image.at(499, 499), kWhite);
-  EXPECT_EQ(image.at(499, 0), kWhite);
+  ExpectSize(image, 500, 500);
+  ExpectPixels(image, {{0, 0, kWhite}, {499, 499, kWhite}, {499, 0, kWhite}});
   // The rod and its caps cover about 0.2 x 1.2 world units of the 4.4 x 4.4 view.
   const Blob rod = FindColor(image, kRod);
   EXPECT_NEAR(rod.count, 0.2 * kScale * kScale + kPi * 11 * 11 - kPi * 5 * 5, 150);
@@ -192,14 +189,12 @@ TEST(PendulumRenderTest, RenderSizedDrawsAtTheRequestedSize) {
 
 TEST(PendulumRenderTest, RefusesBadSizesAndRenderingBeforeReset) {
   Pendulum env;
-  std::vector<uint8_t> rgb;
-  int width = 0;
-  int height = 0;
-  EXPECT_THROW(env.Render(&rgb, &width, &height), std::logic_error);
+  ExpectRenderRefusedBeforeReset(env);
   env.Reset(2);
+  std::vector<uint8_t> rgb;
   EXPECT_THROW(env.RenderSized(0, 10, &rgb), std::invalid_argument);
   EXPECT_THROW(env.RenderSized(10, -1, &rgb), std::invalid_argument);
-  EXPECT_NO_THROW(env.Render(&rgb, &width, &height));
+  EXPECT_NO_THROW(Rendered(env));
 }
 
 }  // namespace

@@ -2,11 +2,13 @@
 
 #include <stdexcept>
 #include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
 #include "envs/registry.h"
 #include "envs/specs.h"
+#include "tests/common/error_of.h"
 
 namespace rl::envs {
 namespace {
@@ -55,13 +57,10 @@ TEST(PixelSpecTest, KeepsTheDefaultsOfKeysNotGiven) {
 }
 
 TEST(PixelSpecTest, RefusesBadSpecsWithTheReason) {
+  // The message of the error ParseEnvId throws, which must be a std::invalid_argument.
   const auto message = [](const std::string& id) {
-    try {
-      ParseEnvId(id);
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string("no error");
+    EXPECT_THROW(ParseEnvId(id), std::invalid_argument) << id;
+    return ErrorOf([&] { ParseEnvId(id); });
   };
   EXPECT_NE(message("Catch-v0+pixels(colour=1)").find("unknown pixels key 'colour'"),
             std::string::npos);
@@ -115,9 +114,8 @@ TEST(PixelSpecTest, MakeEnvBuildsThePipelineTheIdDescribes) {
   auto env = MakeEnv("Catch-v0+pixels(width=5,height=10,stack=2,max-pool=0)");
   const EnvSpec& spec = env->spec();
   EXPECT_EQ(spec.id, "Catch-v0");
-  EXPECT_EQ(spec.frame_width, 5);
-  EXPECT_EQ(spec.frame_height, 10);
-  EXPECT_EQ(spec.frame_stack, 2);
+  // Frames of 5 x 10 pixels (width, height), two stacked.
+  EXPECT_EQ(std::tie(spec.frame_width, spec.frame_height, spec.frame_stack), std::tuple(5, 10, 2));
   EXPECT_EQ(spec.observation_size, 100);
   EXPECT_EQ(spec.num_actions, 3);
   env->Reset(3);

@@ -16,6 +16,18 @@ namespace {
 
 constexpr Rgb kRed{255, 0, 0};
 
+// A canvas of width x height, cleared to white, that owns the buffer it draws into (the buffer
+// is a base, so that it is built before the Canvas that points to it).
+struct CanvasBuffer {
+  std::vector<uint8_t> buffer;
+};
+class WhiteCanvas : private CanvasBuffer, public Canvas {
+ public:
+  WhiteCanvas(int width, int height) : Canvas(width, height, &buffer) { Clear(kWhite); }
+  WhiteCanvas(const WhiteCanvas&) = delete;
+  WhiteCanvas& operator=(const WhiteCanvas&) = delete;
+};
+
 int CountColor(const Canvas& canvas, Rgb color) {
   int count = 0;
   for (int y = 0; y < canvas.height(); ++y) {
@@ -36,9 +48,7 @@ TEST(RasterTest, ClearPaintsEveryPixel) {
 }
 
 TEST(RasterTest, RectangleWithIntegerCornersCoversExactlyItsPixels) {
-  std::vector<uint8_t> buffer;
-  Canvas canvas(20, 10, &buffer);
-  canvas.Clear(kWhite);
+  WhiteCanvas canvas(20, 10);
   const std::array<Point, 4> rect = {Point{3, 2}, Point{3, 7}, Point{11, 7}, Point{11, 2}};
   canvas.FillPolygon(rect, kRed);
   EXPECT_EQ(CountColor(canvas, kRed), 8 * 5);
@@ -53,11 +63,7 @@ TEST(RasterTest, TrianglesSharingAnEdgeNeitherOverlapNorLeaveGaps) {
   // Two triangles splitting a square along a diagonal through pixel centres.
   const std::array<Point, 3> lower = {Point{2.5, 2.5}, Point{30.5, 2.5}, Point{30.5, 30.5}};
   const std::array<Point, 3> upper = {Point{2.5, 2.5}, Point{30.5, 30.5}, Point{2.5, 30.5}};
-  std::vector<uint8_t> a_buffer, b_buffer, both_buffer;
-  Canvas a(40, 40, &a_buffer), b(40, 40, &b_buffer), both(40, 40, &both_buffer);
-  a.Clear(kWhite);
-  b.Clear(kWhite);
-  both.Clear(kWhite);
+  WhiteCanvas a(40, 40), b(40, 40), both(40, 40);
   a.FillPolygon(lower, kRed);
   b.FillPolygon(upper, kRed);
   const std::array<Point, 4> square = {Point{2.5, 2.5}, Point{30.5, 2.5}, Point{30.5, 30.5},
@@ -84,17 +90,13 @@ TEST(RasterTest, TriangleFanTilesItsPolygonExactlyOnce) {
   const std::vector<Point> ring = {{10.3, 4.7},  {33.1, 2.2},  {47.9, 15.5}, {45.2, 38.6},
                                    {27.7, 47.1}, {6.05, 36.3}, {1.9, 17.5}};
   const Point centre{24.6, 23.5};  // Some vertices lie on pixel-centre rows.
-  std::vector<uint8_t> all_buffer;
-  Canvas all(50, 50, &all_buffer);
-  all.Clear(kWhite);
+  WhiteCanvas all(50, 50);
   all.FillPolygon(ring, kRed);
   std::vector<int> hits(50 * 50, 0);
   for (std::size_t i = 0; i < ring.size(); ++i) {
     std::array<Point, 3> triangle = {centre, ring[i], ring[(i + 1) % ring.size()]};
     if (i % 2 == 1) std::swap(triangle[1], triangle[2]);
-    std::vector<uint8_t> buffer;
-    Canvas canvas(50, 50, &buffer);
-    canvas.Clear(kWhite);
+    WhiteCanvas canvas(50, 50);
     canvas.FillPolygon(triangle, kRed);
     for (int y = 0; y < 50; ++y) {
       for (int x = 0; x < 50; ++x) hits[y * 50 + x] += canvas.pixel(x, y) == kRed;
@@ -109,9 +111,7 @@ TEST(RasterTest, TriangleFanTilesItsPolygonExactlyOnce) {
 }
 
 TEST(RasterTest, RotatedSquareCoversAboutItsArea) {
-  std::vector<uint8_t> buffer;
-  Canvas canvas(100, 100, &buffer);
-  canvas.Clear(kWhite);
+  WhiteCanvas canvas(100, 100);
   // A 40x40 square rotated by 30 degrees about (50, 50).
   std::array<Point, 4> square;
   const double c = std::cos(std::numbers::pi / 6), s = std::sin(std::numbers::pi / 6);
@@ -126,9 +126,7 @@ TEST(RasterTest, RotatedSquareCoversAboutItsArea) {
 }
 
 TEST(RasterTest, CircleCoversAboutPiRSquaredSymmetrically) {
-  std::vector<uint8_t> buffer;
-  Canvas canvas(64, 64, &buffer);
-  canvas.Clear(kWhite);
+  WhiteCanvas canvas(64, 64);
   canvas.FillEllipse(Point{32, 32}, 20, 20, kRed);
   EXPECT_NEAR(CountColor(canvas, kRed), std::numbers::pi * 400, 40);
   for (int d = 0; d < 25; ++d) {
@@ -140,9 +138,7 @@ TEST(RasterTest, CircleCoversAboutPiRSquaredSymmetrically) {
 }
 
 TEST(RasterTest, EllipseUsesBothRadii) {
-  std::vector<uint8_t> buffer;
-  Canvas canvas(64, 64, &buffer);
-  canvas.Clear(kWhite);
+  WhiteCanvas canvas(64, 64);
   canvas.FillEllipse(Point{32, 32}, 20, 5, kRed);
   EXPECT_NEAR(CountColor(canvas, kRed), std::numbers::pi * 100, 25);
   EXPECT_EQ(canvas.pixel(50, 32), kRed);
@@ -150,9 +146,7 @@ TEST(RasterTest, EllipseUsesBothRadii) {
 }
 
 TEST(RasterTest, ShapesAreClippedToTheImage) {
-  std::vector<uint8_t> buffer;
-  Canvas canvas(10, 10, &buffer);
-  canvas.Clear(kWhite);
+  WhiteCanvas canvas(10, 10);
   const std::array<Point, 4> big = {Point{-5, -5}, Point{15, -5}, Point{15, 15}, Point{-5, 15}};
   canvas.FillPolygon(big, kRed);
   EXPECT_EQ(CountColor(canvas, kRed), 100);
@@ -166,9 +160,7 @@ TEST(RasterTest, ShapesAreClippedToTheImage) {
 }
 
 TEST(RasterTest, HugeOrNonFiniteCoordinatesDrawNothingOrClipSafely) {
-  std::vector<uint8_t> buffer;
-  Canvas canvas(10, 10, &buffer);
-  canvas.Clear(kWhite);
+  WhiteCanvas canvas(10, 10);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   const std::array<Point, 3> with_nan = {Point{0, 0}, Point{nan, 5}, Point{5, 5}};

@@ -14,19 +14,21 @@ namespace {
 
 // Every field of the two specs, so that a mismatch names the field.
 void ExpectSameSpec(const EnvSpec& built, const EnvSpec& looked_up, const std::string& id) {
-  EXPECT_EQ(built.id, looked_up.id) << id;
-  EXPECT_EQ(built.observation_size, looked_up.observation_size) << id;
-  EXPECT_EQ(built.num_actions, looked_up.num_actions) << id;
-  EXPECT_EQ(built.max_episode_steps, looked_up.max_episode_steps) << id;
-  EXPECT_EQ(built.reward_threshold, looked_up.reward_threshold) << id;
-  EXPECT_EQ(built.action_dim, looked_up.action_dim) << id;
-  EXPECT_EQ(built.action_low, looked_up.action_low) << id;
-  EXPECT_EQ(built.action_high, looked_up.action_high) << id;
-  EXPECT_EQ(built.frame_height, looked_up.frame_height) << id;
-  EXPECT_EQ(built.frame_width, looked_up.frame_width) << id;
-  EXPECT_EQ(built.frame_stack, looked_up.frame_stack) << id;
-  EXPECT_EQ(built.render_width, looked_up.render_width) << id;
-  EXPECT_EQ(built.render_height, looked_up.render_height) << id;
+#define EXPECT_SAME_FIELD(field) EXPECT_EQ(built.field, looked_up.field) << id
+  EXPECT_SAME_FIELD(id);
+  EXPECT_SAME_FIELD(observation_size);
+  EXPECT_SAME_FIELD(num_actions);
+  EXPECT_SAME_FIELD(max_episode_steps);
+  EXPECT_SAME_FIELD(reward_threshold);
+  EXPECT_SAME_FIELD(action_dim);
+  EXPECT_SAME_FIELD(action_low);
+  EXPECT_SAME_FIELD(action_high);
+  EXPECT_SAME_FIELD(frame_height);
+  EXPECT_SAME_FIELD(frame_width);
+  EXPECT_SAME_FIELD(frame_stack);
+  EXPECT_SAME_FIELD(render_width);
+  EXPECT_SAME_FIELD(render_height);
+#undef EXPECT_SAME_FIELD
 }
 
 // The values every spec must hold: the references' registrations (Gymnasium, bsuite, the KUKA

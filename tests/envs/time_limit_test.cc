@@ -214,8 +214,7 @@ TEST(TimeLimitTest, BalancedCartPoleIsTruncatedAtExactlyStep500) {
 
 TEST(TimeLimitTest, CartPoleFallingOnStep500IsTerminatedAndTruncated) {
   auto env = MakeEnv("CartPole-v1");
-  auto& limit = dynamic_cast<TimeLimit&>(*env);
-  auto& cartpole = dynamic_cast<CartPole&>(limit.wrapped_env());
+  auto& cartpole = dynamic_cast<CartPole&>(dynamic_cast<TimeLimit&>(*env).wrapped_env());
   env->Reset(3);
   for (int t = 1; t <= 499; ++t) {
     ASSERT_FALSE(env->Step(DiscreteAction(BalancingAction(env->observation()))).truncated);

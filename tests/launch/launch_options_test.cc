@@ -85,28 +85,28 @@ TEST(LaunchOptionsTest, ResumeAndStopTakeARunFolder) {
 }
 
 TEST(LaunchOptionsTest, RefusesNumbersThatAreNoneOrOutOfRange) {
-  EXPECT_EQ(ErrorOf({"cartpole", "--time-budget", "-5"}),
-            "--time-budget must be a positive number of seconds, not '-5'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--time-budget", "0"}),
-            "--time-budget must be a positive number of seconds, not '0'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--time-budget", "ten"}),
-            "--time-budget must be a positive number of seconds, not 'ten'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--time-budget", "nan"}),
-            "--time-budget must be a positive number of seconds, not 'nan'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--actors", "-1"}),
-            "--actors must be a whole number from 0 to 4096, not '-1'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--actors", "2x"}),
-            "--actors must be a whole number from 0 to 4096, not '2x'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--seed", "1.5"}), "--seed must be a whole number, not '1.5'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--goal", "high"}),
-            "--goal must be a number (an evaluation mean), not 'high'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--ttl", "2"}), "--ttl must be 0 or 1, not '2'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--port", "65535"}),
-            "--port must be a UDP port from 1024 to 65534 (P and P+1), not '65535'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--record-mb", "4"}),
-            "--record-mb must be a whole number of at least 8, not '4'");
-  EXPECT_EQ(ErrorOf({"cartpole", "--max-backoff", "-1"}),
-            "--max-backoff must be a positive number of seconds, not '-1'");
+  // Each option, what it takes, and values it refuses with "<option> must be <what it takes>, not
+  // '<value>'".
+  const struct {
+    std::string option;
+    std::string takes;
+    std::vector<std::string> refused;
+  } cases[] = {
+      {"--time-budget", "a positive number of seconds", {"-5", "0", "ten", "nan"}},
+      {"--actors", "a whole number from 0 to 4096", {"-1", "2x"}},
+      {"--seed", "a whole number", {"1.5"}},
+      {"--goal", "a number (an evaluation mean)", {"high"}},
+      {"--ttl", "0 or 1", {"2"}},
+      {"--port", "a UDP port from 1024 to 65534 (P and P+1)", {"65535"}},
+      {"--record-mb", "a whole number of at least 8", {"4"}},
+      {"--max-backoff", "a positive number of seconds", {"-1"}},
+  };
+  for (const auto& c : cases) {
+    for (const std::string& value : c.refused) {
+      EXPECT_EQ(ErrorOf({"cartpole", c.option, value}),
+                c.option + " must be " + c.takes + ", not '" + value + "'");
+    }
+  }
   EXPECT_EQ(ErrorOf({"cartpole", "--actors", "4", "--num-actors", "2"}),
             "--num-actors (2) must be at least --actors (4)");
 }

@@ -7,47 +7,30 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/learner/owned_batch.h"
+
 namespace rl::learner {
 namespace {
 
 // A two-state chain: from s0 (obs [1,0]) action 1 gives reward 0 and leads to s1; action 0 ends
 // the episode with reward 0.5. From s1 (obs [0,1]) action 0 ends with reward 1, action 1 ends
 // with reward 0. With gamma 0.9: Q(s1) = (1, 0), Q(s0) = (0.5, 0.9).
-struct ChainBatch {
-  std::vector<float> obs, next_obs, reward, discount, weight;
-  std::vector<float> action;
-  nn::Matrix obs_m, next_obs_m;
-  Batch view() {
-    const int n = static_cast<int>(action.size());
-    obs_m = Eigen::Map<const nn::Matrix>(obs.data(), 2, n);
-    next_obs_m = Eigen::Map<const nn::Matrix>(next_obs.data(), 2, n);
-    Batch b;
-    b.count = n;
-    b.action_width = 1;
-    b.obs = &obs_m;
-    b.next_obs = &next_obs_m;
-    b.action = action;
-    b.reward = reward;
-    b.discount = discount;
-    b.weight = weight;
-    return b;
-  }
-};
-
-ChainBatch MakeChain(int n, std::mt19937* rng) {
-  ChainBatch c;
+// n random transitions of the chain (view(1): one action index each).
+OwnedBatch MakeChain(int n, std::mt19937* rng) {
+  OwnedBatch c;
+  c.obs = nn::Matrix::Zero(2, n);
+  c.next_obs = nn::Matrix::Zero(2, n);
   std::uniform_int_distribution<int> coin(0, 1);
   for (int i = 0; i < n; ++i) {
     const bool in_s0 = coin(*rng) == 0;
     const int a = coin(*rng);
-    c.obs.insert(c.obs.end(), {in_s0 ? 1.0f : 0.0f, in_s0 ? 0.0f : 1.0f});
+    c.obs(in_s0 ? 0 : 1, i) = 1.0f;
     c.action.push_back(static_cast<float>(a));
     if (in_s0 && a == 1) {
-      c.next_obs.insert(c.next_obs.end(), {0.0f, 1.0f});
+      c.next_obs(1, i) = 1.0f;
       c.reward.push_back(0.0f);
       c.discount.push_back(0.9f);
     } else {
-      c.next_obs.insert(c.next_obs.end(), {0.0f, 0.0f});
       c.reward.push_back(in_s0 ? 0.5f : (a == 0 ? 1.0f : 0.0f));
       c.discount.push_back(0.0f);
     }
@@ -55,12 +38,18 @@ ChainBatch MakeChain(int n, std::mt19937* rng) {
   return c;
 }
 
+// A Dqn for the chain with one hidden layer of 4 units.
+Dqn SmallDqn() {
+  DqnConfig c;
+  c.hidden = {4};
+  return Dqn(2, 2, c);
+}
+
 void ExpectChainSolved(const DqnConfig& config) {
   Dqn dqn(2, 2, config);
   std::mt19937 rng(3);
   for (int i = 0; i < 3000; ++i) {
-    ChainBatch b = MakeChain(32, &rng);
-    dqn.Update(b.view());
+    dqn.Update(MakeChain(32, &rng).view(1));
   }
   const float s0[2] = {1, 0};
   const float s1[2] = {0, 1};
@@ -99,18 +88,14 @@ TEST(DqnTest, LearnsTheChainWithCenteredRmsProp) {
 }
 
 TEST(DqnTest, ReportsTdErrorsAndHonoursImportanceWeights) {
-  DqnConfig c;
-  c.hidden = {4};
-  Dqn dqn(2, 2, c);
+  Dqn dqn = SmallDqn();
   std::mt19937 rng(4);
-  ChainBatch b = MakeChain(8, &rng);
+  OwnedBatch b = MakeChain(8, &rng);
   // Zero weights: no gradient, so the parameters must not move.
   b.weight.assign(8, 0.0f);
-  std::vector<float> before, after;
-  dqn.online().GetFlat(&before);
-  const UpdateResult r = dqn.Update(b.view());
-  dqn.online().GetFlat(&after);
-  EXPECT_EQ(before, after);
+  const std::vector<float> before = Flat(dqn.online());
+  const UpdateResult r = dqn.Update(b.view(1));
+  EXPECT_EQ(Flat(dqn.online()), before);
   EXPECT_FLOAT_EQ(r.loss, 0.0f);
   ASSERT_EQ(dqn.last_td_errors().size(), 8U);
   EXPECT_GT(dqn.last_td_errors()[0] + dqn.last_td_errors()[1], 0.0f);
@@ -119,30 +104,25 @@ TEST(DqnTest, ReportsTdErrorsAndHonoursImportanceWeights) {
 // A batch that does not fit is refused before anything changes: observation size, an action
 // index out of range or not an integer, an action width other than 1.
 TEST(DqnTest, RefusesABatchThatDoesNotFitTheNetworkAndChangesNothing) {
-  DqnConfig c;
-  c.hidden = {4};
-  Dqn dqn(2, 2, c);
+  Dqn dqn = SmallDqn();
   std::mt19937 rng(4);
-  ChainBatch b = MakeChain(4, &rng);
-  std::vector<float> before, after;
-  dqn.online().GetFlat(&before);
-  Batch v = b.view();
+  OwnedBatch b = MakeChain(4, &rng);
+  const std::vector<float> before = Flat(dqn.online());
+  Batch v = b.view(1);
   nn::Matrix three(3, 4);
   three.setZero();
   v.obs = &three;
   EXPECT_THROW(dqn.Update(v), std::invalid_argument);
   b.action[0] = 5;
-  EXPECT_THROW(dqn.Update(b.view()), std::invalid_argument);
+  EXPECT_THROW(dqn.Update(b.view(1)), std::invalid_argument);
   b.action[0] = 0.5f;
-  EXPECT_THROW(dqn.Update(b.view()), std::invalid_argument);
+  EXPECT_THROW(dqn.Update(b.view(1)), std::invalid_argument);
   b.action[0] = 1;
-  v = b.view();
-  v.action_width = 2;
+  v = b.view(2);
   EXPECT_THROW(dqn.Update(v), std::invalid_argument);
-  dqn.online().GetFlat(&after);
-  EXPECT_EQ(before, after);
+  EXPECT_EQ(Flat(dqn.online()), before);
   EXPECT_EQ(dqn.updates(), 0);
-  EXPECT_NO_THROW(dqn.Update(b.view()));
+  EXPECT_NO_THROW(dqn.Update(b.view(1)));
   EXPECT_EQ(dqn.updates(), 1);
 }
 
@@ -212,8 +192,7 @@ TEST(DqnTest, RestoredStateContinuesBitForBit) {
     Dqn a(2, 2, config);
     std::mt19937 rng(3);
     for (int i = 0; i < 7; ++i) {
-      ChainBatch b = MakeChain(16, &rng);
-      a.Update(b.view());
+      a.Update(MakeChain(16, &rng).view(1));
     }
     StateFile state("dqn");
     a.SaveState(&state);
@@ -222,13 +201,10 @@ TEST(DqnTest, RestoredStateContinuesBitForBit) {
     restored.LoadState(state);
     EXPECT_EQ(restored.updates(), 7);
     for (int i = 0; i < 6; ++i) {  // across a target refresh (update 10)
-      ChainBatch b = MakeChain(16, &rng);
-      EXPECT_EQ(a.Update(b.view()).loss, restored.Update(b.view()).loss) << i;
+      const OwnedBatch b = MakeChain(16, &rng);
+      EXPECT_EQ(a.Update(b.view(1)).loss, restored.Update(b.view(1)).loss) << i;
     }
-    std::vector<float> fa, fb;
-    a.online().GetFlat(&fa);
-    restored.online().GetFlat(&fb);
-    EXPECT_EQ(fa, fb);
+    EXPECT_EQ(Flat(a.online()), Flat(restored.online()));
     DqnConfig other = config;
     other.hidden = {8};
     Dqn wrong(2, 2, other);

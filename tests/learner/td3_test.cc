@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "envs/specs.h"
+#include "tests/learner/owned_batch.h"
 
 namespace rl::learner {
 namespace {
@@ -32,24 +33,7 @@ Td3Config SmallConfig() {
   return c;
 }
 
-// A batch of n random transitions of `spec`, owning its arrays.
-struct OwnedBatch {
-  nn::Matrix obs, next_obs;
-  std::vector<float> action, reward, discount, weight;
-  Batch view(int width) const {
-    Batch b;
-    b.count = static_cast<int>(reward.size());
-    b.action_width = width;
-    b.obs = &obs;
-    b.next_obs = &next_obs;
-    b.action = action;
-    b.reward = reward;
-    b.discount = discount;
-    b.weight = weight;
-    return b;
-  }
-};
-
+// A batch of n random transitions of `spec`.
 OwnedBatch RandomBatch(const envs::EnvSpec& spec, int n, std::mt19937* rng) {
   std::normal_distribution<float> normal;
   OwnedBatch b;
@@ -70,17 +54,6 @@ OwnedBatch RandomBatch(const envs::EnvSpec& spec, int n, std::mt19937* rng) {
     b.discount.push_back(i % 3 == 0 ? 0.0f : (i % 3 == 1 ? 0.99f : 0.99f * 0.99f * 0.99f));
   }
   return b;
-}
-
-std::vector<float> Flat(const nn::Sequential& net) {
-  std::vector<float> f;
-  net.GetFlat(&f);
-  return f;
-}
-std::vector<float> Flat(const nn::ActionValueNet& net) {
-  std::vector<float> f;
-  net.GetFlat(&f);
-  return f;
 }
 
 // y = r + discount * min(Q1'(s', a'), Q2'(s', a')) with a' = mu'(s') (no smoothing noise),
@@ -300,12 +273,6 @@ envs::EnvSpec CarPixelSpec() {
   return spec;
 }
 
-std::vector<float> FlatOf(const nn::Sequential& net) {
-  std::vector<float> flat;
-  net.GetFlat(&flat);
-  return flat;
-}
-
 TEST(Td3Test, SharedEncoderPolicyIsTheEncoderFollowedByTheActorHead) {
   const envs::EnvSpec spec = CarPixelSpec();
   Td3Config c;
@@ -317,10 +284,10 @@ TEST(Td3Test, SharedEncoderPolicyIsTheEncoderFollowedByTheActorHead) {
   EXPECT_EQ(policy.InputSize(), 4 * 84 * 84);
   EXPECT_EQ(policy.OutputSize(), 3);
   EXPECT_EQ(td3.actor().InputSize(), 512);
-  std::vector<float> joined = FlatOf(td3.encoder());
-  const std::vector<float> head = FlatOf(td3.actor());
+  std::vector<float> joined = Flat(td3.encoder());
+  const std::vector<float> head = Flat(td3.actor());
   joined.insert(joined.end(), head.begin(), head.end());
-  EXPECT_EQ(FlatOf(policy), joined);
+  EXPECT_EQ(Flat(policy), joined);
   // Same actions as the head on the encoder's features.
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> unit(0, 1);
@@ -347,24 +314,24 @@ TEST(Td3Test, SharedEncoderLearnsFromTheCriticsOnly) {
   frozen.critic_learning_rate = 1e-30f;
   frozen.actor_learning_rate = 1e-2f;
   Td3 a(spec, frozen);
-  const std::vector<float> encoder_before = FlatOf(a.encoder());
-  const std::vector<float> head_before = FlatOf(a.actor());
+  const std::vector<float> encoder_before = Flat(a.encoder());
+  const std::vector<float> head_before = Flat(a.actor());
   a.Update(b.view(3));
   EXPECT_EQ(a.actor_updates(), 1);
-  EXPECT_EQ(FlatOf(a.encoder()), encoder_before);  // The actor's loss does not reach it.
-  EXPECT_NE(FlatOf(a.actor()), head_before);
+  EXPECT_EQ(Flat(a.encoder()), encoder_before);  // The actor's loss does not reach it.
+  EXPECT_NE(Flat(a.actor()), head_before);
   // With a real critic learning rate the encoder moves.
   Td3Config learning = frozen;
   learning.critic_learning_rate = 1e-3f;
   Td3 c(spec, learning);
-  const std::vector<float> before = FlatOf(c.encoder());
+  const std::vector<float> before = Flat(c.encoder());
   c.Update(b.view(3));
-  EXPECT_NE(FlatOf(c.encoder()), before);
+  EXPECT_NE(Flat(c.encoder()), before);
   // The broadcast policy follows both parts.
-  std::vector<float> joined = FlatOf(c.encoder());
-  const std::vector<float> head = FlatOf(c.actor());
+  std::vector<float> joined = Flat(c.encoder());
+  const std::vector<float> head = Flat(c.actor());
   joined.insert(joined.end(), head.begin(), head.end());
-  EXPECT_EQ(FlatOf(c.policy()), joined);
+  EXPECT_EQ(Flat(c.policy()), joined);
 }
 
 TEST(Td3Test, SharedEncoderNeedsCarRacingStacks) {
@@ -406,7 +373,7 @@ TEST(Td3Test, RestoredStateContinuesBitForBit) {
       const UpdateResult rb = restored.Update(b.view(width));
       EXPECT_EQ(ra.loss, rb.loss);
     }
-    EXPECT_EQ(FlatOf(a.policy()), FlatOf(restored.policy()));
+    EXPECT_EQ(Flat(a.policy()), Flat(restored.policy()));
     // Another architecture is refused.
     Td3Config other = c;
     other.hidden = {8, 8};

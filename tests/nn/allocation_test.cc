@@ -35,6 +35,24 @@ int64_t AllocationsOfRepeats(int warmup, int repeats, Work&& work) {
   return AllocationCount() - before;
 }
 
+// A batch for an update of a network: random non-negative inputs (as pixels are) and random
+// gradients of its outputs.
+struct Batch {
+  Matrix x;
+  Matrix dq;
+};
+
+Batch RandomBatch(const Sequential& net, int batch, std::mt19937* rng) {
+  return {RandomMatrix(net.InputSize(), batch, rng).cwiseAbs(),
+          RandomMatrix(net.OutputSize(), batch, rng)};
+}
+
+// The forward pass and the parameter gradients of one update.
+void ForwardBackwardParams(Sequential* net, const Batch& batch) {
+  net->Forward(batch.x);
+  net->BackwardParams(batch.dq);
+}
+
 TEST(AllocationTest, CounterSeesAllocations) {
   ASSERT_TRUE(AllocationCountingAvailable()) << "this test needs glibc without a sanitizer";
   const int64_t before = AllocationCount();
@@ -161,18 +179,14 @@ TEST(AllocationTest, PixelNetworksDoNotAllocateWithTwoThreads) {
   Sequential nature_actor = nature;
   Sequential grasp_actor = grasp;
   const int64_t sections = internal::ParallelSections();
-  const Matrix nature_x = RandomMatrix(nature.InputSize(), 4, &rng).cwiseAbs();
-  const Matrix grasp_x = RandomMatrix(grasp.InputSize(), 32, &rng).cwiseAbs();
-  const Matrix nature_dq = RandomMatrix(7, 4, &rng);
-  const Matrix grasp_dq = RandomMatrix(7, 32, &rng);
+  const Batch nature_batch = RandomBatch(nature, 4, &rng);
+  const Batch grasp_batch = RandomBatch(grasp, 32, &rng);
   int sum = 0;
   const int64_t allocations = AllocationsOfRepeats(1, 3, [&] {
-    nature.Forward(nature_x);
-    nature.BackwardParams(nature_dq);
-    grasp.Forward(grasp_x);
-    grasp.BackwardParams(grasp_dq);
-    sum += nature_actor.Argmax(nature_x.data(), nature.InputSize()) +
-           grasp_actor.Argmax(grasp_x.data(), grasp.InputSize());
+    ForwardBackwardParams(&nature, nature_batch);
+    ForwardBackwardParams(&grasp, grasp_batch);
+    sum += nature_actor.Argmax(nature_batch.x.data(), nature.InputSize()) +
+           grasp_actor.Argmax(grasp_batch.x.data(), grasp.InputSize());
   });
   SetNumThreads(1);
   EXPECT_EQ(allocations, 0) << sum;
@@ -193,17 +207,14 @@ TEST(AllocationTest, Bf16NetworksDoNotAllocateOnEveryPath) {
       nature.set_precision(Precision::kBf16);
       mlp.set_precision(Precision::kBf16);
       Sequential actor = nature;
-      const Matrix nature_x = RandomMatrix(nature.InputSize(), 4, &rng).cwiseAbs();
-      const Matrix nature_dq = RandomMatrix(7, 4, &rng);
-      const Matrix mlp_x = RandomMatrix(10, 256, &rng);
-      const Matrix mlp_dq = RandomMatrix(1, 256, &rng);
+      const Batch nature_batch = RandomBatch(nature, 4, &rng);
+      const Batch mlp_batch = RandomBatch(mlp, 256, &rng);
       int sum = 0;
       const int64_t allocations = AllocationsOfRepeats(2, 3, [&] {
-        nature.Forward(nature_x);
-        nature.BackwardParams(nature_dq);
-        mlp.Forward(mlp_x);
-        mlp.Backward(mlp_dq);
-        sum += actor.Argmax(nature_x.data(), nature.InputSize());
+        ForwardBackwardParams(&nature, nature_batch);
+        mlp.Forward(mlp_batch.x);
+        mlp.Backward(mlp_batch.dq);
+        sum += actor.Argmax(nature_batch.x.data(), nature.InputSize());
       });
       EXPECT_EQ(allocations, 0) << path << ", " << threads << " threads " << sum;
     }

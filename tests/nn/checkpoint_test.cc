@@ -15,22 +15,20 @@
 
 #include "nn/presets.h"
 #include "nn/sequential.h"
+#include "tests/common/error_of.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::nn {
 namespace {
 
 namespace fs = std::filesystem;
 
-// Gives each test an empty directory of its own and removes it afterwards.
-class CheckpointTest : public ::testing::Test {
+class CheckpointTest : public TempDirTest {
  protected:
   void SetUp() override {
-    std::string tmpl = ::testing::TempDir() + "nn_checkpoint_test_XXXXXX";
-    ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-    dir_ = tmpl;
+    TempDirTest::SetUp();
     path_ = (dir_ / "model.ckpt").string();
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   static Checkpoint MakeCheckpoint() {
     std::mt19937 rng(17);
@@ -61,17 +59,12 @@ class CheckpointTest : public ::testing::Test {
     }
     return names;
   }
-  // The message of the runtime_error LoadCheckpoint throws, or "" if it does not throw.
+  // The message of the error LoadCheckpoint throws, which must be a std::runtime_error.
   std::string LoadError() const {
-    try {
-      LoadCheckpoint(path_);
-    } catch (const std::runtime_error& e) {
-      return e.what();
-    }
-    return "";
+    EXPECT_THROW(LoadCheckpoint(path_), std::runtime_error);
+    return ErrorOf([this] { LoadCheckpoint(path_); });
   }
 
-  fs::path dir_;
   std::string path_;
 };
 

@@ -10,6 +10,7 @@
 
 #include "tests/nn/gradient_check.h"
 #include "tests/nn/kernel_paths.h"
+#include "tests/nn/layer_gradient_check.h"
 
 namespace rl::nn {
 namespace {
@@ -143,15 +144,9 @@ void CheckGradients(const ConvCase& g, int batch) {
   SCOPED_TRACE(g.Name() + " batch " + std::to_string(batch));
   std::mt19937 rng(static_cast<unsigned>(g.kernel * 100 + g.stride * 10 + g.padding + batch));
   Conv2d conv = g.Make(&rng);
-  Matrix x = RandomMatrix(conv.input_size(), batch, &rng);
+  const Matrix x = RandomMatrix(conv.input_size(), batch, &rng);
   const Matrix r = RandomMatrix(conv.output_size(), batch, &rng);
-  auto loss = [&] { return Dot(r, conv.Forward(x)); };
-
-  conv.Forward(x);
-  const Matrix dx = conv.Backward(r);
-  ExpectGradientsClose(dx, NumericalGradient(loss, &x), "input");
-  ExpectGradientsClose(conv.weight_grad(), NumericalGradient(loss, &conv.weight()), "weight");
-  ExpectGradientsClose(conv.bias_grad(), NumericalGradient(loss, &conv.bias()), "bias");
+  ExpectWeightAndBiasGradientsMatch(&conv, x, r);
 
   // BackwardParams() adds the same parameter gradients.
   const Matrix dw = conv.weight_grad();

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/nn/gradient_check.h"
+#include "tests/nn/layer_gradient_check.h"
 
 namespace rl::nn {
 namespace {
@@ -31,14 +32,9 @@ TEST(LayerNormTest, GradientsMatchFiniteDifferences) {
   LayerNorm ln(7);
   ln.weight() = RandomMatrix(7, 1, &rng) + Matrix::Constant(7, 1, 1.0f);
   ln.bias() = RandomMatrix(7, 1, &rng);
-  Matrix x = RandomMatrix(7, 5, &rng, 2.0f);
+  const Matrix x = RandomMatrix(7, 5, &rng, 2.0f);
   const Matrix r = RandomMatrix(7, 5, &rng);
-  auto loss = [&] { return Dot(r, ln.Forward(x)); };
-  ln.Forward(x);
-  const Matrix dx = ln.Backward(r);
-  ExpectGradientsClose(dx, NumericalGradient(loss, &x), "input");
-  ExpectGradientsClose(ln.weight_grad(), NumericalGradient(loss, &ln.weight()), "weight");
-  ExpectGradientsClose(ln.bias_grad(), NumericalGradient(loss, &ln.bias()), "bias");
+  ExpectWeightAndBiasGradientsMatch(&ln, x, r);
 }
 
 TEST(LayerNormTest, DescribesItselfAndRejectsZeroFeatures) {

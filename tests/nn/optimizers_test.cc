@@ -1,5 +1,6 @@
 #include "nn/optimizers.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -44,28 +45,19 @@ TEST(AdamTest, FirstTwoStepsMatchPyTorchUpdateRule) {
 struct RmsCase {
   bool centered;
   float momentum;
-  double step1[2];
-  double step2[2];
+  std::array<double, 2> step1;
+  std::array<double, 2> step2;
 };
 
 TEST(RmsPropTest, FirstTwoStepsMatchPyTorchUpdateRule) {
+  // The first step does not depend on the momentum: its buffer starts at zero.
+  constexpr std::array<double, 2> kPlainStep1 = {0.900000019999996, -1.9000000999999};
+  constexpr std::array<double, 2> kCenteredStep1 = {0.899496238676095, -1.8994963194840784};
   const RmsCase cases[] = {
-      {false,
-       0.0f,
-       {0.900000019999996, -1.9000000999999},
-       {0.8626998346269039, -1.9949158695451294}},
-      {true,
-       0.0f,
-       {0.899496238676095, -1.8994963194840784},
-       {0.8618787112241529, -1.9946045995978066}},
-      {false,
-       0.9f,
-       {0.900000019999996, -1.9000000999999},
-       {0.7726998526269003, -1.9049159595450393}},
-      {true,
-       0.9f,
-       {0.899496238676095, -1.8994963194840784},
-       {0.7714253260326385, -1.9041512871334771}},
+      {false, 0.0f, kPlainStep1, {0.8626998346269039, -1.9949158695451294}},
+      {true, 0.0f, kCenteredStep1, {0.8618787112241529, -1.9946045995978066}},
+      {false, 0.9f, kPlainStep1, {0.7726998526269003, -1.9049159595450393}},
+      {true, 0.9f, kCenteredStep1, {0.7714253260326385, -1.9041512871334771}},
   };
   for (const RmsCase& c : cases) {
     SCOPED_TRACE(::testing::Message() << "centered " << c.centered << " momentum " << c.momentum);

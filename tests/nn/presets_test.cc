@@ -1,7 +1,9 @@
 #include "nn/presets.h"
 
+#include <initializer_list>
 #include <random>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -16,6 +18,24 @@ std::vector<float> Flat(const Sequential& net) {
   std::vector<float> flat;
   net.GetFlat(&flat);
   return flat;
+}
+
+// Expects the image shape after each listed layer (layer index, shape).
+void ExpectLayerShapes(const Sequential& net,
+                       std::initializer_list<std::pair<int, ImageShape>> shapes) {
+  for (const auto& [layer, shape] : shapes) {
+    EXPECT_EQ(net.layer(layer).output_shape(), shape) << "layer " << layer;
+  }
+}
+
+// Runs `batch` random observations in [0, 1] through *net: a column of `actions` finite
+// Q-values each.
+void ExpectQValues(Sequential* net, int actions, int batch, std::mt19937* rng) {
+  const Matrix x = RandomMatrix(net->InputSize(), batch, rng, 0.5f).array() + 0.5f;
+  const Matrix& q = net->Forward(x);
+  EXPECT_EQ(q.rows(), actions);
+  EXPECT_EQ(q.cols(), batch);
+  EXPECT_TRUE(q.allFinite());
 }
 
 TEST(PresetsTest, NatureCnnHasThePyTorchShapesAndParameterCount) {
@@ -38,12 +58,7 @@ TEST(PresetsTest, NatureCnnHasThePyTorchShapesAndParameterCount) {
   EXPECT_EQ(net.NumBuffers(), 0);
   EXPECT_EQ(net.Params()[0].value->rows(), 4 * 8 * 8);
   EXPECT_EQ(net.Params()[0].value->cols(), 32);
-
-  const Matrix x = RandomMatrix(net.InputSize(), 3, &rng, 0.5f).array() + 0.5f;
-  const Matrix& q = net.Forward(x);
-  EXPECT_EQ(q.rows(), 7);
-  EXPECT_EQ(q.cols(), 3);
-  EXPECT_TRUE(q.allFinite());
+  ExpectQValues(&net, 7, 3, &rng);
 }
 
 TEST(PresetsTest, GraspCnnHasThePyTorchShapesAndParameterCount) {
@@ -52,9 +67,8 @@ TEST(PresetsTest, GraspCnnHasThePyTorchShapesAndParameterCount) {
   EXPECT_EQ(net.Architecture(), GraspCnnArchitecture(7, 4));
   EXPECT_EQ(net.InputSize(), 4 * 40 * 40);
   // 40 -> 9 -> 3 -> 1.
-  EXPECT_EQ(net.layer(0).output_shape(), (ImageShape{32, 9, 9}));
-  EXPECT_EQ(net.layer(3).output_shape(), (ImageShape{64, 3, 3}));
-  EXPECT_EQ(net.layer(6).output_shape(), (ImageShape{64, 1, 1}));
+  ExpectLayerShapes(net, {{0, {32, 9, 9}}, {3, {64, 3, 3}}, {6, {64, 1, 1}}});
+  ExpectQValues(&net, 7, 5, &rng);
   const int64_t expected = (4 * 32 * 8 * 8 + 32)     // conv1: 8,224
                            + 2 * 32                  // bn1 weight and bias: 64
                            + (32 * 64 * 4 * 4 + 64)  // conv2: 32,832
@@ -66,11 +80,6 @@ TEST(PresetsTest, GraspCnnHasThePyTorchShapesAndParameterCount) {
   EXPECT_EQ(net.NumParams(), 115047);
   EXPECT_EQ(net.NumBuffers(), 2 * 32 + 2 * 64);
   EXPECT_EQ(MakeGraspCnn(3, &rng, /*in_channels=*/1).InputSize(), 40 * 40);
-
-  const Matrix x = RandomMatrix(net.InputSize(), 5, &rng, 0.5f).array() + 0.5f;
-  const Matrix& q = net.Forward(x);
-  EXPECT_EQ(q.rows(), 7);
-  EXPECT_EQ(q.cols(), 5);
 }
 
 TEST(PresetsTest, Grasp48CnnKeepsASixBySixMap) {
@@ -78,10 +87,6 @@ TEST(PresetsTest, Grasp48CnnKeepsASixBySixMap) {
   Sequential net = MakeGrasp48Cnn(7, &rng);
   EXPECT_EQ(net.Architecture(), Grasp48CnnArchitecture(7, 4));
   EXPECT_EQ(net.InputSize(), 4 * 48 * 48);
-  // 48 -> 24 -> 12 -> 6.
-  EXPECT_EQ(net.layer(0).output_shape(), (ImageShape{16, 24, 24}));
-  EXPECT_EQ(net.layer(2).output_shape(), (ImageShape{32, 12, 12}));
-  EXPECT_EQ(net.layer(4).output_shape(), (ImageShape{32, 6, 6}));
   const int64_t expected = (4 * 16 * 5 * 5 + 16)     // conv1: 1,616
                            + (16 * 32 * 3 * 3 + 32)  // conv2: 4,640
                            + (32 * 32 * 3 * 3 + 32)  // conv3: 9,248
@@ -90,14 +95,12 @@ TEST(PresetsTest, Grasp48CnnKeepsASixBySixMap) {
   EXPECT_EQ(expected, 312471);
   EXPECT_EQ(net.NumParams(), 312471);
   EXPECT_EQ(net.NumBuffers(), 0);
+  // 48 -> 24 -> 12 -> 6.
+  ExpectLayerShapes(net, {{0, {16, 24, 24}}, {2, {32, 12, 12}}, {4, {32, 6, 6}}});
   EXPECT_EQ(MakeGrasp48Cnn(3, &rng, /*in_channels=*/1).InputSize(), 48 * 48);
   const Sequential dueling = MakeGrasp48Cnn(7, &rng, 4, /*dueling=*/true);
   EXPECT_NE(dueling.Architecture().find("flatten,dueling(1152,256,7)"), std::string::npos);
-
-  const Matrix x = RandomMatrix(net.InputSize(), 5, &rng, 0.5f).array() + 0.5f;
-  const Matrix& q = net.Forward(x);
-  EXPECT_EQ(q.rows(), 7);
-  EXPECT_EQ(q.cols(), 5);
+  ExpectQValues(&net, 7, 5, &rng);
   EXPECT_THROW(Grasp48CnnArchitecture(0), std::invalid_argument);
   EXPECT_THROW(MakeGrasp48Cnn(3, &rng, 0), std::invalid_argument);
 }

@@ -29,10 +29,11 @@ std::vector<float> Flat(const Sequential& net) {
 
 // Expects BuildFromArchitecture to throw std::invalid_argument for each architecture string,
 // with a message that contains the case's text.
-void ExpectRefused(std::span<const std::pair<std::string, std::string>> cases, std::mt19937* rng) {
+void ExpectRefused(std::span<const std::pair<std::string, std::string>> cases) {
+  std::mt19937 rng(0);
   for (const auto& [arch, message] : cases) {
     try {
-      BuildFromArchitecture(arch, rng);
+      BuildFromArchitecture(arch, &rng);
       ADD_FAILURE() << "no exception for '" << arch << "'";
     } catch (const std::invalid_argument& e) {
       EXPECT_NE(std::string(e.what()).find(message), std::string::npos)
@@ -78,7 +79,6 @@ TEST(SequentialTest, SameSeedBuildsIdenticalNetworks) {
 }
 
 TEST(SequentialTest, MalformedArchitecturesThrowWithTheOffendingLayer) {
-  std::mt19937 rng(0);
   const std::pair<std::string, std::string> cases[] = {
       {"", "no layers"},
       {"linear(4)", "needs linear(in,out)"},
@@ -92,14 +92,13 @@ TEST(SequentialTest, MalformedArchitecturesThrowWithTheOffendingLayer) {
       {"linear(4,8)x", "text after ')'"},
       {"linear(4,8),relu,linear(7,2)", "expects 7 inputs but the previous layer produces 8"},
   };
-  ExpectRefused(cases, &rng);
+  ExpectRefused(cases);
 }
 
 // Strings from checkpoint files and weight messages: sizes that would overflow an int or
 // allocate gigabytes are refused before anything is built (each one was undefined behaviour or a
 // 16 GB allocation). Found by fuzz/fuzz_checkpoint.
 TEST(SequentialTest, BuildFromArchitectureRefusesSizesBeyondItsLimits) {
-  std::mt19937 rng(1);
   const std::pair<std::string, std::string> cases[] = {
       {"linear(65535,65535)", "more than 67108864 parameters"},
       {"linear(4,8),relu,linear(8,70000)", "70000 is above the limit of 65536"},
@@ -108,8 +107,9 @@ TEST(SequentialTest, BuildFromArchitectureRefusesSizesBeyondItsLimits) {
       {"batchnorm2d(1,50000,50000)", "an image of more than 67108864 values"},
       {"maxpool2d(1,1,50000,50000),flatten,linear(1,1)", "an image of more than 67108864 values"},
   };
-  ExpectRefused(cases, &rng);
+  ExpectRefused(cases);
   // The largest network of ours is far below the limits.
+  std::mt19937 rng(1);
   EXPECT_NO_THROW(BuildFromArchitecture(
       "conv2d(4,32,8,4,0,84,84),relu,conv2d(32,64,4,2,0,20,20),relu,conv2d(64,64,3,1,0,9,9),relu,"
       "flatten,linear(3136,512),relu,linear(512,18)",
@@ -395,7 +395,6 @@ TEST(SequentialTest, ArchitecturesWithEveryLayerKindRoundTrip) {
 }
 
 TEST(SequentialTest, MalformedConvolutionalArchitecturesThrowWithTheOffendingLayer) {
-  std::mt19937 rng(0);
   const std::pair<std::string, std::string> cases[] = {
       {"conv2d(4,32,8,4,0,84)", "needs conv2d(in_channels,out_channels,kernel,stride,padding,"},
       {"conv2d(4,32,8,4,-1,84,84)", "'-1' is not a non-negative integer"},
@@ -410,7 +409,7 @@ TEST(SequentialTest, MalformedConvolutionalArchitecturesThrowWithTheOffendingLay
        "expects 16x40x20 images but the previous layers produce 32x20x20"},
       {"maxpool(2)", "unknown layer 0 'maxpool' (known: linear(in,out), conv2d("},
   };
-  ExpectRefused(cases, &rng);
+  ExpectRefused(cases);
 }
 
 TEST(SequentialTest, BuffersFollowTheParametersInGetFlat) {

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -12,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "evaluator/report.h"
+#include "tests/common/error_of.h"
 
 namespace rl::tools {
 namespace {
@@ -47,19 +49,32 @@ class CompareRunsTest : public ::testing::Test {
     return dir.string();
   }
 
-  static void AddEval(const std::string& dir, int64_t update, int64_t steps, double wall,
-                      double mean, double std = 10) {
-    EvalRecord r;
-    r.checkpoint = "ckpt-" + std::to_string(update) + ".bin";
-    r.update = update;
-    r.env_steps = steps;
-    r.wall_seconds = wall;
-    r.mean = mean;
-    r.std = std;
-    r.min = mean - std;
-    r.max = mean + std;
-    r.episodes = 100;
-    evaluator::AppendJsonLine(dir + "/eval.jsonl", r);
+  // One evaluation of a run: a checkpoint's update, env steps and wall seconds, and the mean
+  // score of its episodes with their standard deviation.
+  struct Eval {
+    int64_t update;
+    int64_t steps;
+    double wall;
+    double mean;
+    double std = 10;
+  };
+
+  // Appends `evals` to dir/eval.jsonl as the evaluator writes them (100 episodes each, min and
+  // max one standard deviation from the mean).
+  static void AddEvals(const std::string& dir, std::initializer_list<Eval> evals) {
+    for (const Eval& e : evals) {
+      EvalRecord r;
+      r.checkpoint = "ckpt-" + std::to_string(e.update) + ".bin";
+      r.update = e.update;
+      r.env_steps = e.steps;
+      r.wall_seconds = e.wall;
+      r.mean = e.mean;
+      r.std = e.std;
+      r.min = e.mean - e.std;
+      r.max = e.mean + e.std;
+      r.episodes = 100;
+      evaluator::AppendJsonLine(dir + "/eval.jsonl", r);
+    }
   }
 
   static std::string Read(const fs::path& path) {
@@ -110,8 +125,7 @@ class CompareRunsTest : public ::testing::Test {
 
 TEST_F(CompareRunsTest, LoadsThePresetEnvGoalSeedAndEvaluations) {
   const std::string dir = MakeRun("cartpole-1", "cartpole", "CartPole-v1", 3, 475);
-  AddEval(dir, 500, 10000, 4.5, 120);
-  AddEval(dir, 1000, 20000, 9.0, 480.5);
+  AddEvals(dir, {{500, 10000, 4.5, 120}, {1000, 20000, 9.0, 480.5}});
   const CompareRun run = LoadCompareRun(dir);
   EXPECT_EQ(run.preset, "cartpole");
   EXPECT_EQ(run.env_id, "CartPole-v1");
@@ -123,13 +137,10 @@ TEST_F(CompareRunsTest, LoadsThePresetEnvGoalSeedAndEvaluations) {
 }
 
 TEST_F(CompareRunsTest, RefusesFoldersThatAreNotScoredRuns) {
+  // The message of the error LoadCompareRun throws, which must be a std::runtime_error.
   const auto message = [](const std::string& dir) {
-    try {
-      LoadCompareRun(dir);
-    } catch (const std::runtime_error& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
+    EXPECT_THROW(LoadCompareRun(dir), std::runtime_error) << dir;
+    return ErrorOf([&] { LoadCompareRun(dir); });
   };
   EXPECT_NE(message((root_ / "missing").string()).find("not a folder"), std::string::npos);
   fs::create_directories(root_ / "bare");
@@ -149,10 +160,7 @@ TEST_F(CompareRunsTest, RefusesFoldersThatAreNotScoredRuns) {
 
 TEST_F(CompareRunsTest, BestSoFarStepsAtEveryImprovementAndEndsAtTheLastEvaluation) {
   const std::string dir = MakeRun("r", "cartpole", "CartPole-v1", 1, 475);
-  AddEval(dir, 4, 400, 4, 15);
-  AddEval(dir, 1, 100, 1, 10);
-  AddEval(dir, 2, 200, 2, 5);
-  AddEval(dir, 3, 300, 3, 20);
+  AddEvals(dir, {{4, 400, 4, 15}, {1, 100, 1, 10}, {2, 200, 2, 5}, {3, 300, 3, 20}});
   const CompareRun run = LoadCompareRun(dir);
   const std::vector<StepPoint> steps = BestSoFar(run, CurveAxis::kEnvSteps);
   ASSERT_EQ(steps.size(), 3u);
@@ -186,11 +194,11 @@ TEST_F(CompareRunsTest, CombinesStepsFromWhereEveryRunHasAValueAndHoldsTheirLast
 
 TEST_F(CompareRunsTest, SummarizesBestFinalAndTheFirstEvaluationAtTheGoal) {
   const std::string dir = MakeRun("r", "cartpole", "CartPole-v1", 1, 475);
-  AddEval(dir, 500, 10000, 5, 300);
-  AddEval(dir, 1000, 20000, 10, 476);
-  AddEval(dir, 1500, 30000, 15, 490);
-  AddEval(dir, 2000, 40000, 20, 490);
-  AddEval(dir, 2500, 50000, 25, 410);
+  AddEvals(dir, {{500, 10000, 5, 300},
+                 {1000, 20000, 10, 476},
+                 {1500, 30000, 15, 490},
+                 {2000, 40000, 20, 490},
+                 {2500, 50000, 25, 410}});
   const RunSummary s = Summarize(LoadCompareRun(dir));
   EXPECT_EQ(s.evaluations, 5);
   EXPECT_EQ(s.best.update, 1500);
@@ -215,12 +223,10 @@ TEST_F(CompareRunsTest, LabelsRunsOfTheSameNameByTheirParentFolders) {
 
 TEST_F(CompareRunsTest, PageOfTwoRunsShowsBothRunsTheirGroupAndTheirSummaryNumbers) {
   const std::string one = MakeRun("cartpole-seed1", "cartpole", "CartPole-v1", 1, 475);
-  AddEval(one, 500, 12000, 6.5, 150.25);
-  AddEval(one, 1000, 24690, 42.2, 480.5, 12);
-  AddEval(one, 1500, 37035, 63, 470);
+  AddEvals(one,
+           {{500, 12000, 6.5, 150.25}, {1000, 24690, 42.2, 480.5, 12}, {1500, 37035, 63, 470}});
   const std::string two = MakeRun("cartpole-seed2", "cartpole", "CartPole-v1", 2, 475);
-  AddEval(two, 500, 11000, 5.1, 311.9, 20);
-  AddEval(two, 1000, 22000, 150, 200);
+  AddEvals(two, {{500, 11000, 5.1, 311.9, 20}, {1000, 22000, 150, 200}});
   fs::create_directories(one + "/report");
   std::ofstream(one + "/report/index.html") << "<!DOCTYPE html>\n";
   std::vector<CompareRun> runs = {LoadCompareRun(one), LoadCompareRun(two)};
@@ -267,12 +273,11 @@ TEST_F(CompareRunsTest, PageOfTwoRunsShowsBothRunsTheirGroupAndTheirSummaryNumbe
 
 TEST_F(CompareRunsTest, RunsOfTwoPresetsFormTwoGroupsAndTwoEnvsGetTheirOwnPlots) {
   const std::string a = MakeRun("a", "cartpole", "CartPole-v1", 1, 475);
-  AddEval(a, 1, 100, 1, 100);
+  AddEvals(a, {{1, 100, 1, 100}});
   const std::string b = MakeRun("b", "pendulum", "Pendulum-v1", 1, -200);
-  AddEval(b, 1, 100, 1, -1200);
-  AddEval(b, 2, 200, 2, -180);
+  AddEvals(b, {{1, 100, 1, -1200}, {2, 200, 2, -180}});
   const std::string c = MakeRun("c", "cartpole_big", "CartPole-v1", 1, 475);
-  AddEval(c, 1, 100, 1, 90);
+  AddEvals(c, {{1, 100, 1, 90}});
   std::vector<CompareRun> runs = {LoadCompareRun(a), LoadCompareRun(b), LoadCompareRun(c)};
   MakeLabelsUnique(&runs);
   const std::string html = RenderComparePage(runs, "");

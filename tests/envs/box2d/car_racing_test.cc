@@ -17,6 +17,7 @@
 #include "envs/pixel_spec.h"
 #include "envs/registry.h"
 #include "envs/wrapper.h"
+#include "tests/envs/image_testing.h"
 
 namespace rl::envs {
 namespace {
@@ -449,16 +450,11 @@ int SpeedBar(const std::vector<uint8_t>& rgb) {
 TEST(CarRacingTest, IndicatorBarShowsTheSpeed) {
   CarRacing env;
   env.Reset(14);
-  std::vector<uint8_t> rgb;
-  int w = 0, h = 0;
-  env.Render(&rgb, &w, &h);
-  const int resting = SpeedBar(rgb);
+  const int resting = SpeedBar(Rendered(env).rgb);
   for (int k = 0; k < 20; ++k) Drive(env, 0, 1, 0);
-  env.Render(&rgb, &w, &h);
-  const int slow = SpeedBar(rgb);
+  const int slow = SpeedBar(Rendered(env).rgb);
   for (int k = 0; k < 30; ++k) Drive(env, 0, 1, 0);
-  env.Render(&rgb, &w, &h);
-  const int fast = SpeedBar(rgb);
+  const int fast = SpeedBar(Rendered(env).rgb);
   EXPECT_LT(resting, 100);
   EXPECT_GT(slow, resting + 250);
   EXPECT_GT(fast, slow + 250);

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/envs/image/scripted_image_env.h"
+#include "tests/envs/image/span_vectors.h"
 
 namespace rl::envs {
 namespace {
@@ -18,9 +19,6 @@ using testing::GrayShape;
 using testing::RgbShape;
 using testing::ScriptedImageEnv;
 using testing::ScriptedStep;
-
-std::vector<float> Floats(std::span<const float> values) { return {values.begin(), values.end()}; }
-std::vector<uint8_t> Bytes(std::span<const uint8_t> image) { return {image.begin(), image.end()}; }
 
 // 2x1 grayscale frames of multiples of 51, so that each byte / 255 is a short decimal:
 // 0 -> 0, 51 -> 0.2, 102 -> 0.4, 153 -> 0.6, 204 -> 0.8, 255 -> 1.

@@ -14,6 +14,7 @@
 #include "envs/catch.h"
 #include "envs/registry.h"
 #include "tests/envs/image/scripted_image_env.h"
+#include "tests/envs/image/span_vectors.h"
 
 namespace rl::envs {
 namespace {
@@ -22,9 +23,6 @@ using testing::GrayRgb;
 using testing::RgbShape;
 using testing::ScriptedImageEnv;
 using testing::ScriptedStep;
-
-std::vector<float> Floats(std::span<const float> values) { return {values.begin(), values.end()}; }
-std::vector<uint8_t> Bytes(std::span<const uint8_t> image) { return {image.begin(), image.end()}; }
 
 // Expects config.Validate() to throw std::invalid_argument with `field` in the message.
 void ExpectInvalid(const std::function<void(ImagePipelineConfig&)>& change, const char* field) {
@@ -243,6 +241,18 @@ std::vector<std::pair<int, int>> CellPixels(int cell, int width,
   return pixels;
 }
 
+// Resets a pixel Catch env with `seed` and returns the ball's column, or -1 if its first frame
+// shows no ball. The frame (a grid of `cell`-pixel squares, `width` pixels wide) must show only
+// the ball in row 0 and the paddle in column 2.
+int ResetAndFindTheBall(Env* env, uint64_t seed, int cell, int width) {
+  env->Reset(seed);
+  const std::vector<std::pair<int, int>> first = BrightPixels(env->frame(), width);
+  if (first.empty()) return -1;
+  const int ball = first.front().first / cell;
+  EXPECT_EQ(first, CellPixels(cell, width, {{0, ball}, {9, 2}}));
+  return ball;
+}
+
 TEST(MakePixelEnvTest, CatchAtItsNativeSizeShowsTheBallAndPaddleCells) {
   ImagePipelineConfig config;
   config.width = 0;
@@ -253,12 +263,9 @@ TEST(MakePixelEnvTest, CatchAtItsNativeSizeShowsTheBallAndPaddleCells) {
   EXPECT_EQ(env->spec().frame_height, 80);
   EXPECT_EQ(env->spec().observation_size, 2 * 40 * 80);
   EXPECT_EQ(env->spec().id, "Catch-v0");
-  env->Reset(11);
   // Which column the ball is in: the bright pixels of row 0 (8 per cell).
-  const auto first = BrightPixels(env->frame(), 40);
-  ASSERT_FALSE(first.empty());
-  const int ball = first.front().first / 8;
-  EXPECT_EQ(first, CellPixels(8, 40, {{0, ball}, {9, 2}}));
+  const int ball = ResetAndFindTheBall(env.get(), 11, 8, 40);
+  ASSERT_GE(ball, 0) << "no ball in the first frame";
   // Left: paddle to column 1, ball to row 1.
   env->Step(DiscreteAction(0));
   EXPECT_EQ(BrightPixels(env->frame(), 40), CellPixels(8, 40, {{1, ball}, {9, 1}}));
@@ -271,12 +278,9 @@ TEST(MakePixelEnvTest, CatchResizedTo20By40ShowsTheCellsAtHalfSize) {
   config.frame_skip = 2;
   auto env = MakePixelEnv(MakeEnv("Catch-v0"), config);
   EXPECT_EQ(env->spec().max_episode_steps, 5);  // ceil(9 / 2).
-  env->Reset(5);
-  const auto first = BrightPixels(env->frame(), 20);
-  ASSERT_FALSE(first.empty());
-  const int ball = first.front().first / 4;
   // Each cell is a 4x4 square of 255: the area mean of a uniform 8x8 cell.
-  EXPECT_EQ(first, CellPixels(4, 20, {{0, ball}, {9, 2}}));
+  const int ball = ResetAndFindTheBall(env.get(), 5, 4, 20);
+  ASSERT_GE(ball, 0) << "no ball in the first frame";
   // Two inner steps to the right. The frame is the max of the two raw frames, so it shows both
   // positions: the ball in rows 1 and 2, the paddle in columns 3 and 4.
   env->Step(DiscreteAction(2));

@@ -11,6 +11,7 @@
 #include "envs/kuka/kuka_objects.h"
 #include "envs/kuka/kuka_renderer.h"
 #include "envs/kuka/kuka_scene.h"
+#include "tests/envs/image_testing.h"
 
 namespace rl::envs::kuka {
 namespace {
@@ -36,14 +37,13 @@ int CountDifferentPixels(const std::vector<uint8_t>& a, const std::vector<uint8_
 TEST(KukaRenderTest, RendersTheNativeSizeAndAnyRequestedSize) {
   KukaDiverseObjectEnv env;
   env.Reset(1);
-  std::vector<uint8_t> rgb;
-  int w = 0, h = 0;
-  env.Render(&rgb, &w, &h);
-  EXPECT_EQ(w, 48);
-  EXPECT_EQ(h, 48);
-  ASSERT_EQ(rgb.size(), 48u * 48 * 3);
+  const Image image = Rendered(env);
+  EXPECT_EQ(image.width, 48);
+  EXPECT_EQ(image.height, 48);
+  ASSERT_EQ(image.rgb.size(), 48u * 48 * 3);
   // The camera looks down at the tray and table: no background left in the middle.
-  EXPECT_FALSE(IsWhite(rgb, 24 * 48 + 24));
+  EXPECT_FALSE(IsWhite(image.rgb, 24 * 48 + 24));
+  std::vector<uint8_t> rgb;
   env.RenderSized(160, 120, &rgb);
   EXPECT_EQ(rgb.size(), 160u * 120 * 3);
   EXPECT_THROW(env.RenderSized(0, 10, &rgb), std::invalid_argument);
@@ -54,12 +54,9 @@ TEST(KukaRenderTest, RendersTheNativeSizeAndAnyRequestedSize) {
 TEST(KukaRenderTest, ImageChangesWhenTheArmMoves) {
   KukaDiverseObjectEnv env;
   env.Reset(2);
-  std::vector<uint8_t> before, after;
-  int w = 0, h = 0;
-  env.Render(&before, &w, &h);
+  const Image before = Rendered(env);
   env.Step(rl::envs::DiscreteAction(2));  // +x and down.
-  env.Render(&after, &w, &h);
-  EXPECT_GT(CountDifferentPixels(before, after), 20);
+  EXPECT_GT(CountDifferentPixels(before.rgb, Rendered(env).rgb), 20);
 }
 
 TEST(KukaRenderTest, ImageChangesWhereAnObjectIsAdded) {
