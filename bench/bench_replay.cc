@@ -797,21 +797,26 @@ int RunPixelLcm(int repeats, double seconds, int port, const std::string& key = 
   return 0;
 }
 
-// VmRSS of this process in bytes (0 when it cannot be read).
-int64_t RssBytes() {
-  std::FILE* f = std::fopen("/proc/self/status", "r");
+// The first line of the /proc file `path` that starts with `field` (e.g. "VmRSS:"), its number
+// of kB in bytes; 0 when the file or the line cannot be read.
+int64_t ProcKbField(const char* path, const char* field) {
+  std::FILE* f = std::fopen(path, "r");
   if (f == nullptr) return 0;
+  const size_t length = std::strlen(field);
   char line[256];
   int64_t kb = 0;
   while (std::fgets(line, sizeof(line), f) != nullptr) {
-    if (std::strncmp(line, "VmRSS:", 6) == 0) {
-      kb = std::atoll(line + 6);
+    if (std::strncmp(line, field, length) == 0) {
+      kb = std::atoll(line + length);
       break;
     }
   }
   std::fclose(f);
   return kb * 1024;
 }
+
+// VmRSS of this process in bytes (0 when it cannot be read).
+int64_t RssBytes() { return ProcKbField("/proc/self/status", "VmRSS:"); }
 
 // pixel_replay_bytes_per_transition[_prioritized]: a PixelTable of kMemoryFill transitions, its
 // own accounting and the process's RSS growth.
@@ -877,20 +882,7 @@ void PixelMemory(bool prioritized) {
 }
 
 // Bytes of this process's anonymous memory in transparent huge pages (0 when unknown).
-int64_t AnonHugePageBytes() {
-  std::FILE* f = std::fopen("/proc/self/smaps_rollup", "r");
-  if (f == nullptr) return 0;
-  char line[256];
-  int64_t kb = 0;
-  while (std::fgets(line, sizeof(line), f) != nullptr) {
-    if (std::strncmp(line, "AnonHugePages:", 14) == 0) {
-      kb = std::atoll(line + 14);
-      break;
-    }
-  }
-  std::fclose(f);
-  return kb * 1024;
-}
+int64_t AnonHugePageBytes() { return ProcKbField("/proc/self/smaps_rollup", "AnonHugePages:"); }
 
 // Snapshots of a full table: `insert` stores one batch and returns its transitions, `save` adds
 // the table to a snapshot. Emits the pause and write rows for `name`.

@@ -112,16 +112,23 @@ rlmsg::sample_batch_t PixelSamples() {
 rlmsg::priority_update_t Priorities() { return rl::examples::Example<rlmsg::priority_update_t>(); }
 rlmsg::weights_chunk_t Chunk() { return rl::examples::WeightsChunk("linear(4,2)", 10, 1, 0); }
 
+// A target on `channel` whose well-formed message is make() and whose invalid one is make() with
+// break_it() applied.
+template <class Make, class Break>
+Target Broken(const char* channel, Make make, Break break_it) {
+  return {channel, [make](const rlmsg::header_t& r) { return Encode(make(), r); },
+          [make, break_it](const rlmsg::header_t& r) {
+            auto m = make();
+            break_it(m);
+            return Encode(m, r);
+          }};
+}
+
 std::vector<Target> Targets() {
   const float nan = std::nanf("");
   std::vector<Target> t;
-  t.push_back({rl::channels::kTransitions,
-               [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
-               [nan](const rlmsg::header_t& r) {
-                 auto m = Transitions();
-                 m.reward[0] = nan;
-                 return Encode(m, r);
-               }});
+  t.push_back(
+      Broken(rl::channels::kTransitions, Transitions, [nan](auto& m) { m.reward[0] = nan; }));
   t.push_back({rl::channels::kSampleRequest,
                [](const rlmsg::header_t& r) {
                  rlmsg::sample_request_t m{};
@@ -134,66 +141,27 @@ std::vector<Target> Targets() {
                  m.batch_size = -5;
                  return Encode(m, r);
                }});
-  t.push_back({rl::channels::kSamples,
-               [](const rlmsg::header_t& r) { return Encode(Samples(), r); },
-               [nan](const rlmsg::header_t& r) {
-                 auto m = Samples();
-                 m.obs[0] = nan;
-                 return Encode(m, r);
-               }});
-  t.push_back({rl::channels::kTransitions,
-               [](const rlmsg::header_t& r) { return Encode(PixelTransitions(), r); },
-               [](const rlmsg::header_t& r) {
-                 auto m = PixelTransitions();
-                 m.frame_id = {1, 0};  // ids must increase
-                 return Encode(m, r);
-               }});
+  t.push_back(Broken(rl::channels::kSamples, Samples, [nan](auto& m) { m.obs[0] = nan; }));
+  // Frame ids must increase.
+  t.push_back(Broken(rl::channels::kTransitions, PixelTransitions, [](auto& m) {
+    m.frame_id = {1, 0};
+  }));
   // The action fields: a NaN action (refused by every receiver's check), and actions that are
   // well-formed but not the run env's (refused by the replay, which knows the env): a value far
   // out of range (an index for a discrete env, a bound for a continuous one), and one action
   // value too many. Each counts as one invalid message.
-  t.push_back({rl::channels::kTransitions,
-               [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
-               [nan](const rlmsg::header_t& r) {
-                 auto m = Transitions();
-                 m.action[0] = nan;
-                 return Encode(m, r);
-               }});
-  t.push_back({rl::channels::kTransitions,
-               [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
-               [](const rlmsg::header_t& r) {
-                 auto m = Transitions();
-                 m.action[0] = 99;
-                 return Encode(m, r);
-               }});
-  t.push_back({rl::channels::kTransitions,
-               [](const rlmsg::header_t& r) { return Encode(Transitions(), r); },
-               [](const rlmsg::header_t& r) {
-                 auto m = Transitions();
-                 m.action.push_back(m.action[0]);
-                 m.action_width = m.num_action_values = static_cast<int32_t>(m.action.size());
-                 return Encode(m, r);
-               }});
-  t.push_back({rl::channels::kPriorities,
-               [](const rlmsg::header_t& r) { return Encode(Priorities(), r); },
-               [nan](const rlmsg::header_t& r) {
-                 auto m = Priorities();
-                 m.priority[0] = nan;
-                 return Encode(m, r);
-               }});
-  t.push_back({rl::channels::kSamples,
-               [](const rlmsg::header_t& r) { return Encode(PixelSamples(), r); },
-               [](const rlmsg::header_t& r) {
-                 auto m = PixelSamples();
-                 m.discount[0] = 2;  // outside [0, 1]
-                 return Encode(m, r);
-               }});
-  t.push_back({rl::channels::kWeights, [](const rlmsg::header_t& r) { return Encode(Chunk(), r); },
-               [](const rlmsg::header_t& r) {
-                 auto m = Chunk();
-                 m.chunk_index = 3;
-                 return Encode(m, r);
-               }});
+  t.push_back(
+      Broken(rl::channels::kTransitions, Transitions, [nan](auto& m) { m.action[0] = nan; }));
+  t.push_back(Broken(rl::channels::kTransitions, Transitions, [](auto& m) { m.action[0] = 99; }));
+  t.push_back(Broken(rl::channels::kTransitions, Transitions, [](auto& m) {
+    m.action.push_back(m.action[0]);
+    m.action_width = m.num_action_values = static_cast<int32_t>(m.action.size());
+  }));
+  t.push_back(
+      Broken(rl::channels::kPriorities, Priorities, [nan](auto& m) { m.priority[0] = nan; }));
+  // A discount outside [0, 1].
+  t.push_back(Broken(rl::channels::kSamples, PixelSamples, [](auto& m) { m.discount[0] = 2; }));
+  t.push_back(Broken(rl::channels::kWeights, Chunk, [](auto& m) { m.chunk_index = 3; }));
   t.push_back({rl::channels::kFlow,
                [](const rlmsg::header_t& r) {
                  rlmsg::flow_control_t m{};

@@ -26,10 +26,29 @@ class ActorTest : public ::testing::Test {
     bus_.Subscribe<rlmsg::transition_batch_t>(
         channels::kTransitions,
         [this](const rlmsg::transition_batch_t& m) { batches_.push_back(m); });
+    bus_.Subscribe<rlmsg::stats_actor_t>(
+        channels::kStatsActor, [this](const rlmsg::stats_actor_t& s) { stats_.push_back(s); });
   }
+
+  // Publishes `f` as the replay's flow message and delivers it.
+  void SendFlow(rlmsg::flow_control_t* f) {
+    bus_.Publish(channels::kFlow, f);
+    bus_.Handle(0);
+  }
+
+  // Publishes version `version` of `net`'s parameters `flat` as the learner does (in chunks) and
+  // delivers them.
+  void SendWeights(int64_t version, const nn::Sequential& net, const std::vector<float>& flat) {
+    for (auto& c : learner::MakeWeightChunks(version, net.Architecture(), flat)) {
+      bus_.Publish(channels::kWeights, &c, Port::kBulk);
+    }
+    bus_.Handle(0);
+  }
+
   Bus bus_;
   ActorConfig config_;
   std::vector<rlmsg::transition_batch_t> batches_;
+  std::vector<rlmsg::stats_actor_t> stats_;
 };
 
 TEST_F(ActorTest, PublishesFullBatchesOfConsistentTransitions) {
@@ -61,13 +80,11 @@ TEST_F(ActorTest, PausesWhenTheReplayAsksAndResumesAfter) {
   EXPECT_TRUE(actor.paused()) << "before the replay's first flow message";
   rlmsg::flow_control_t f{};
   f.insert_allowed = 0;
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_TRUE(actor.paused());
   f.insert_allowed = 1;
   f.insert_credit = -1;  // the ratio is not enforced
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_FALSE(actor.paused());
 }
 
@@ -84,8 +101,7 @@ TEST_F(ActorTest, PausesAtItsShareOfTheInsertCredit) {
   f.num_actors = 2;
   f.actor_id = {0, 1};
   f.actor_inserts = {500, 16};  // 16 of this actor's 32 are still on the way
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_EQ(actor.insert_limit(), 32 + 21 - 16);
   EXPECT_FALSE(actor.paused());
   while (!actor.paused()) actor.StepEnvs();
@@ -93,8 +109,7 @@ TEST_F(ActorTest, PausesAtItsShareOfTheInsertCredit) {
   // More stored under this id than it has published (a restarted actor): nothing on the way.
   f.actor_inserts = {500, 1000};
   f.insert_credit = 7;
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_EQ(actor.insert_limit(), 48 + 4);
   // A message that no longer names this actor: a replay restarted empty. What the actor
   // published until then is lost, not on the way.
@@ -102,18 +117,15 @@ TEST_F(ActorTest, PausesAtItsShareOfTheInsertCredit) {
   f.actor_id = {0};
   f.actor_inserts = {500};
   f.insert_credit = 200;
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_EQ(actor.insert_limit(), 48 + 100);
   // No credit without insert_allowed; no limit when the ratio is not enforced.
   f.insert_allowed = 0;
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_TRUE(actor.paused());
   f.insert_allowed = 1;
   f.insert_credit = -1;
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_FALSE(actor.paused());
 }
 
@@ -127,25 +139,21 @@ TEST_F(ActorTest, GoesOnAfterTheReplayRestartsFromASnapshot) {
   f.num_actors = 1;
   f.actor_id = {0};
   f.actor_inserts = {0};
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   while (actor.published() < 320) actor.StepEnvs();
   f.insert_credit = 10;  // nearly spent, 300 stored: 20 on the way
   f.actor_inserts = {300};
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_TRUE(actor.paused());
   // The restarted replay holds 200 (its snapshot's) and has credit again.
   f.insert_credit = 100;
   f.actor_inserts = {200};
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_EQ(actor.insert_limit(), 320 + 100);
   EXPECT_FALSE(actor.paused());
   // Transitions that were on the way arrive: nothing of its own counts twice.
   f.actor_inserts = {216};
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_EQ(actor.insert_limit(), actor.published() + 100);
 }
 
@@ -161,10 +169,7 @@ TEST_F(ActorTest, SwitchesToACompleteWeightsVersionAndActsGreedily) {
   net.GetFlat(&flat);
   std::fill(flat.begin(), flat.end(), 0.0f);
   flat.back() = 100.0f;  // bias of the last layer's output 1
-  for (auto& c : learner::MakeWeightChunks(3, net.Architecture(), flat)) {
-    bus_.Publish(channels::kWeights, &c, Port::kBulk);
-  }
-  bus_.Handle(0);
+  SendWeights(3, net, flat);
   EXPECT_EQ(actor.weights_version(), 3);
   for (int i = 0; i < 32; ++i) actor.StepEnvs();
   bus_.Handle(0);
@@ -179,19 +184,13 @@ TEST_F(ActorTest, RefusesWeightsOfANetworkThatDoesNotFitTheEnv) {
   nn::Sequential net = nn::MakeMlp(3, {8}, 2, &rng);  // 3 inputs, CartPole has 4
   std::vector<float> flat;
   net.GetFlat(&flat);
-  for (auto& c : learner::MakeWeightChunks(1, net.Architecture(), flat)) {
-    bus_.Publish(channels::kWeights, &c, Port::kBulk);
-  }
-  bus_.Handle(0);
+  SendWeights(1, net, flat);
   // Refused (counted), not merely not yet complete: a fitting version after it is taken.
   EXPECT_EQ(actor.weights_refused(), 1);
   EXPECT_EQ(actor.weights_version(), -1);
   nn::Sequential fits = nn::MakeMlp(4, {8}, 2, &rng);
   fits.GetFlat(&flat);
-  for (auto& c : learner::MakeWeightChunks(2, fits.Architecture(), flat)) {
-    bus_.Publish(channels::kWeights, &c, Port::kBulk);
-  }
-  bus_.Handle(0);
+  SendWeights(2, fits, flat);
   EXPECT_EQ(actor.weights_refused(), 1);
   EXPECT_EQ(actor.weights_version(), 2);
 }
@@ -204,10 +203,7 @@ TEST_F(ActorTest, RefusesWeightsChunksOfAnotherSizeThanItsNetwork) {
   nn::Sequential net = nn::MakeMlp(4, {8}, 2, &rng);
   std::vector<float> flat;
   net.GetFlat(&flat);
-  for (auto& c : learner::MakeWeightChunks(1, net.Architecture(), flat)) {
-    bus_.Publish(channels::kWeights, &c, Port::kBulk);
-  }
-  bus_.Handle(0);
+  SendWeights(1, net, flat);
   ASSERT_EQ(actor.weights_version(), 1);
   rlmsg::weights_chunk_t huge = learner::MakeWeightChunks(2, net.Architecture(), flat)[0];
   huge.total_size = 1 << 26;
@@ -228,9 +224,6 @@ TEST_F(ActorTest, RefusesWeightsChunksOfAnotherSizeThanItsNetwork) {
 // earlier lives. Its exploration schedule continues from there (here: past the random start,
 // sigma annealed), and its count never goes back.
 TEST_F(ActorTest, TakesUpItsStepCountFromTheReplayBeforeItActs) {
-  std::vector<rlmsg::stats_actor_t> stats;
-  bus_.Subscribe<rlmsg::stats_actor_t>(
-      channels::kStatsActor, [&stats](const rlmsg::stats_actor_t& s) { stats.push_back(s); });
   config_.env_id = "Pendulum-v1";
   config_.actor_id = 1;
   config_.num_actors = 2;
@@ -250,8 +243,7 @@ TEST_F(ActorTest, TakesUpItsStepCountFromTheReplayBeforeItActs) {
   f.num_actors = 2;
   f.actor_id = {0, 1};
   f.actor_inserts = {900, 700};
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   ASSERT_TRUE(actor.count_taken_up());
   EXPECT_EQ(actor.env_steps(), 700);
   EXPECT_EQ(actor.published(), 700);
@@ -262,14 +254,13 @@ TEST_F(ActorTest, TakesUpItsStepCountFromTheReplayBeforeItActs) {
   EXPECT_EQ(actor.env_steps(), 732);
   // A replay restarted from an older snapshot holds fewer: the count does not go back.
   f.actor_inserts = {900, 650};
-  bus_.Publish(channels::kFlow, &f);
-  bus_.Handle(0);
+  SendFlow(&f);
   EXPECT_EQ(actor.env_steps(), 732);
   actor.PublishStats();
   bus_.Handle(0);
-  ASSERT_FALSE(stats.empty());
-  EXPECT_EQ(stats.back().env_steps, 732);
-  EXPECT_NEAR(stats.back().epsilon, 0.5 + (0.1 - 0.5) * 0.732, 1e-12);
+  ASSERT_FALSE(stats_.empty());
+  EXPECT_EQ(stats_.back().env_steps, 732);
+  EXPECT_NEAR(stats_.back().epsilon, 0.5 + (0.1 - 0.5) * 0.732, 1e-12);
 }
 
 // A stopping actor sends every step it took, the pending n-step returns as truncations, so that
@@ -295,17 +286,14 @@ TEST_F(ActorTest, SendsEveryStepItTookWhenItStops) {
 }
 
 TEST_F(ActorTest, PublishesStatsWithItsCounters) {
-  std::vector<rlmsg::stats_actor_t> stats;
-  bus_.Subscribe<rlmsg::stats_actor_t>(
-      channels::kStatsActor, [&stats](const rlmsg::stats_actor_t& s) { stats.push_back(s); });
   Actor actor(config_, &bus_);
   for (int i = 0; i < 50; ++i) actor.StepEnvs();
   actor.PublishStats();
   bus_.Handle(0);
-  ASSERT_EQ(stats.size(), 1U);
-  EXPECT_EQ(stats[0].env_steps, 50);
-  EXPECT_EQ(stats[0].transitions_published, 48);
-  EXPECT_DOUBLE_EQ(stats[0].epsilon, 0.4);
+  ASSERT_EQ(stats_.size(), 1U);
+  EXPECT_EQ(stats_[0].env_steps, 50);
+  EXPECT_EQ(stats_[0].transitions_published, 48);
+  EXPECT_DOUBLE_EQ(stats_[0].epsilon, 0.4);
 }
 
 TEST_F(ActorTest, RefusesAnEpsilonPolicyOnAContinuousEnvAndNoiseOnADiscreteOne) {
@@ -333,10 +321,7 @@ TEST_F(ActorTest, ActsInAContinuousEnvWithNoiseClippedToTheBounds) {
   std::fill(flat.begin(), flat.end(), 0.0f);
   flat[flat.size() - 2] = 100.0f;
   flat[flat.size() - 1] = 0.5f;
-  for (auto& c : learner::MakeWeightChunks(1, net.Architecture(), flat)) {
-    bus_.Publish(channels::kWeights, &c, Port::kBulk);
-  }
-  bus_.Handle(0);
+  SendWeights(1, net, flat);
   ASSERT_EQ(actor.weights_version(), 1);
   EXPECT_DOUBLE_EQ(actor.exploration(), 1.0);  // random start
   for (int i = 0; i < 200; ++i) actor.StepEnvs();

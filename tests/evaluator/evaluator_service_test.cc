@@ -2,6 +2,7 @@
 
 #include <sys/stat.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -44,6 +45,16 @@ nn::Checkpoint AlwaysLeftCheckpoint(int64_t update) {
   return ckpt;
 }
 
+// Checks that `r` (a published result or an EvalRecord) carries the metadata that
+// AlwaysLeftCheckpoint(update) and Announce(path, update) give: `update`, 4 env steps an update and
+// update / 100 seconds.
+template <class Result>
+void ExpectMetadataOfUpdate(const Result& r, int64_t update) {
+  EXPECT_EQ(r.update, update);
+  EXPECT_EQ(r.env_steps, update * 4);
+  EXPECT_DOUBLE_EQ(r.wall_seconds, static_cast<double>(update) / 100.0);
+}
+
 // A CartPole network that balances the pole: its Q(right) - Q(left) is the state feedback
 // u = x + x_dot + 10 theta + theta_dot (through relu(u) - relu(-u)), so it pushes towards the
 // side the pole falls to and lasts far longer than AlwaysLeftCheckpoint.
@@ -66,6 +77,33 @@ nn::Checkpoint BalancingCheckpoint(int64_t update) {
   return ckpt;
 }
 
+// A checkpoint of a random MLP (a hidden layer of 8) for Catch-v0 in stacks of two 10 x 5 frames.
+nn::Checkpoint CatchCheckpoint(int64_t update) {
+  std::mt19937 rng(5);
+  nn::Sequential net = nn::MakeMlp(2 * 10 * 5, {8}, 3, &rng);
+  nn::Checkpoint ckpt;
+  ckpt.architecture = net.Architecture();
+  net.GetFlat(&ckpt.params);
+  ckpt.meta.update = update;
+  ckpt.meta.run_id = 77;
+  return ckpt;
+}
+
+// Reads what was written to `f` from its start, and closes it.
+std::string ReadAndClose(std::FILE* f) {
+  std::rewind(f);
+  std::string text;
+  for (int ch; (ch = std::fgetc(f)) != EOF;) text += static_cast<char>(ch);
+  std::fclose(f);
+  return text;
+}
+
+// Whether `text` contains `part`; the failure shows the whole text.
+::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
+  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "no \"" << part << "\" in:\n" << text;
+}
+
 class EvaluatorServiceTest : public ::testing::Test {
  protected:
   EvaluatorServiceTest() : bus_(MemqConfig()) {
@@ -84,18 +122,33 @@ class EvaluatorServiceTest : public ::testing::Test {
     c.run_config_text = "env = CartPole-v1\n";
     return c;
   }
-
-  std::string WriteCheckpoint(int64_t update) {
-    std::string path = checkpoints_ + "/ckpt_" + std::to_string(update) + ".bin";
-    nn::SaveCheckpoint(path, AlwaysLeftCheckpoint(update));
-    return path;
+  // `c` with a video of each new best checkpoint, of `width` x `height` pixels.
+  static EvaluatorConfig WithVideos(EvaluatorConfig c, int width, int height) {
+    c.videos = true;
+    c.video_width = width;
+    c.video_height = height;
+    return c;
+  }
+  // Config() with a screen of 2 episodes before the full evaluation.
+  EvaluatorConfig ScreenConfig() const {
+    EvaluatorConfig c = Config();
+    c.screen_episodes = 2;
+    return c;
+  }
+  // Config() on Catch in stacks of two 10 x 5 frames (see CatchCheckpoint).
+  EvaluatorConfig CatchConfig() const {
+    EvaluatorConfig c = Config();
+    c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2)";
+    return c;
   }
 
-  std::string WriteBalancingCheckpoint(int64_t update) {
-    std::string path = checkpoints_ + "/ckpt_" + std::to_string(update) + ".bin";
-    nn::SaveCheckpoint(path, BalancingCheckpoint(update));
+  // Saves `ckpt` in the run's checkpoint folder as ckpt_<update>.bin; returns its path.
+  std::string Save(const nn::Checkpoint& ckpt) {
+    std::string path = checkpoints_ + "/ckpt_" + std::to_string(ckpt.meta.update) + ".bin";
+    nn::SaveCheckpoint(path, ckpt);
     return path;
   }
+  std::string WriteCheckpoint(int64_t update) { return Save(AlwaysLeftCheckpoint(update)); }
 
   void Announce(const std::string& path, int64_t update) {
     rlmsg::checkpoint_t m{};
@@ -110,6 +163,29 @@ class EvaluatorServiceTest : public ::testing::Test {
   bool PollUntil(EvaluatorService* service, const std::function<bool()>& done) {
     for (int i = 0; i < 200 && !done(); ++i) service->Poll(10);
     return done();
+  }
+  // Announces the checkpoint at `path` and polls until `count` results have been published
+  // (PollUntil).
+  bool AnnounceUntilResults(EvaluatorService* service, const std::string& path, int64_t update,
+                            size_t count) {
+    Announce(path, update);
+    return PollUntil(service, [&] { return results_.size() == count; });
+  }
+
+  // The service's report: its index.html.
+  static std::string ReportHtml(const EvaluatorService& service) {
+    return ReadFile(service.report_dir() + "/index.html");
+  }
+  // Whether the report has a file `name` of more than `min_bytes` bytes.
+  static ::testing::AssertionResult HasReportFile(const EvaluatorService& service,
+                                                  const std::string& name, uintmax_t min_bytes) {
+    const std::string path = service.report_dir() + "/" + name;
+    if (!std::filesystem::exists(path)) return ::testing::AssertionFailure() << "no " << path;
+    const uintmax_t size = std::filesystem::file_size(path);
+    if (size <= min_bytes) {
+      return ::testing::AssertionFailure() << path << " has " << size << " bytes";
+    }
+    return ::testing::AssertionSuccess();
   }
 
   std::vector<std::string> JsonLines(const EvaluatorService& service) const {
@@ -136,9 +212,7 @@ TEST_F(EvaluatorServiceTest, ScoresAnAnnouncedCheckpointAndPublishesTheResult) {
 
   const rlmsg::eval_result_t& r = results_.front();
   EXPECT_EQ(r.header.run_id, 77);
-  EXPECT_EQ(r.update, 1200);
-  EXPECT_EQ(r.env_steps, 4800);
-  EXPECT_DOUBLE_EQ(r.wall_seconds, 12.0);
+  ExpectMetadataOfUpdate(r, 1200);
   EXPECT_EQ(r.episodes, 5);
   EXPECT_GT(r.mean, 0.0);
   EXPECT_LT(r.mean, 20.0);
@@ -155,7 +229,7 @@ TEST_F(EvaluatorServiceTest, ScoresAnAnnouncedCheckpointAndPublishesTheResult) {
   EXPECT_EQ(rec.checkpoint, "ckpt_1200.bin");
   EXPECT_EQ(rec.update, 1200);
   EXPECT_EQ(rec.mean, r.mean);
-  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  const std::string html = ReportHtml(service);
   EXPECT_NE(html.find("ckpt_1200.bin"), std::string::npos);
   EXPECT_NE(html.find("run-a"), std::string::npos);
 
@@ -175,11 +249,9 @@ TEST_F(EvaluatorServiceTest, ScoresNewBestCheckpointsOnTheSecondMetricToo) {
   c.second_episodes = 3;
   c.second_name = "three episodes";
   EvaluatorService service(c, &bus_, nullptr);
-  Announce(WriteCheckpoint(100), 100);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  ASSERT_TRUE(AnnounceUntilResults(&service, WriteCheckpoint(100), 100, 1));
   // The same policy again: not a new best, so not scored on the second metric.
-  Announce(WriteCheckpoint(200), 200);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 2; }));
+  ASSERT_TRUE(AnnounceUntilResults(&service, WriteCheckpoint(200), 200, 2));
   const std::vector<std::string> lines = JsonLines(service);
   ASSERT_EQ(lines.size(), 2U);
   EvalRecord first, second;
@@ -190,122 +262,72 @@ TEST_F(EvaluatorServiceTest, ScoresNewBestCheckpointsOnTheSecondMetricToo) {
   EXPECT_LT(first.second_mean, 20.0);
   EXPECT_EQ(second.second_episodes, 0);
   EXPECT_EQ(lines[1].find("second_mean"), std::string::npos);
-  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  const std::string html = ReportHtml(service);
   EXPECT_NE(html.find("Second metric (new best checkpoints only): three episodes, 3 episodes"),
             std::string::npos);
   EXPECT_NE(html.find("second metric (update 100): "), std::string::npos);
 }
 
 TEST_F(EvaluatorServiceTest, RecordsAVideoOfEachNewBestCheckpointAndShowsItInTheReport) {
-  EvaluatorConfig c = Config();
-  c.videos = true;
-  c.video_width = 96;
-  c.video_height = 64;
-  EvaluatorService service(c, &bus_, nullptr);
-  Announce(WriteCheckpoint(100), 100);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
-  const std::string video = service.report_dir() + "/best.webm";
-  ASSERT_TRUE(std::filesystem::exists(video));
-  EXPECT_GT(std::filesystem::file_size(video), 100U);
-  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  EvaluatorService service(WithVideos(Config(), 96, 64), &bus_, nullptr);
+  ASSERT_TRUE(AnnounceUntilResults(&service, WriteCheckpoint(100), 100, 1));
+  ASSERT_TRUE(HasReportFile(service, "best.webm", 100));
+  const std::string html = ReportHtml(service);
   EXPECT_NE(html.find("<video src=\"best.webm\""), std::string::npos);
   EXPECT_NE(html.find("ckpt_100.bin (update 100"), std::string::npos);
   // CartPole has no camera frames: no frame grid.
   EXPECT_FALSE(std::filesystem::exists(service.report_dir() + "/frames.png"));
   EXPECT_EQ(html.find("frames.png"), std::string::npos);
   // The same policy scores the same: no new best, so the video stays that of update 100.
-  Announce(WriteCheckpoint(200), 200);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 2; }));
-  EXPECT_NE(ReadFile(service.report_dir() + "/index.html").find("ckpt_100.bin (update 100"),
-            std::string::npos);
+  ASSERT_TRUE(AnnounceUntilResults(&service, WriteCheckpoint(200), 200, 2));
+  EXPECT_NE(ReportHtml(service).find("ckpt_100.bin (update 100"), std::string::npos);
 }
 
 TEST_F(EvaluatorServiceTest, ShowsAGridOfCameraFramesForAPixelEnv) {
-  EvaluatorConfig c = Config();
-  c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2)";
-  c.videos = true;
-  c.video_width = 64;
-  c.video_height = 64;
-  std::mt19937 rng(5);
-  nn::Sequential net = nn::MakeMlp(2 * 10 * 5, {8}, 3, &rng);
-  nn::Checkpoint ckpt;
-  ckpt.architecture = net.Architecture();
-  net.GetFlat(&ckpt.params);
-  ckpt.meta.update = 50;
-  ckpt.meta.run_id = 77;
-  const std::string path = checkpoints_ + "/ckpt_50.bin";
-  nn::SaveCheckpoint(path, ckpt);
-  EvaluatorService service(c, &bus_, nullptr);
-  Announce(path, 50);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
-  const std::string frames = service.report_dir() + "/frames.png";
-  ASSERT_TRUE(std::filesystem::exists(frames));
-  EXPECT_GT(std::filesystem::file_size(frames), 100U);
-  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  EvaluatorService service(WithVideos(CatchConfig(), 64, 64), &bus_, nullptr);
+  ASSERT_TRUE(AnnounceUntilResults(&service, Save(CatchCheckpoint(50)), 50, 1));
+  ASSERT_TRUE(HasReportFile(service, "frames.png", 100));
+  const std::string html = ReportHtml(service);
   EXPECT_NE(html.find("<img src=\"frames.png\""), std::string::npos);
   EXPECT_NE(html.find("4 greedy episodes"), std::string::npos);
 }
 
-// A Catch checkpoint of a random MLP (a hidden layer of 8).
-std::string WriteCatchCheckpoint(const std::string& folder, int64_t update) {
-  std::mt19937 rng(5);
-  nn::Sequential net = nn::MakeMlp(2 * 10 * 5, {8}, 3, &rng);
-  nn::Checkpoint ckpt;
-  ckpt.architecture = net.Architecture();
-  net.GetFlat(&ckpt.params);
-  ckpt.meta.update = update;
-  ckpt.meta.run_id = 77;
-  std::string path = folder + "/ckpt_" + std::to_string(update) + ".bin";
-  nn::SaveCheckpoint(path, ckpt);
-  return path;
-}
-
 TEST_F(EvaluatorServiceTest, DrawsATsneMapOfACheckpointAtTheGoalBeforeItsResult) {
-  EvaluatorConfig c = Config();
-  c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2)";
+  EvaluatorConfig c = CatchConfig();
   c.tsne = 100;
   c.goal = -10;  // every checkpoint reaches it
   std::FILE* log = std::tmpfile();
   ASSERT_NE(log, nullptr);
   EvaluatorService service(c, &bus_, log);
-  Announce(WriteCatchCheckpoint(checkpoints_, 50), 50);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  ASSERT_TRUE(AnnounceUntilResults(&service, Save(CatchCheckpoint(50)), 50, 1));
   EXPECT_FALSE(service.tsne_map_due());
   EXPECT_GT(service.tsne_seconds(), 0.0);
-  const std::string map = service.report_dir() + "/tsne.png";
-  ASSERT_TRUE(std::filesystem::exists(map));
-  EXPECT_GT(std::filesystem::file_size(map), 1000U);
-  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  ASSERT_TRUE(HasReportFile(service, "tsne.png", 1000));
+  const std::string html = ReportHtml(service);
   EXPECT_NE(html.find("<img src=\"tsne.png\""), std::string::npos);
   EXPECT_NE(html.find("in 100 states ("), std::string::npos);
   EXPECT_NE(html.find("of 12 greedy episodes"), std::string::npos);
   EXPECT_NE(html.find("max_a Q(s, a)"), std::string::npos);
   EXPECT_NE(html.find("ckpt_50.bin (update 50"), std::string::npos);
   // One line says what the map took.
-  std::rewind(log);
-  std::string text(4096, '\0');
-  text.resize(std::fread(text.data(), 1, text.size(), log));
-  std::fclose(log);
-  EXPECT_NE(text.find("evaluator: t-SNE map of ckpt_50.bin (update 50): 100 states of 12 greedy "
-                      "episodes ("),
-            std::string::npos)
-      << text;
+  const std::string text = ReadAndClose(log);
+  EXPECT_EQ(CountOccurrences(text, "evaluator: t-SNE map of "), 1) << text;
+  EXPECT_TRUE(Contains(
+      text, "evaluator: t-SNE map of ckpt_50.bin (update 50): 100 states of 12 greedy episodes ("));
 }
 
 TEST_F(EvaluatorServiceTest, KeepsTheTsneMapOfANewBestDueWhileTheTimeShareIsSpent) {
-  EvaluatorConfig c = Config();
-  c.env_id = "Catch-v0+pixels(width=5,height=10,stack=2)";
+  EvaluatorConfig c = CatchConfig();
   c.tsne = 100;
   c.goal = 10;  // never reached
   EvaluatorService service(c, &bus_, nullptr);
-  Announce(WriteCatchCheckpoint(checkpoints_, 50), 50);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  ASSERT_TRUE(AnnounceUntilResults(&service, Save(CatchCheckpoint(50)), 50, 1));
   // Its first map is expected to take kTsneFirstGuessSeconds, more than a fifth of the time the
   // service has run: due, not made.
   EXPECT_TRUE(service.tsne_map_due());
   EXPECT_EQ(service.tsne_seconds(), 0.0);
   EXPECT_FALSE(std::filesystem::exists(service.report_dir() + "/tsne.png"));
-  EXPECT_EQ(ReadFile(service.report_dir() + "/index.html").find("tsne.png"), std::string::npos);
+  EXPECT_EQ(ReportHtml(service).find("tsne.png"), std::string::npos);
 }
 
 TEST_F(EvaluatorServiceTest, RefusesATsneMapForAFlatEnv) {
@@ -426,7 +448,7 @@ TEST_F(EvaluatorServiceTest, StopsAtTheGoalWhenAsked) {
   EXPECT_EQ(results_.front().goal_reached, 1);
   EXPECT_TRUE(service.goal_reached());
   EXPECT_EQ(service.FinalLine(), "evaluator: goal reached");
-  const std::string html = ReadFile(service.report_dir() + "/index.html");
+  const std::string html = ReportHtml(service);
   EXPECT_NE(html.find("badge yes\">reached"), std::string::npos);
 }
 
@@ -434,8 +456,7 @@ TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsTheHistoryAndIgnoresRepeats) 
   const std::string path = WriteCheckpoint(40);
   {
     EvaluatorService first(Config(), &bus_, nullptr);
-    Announce(path, 40);
-    ASSERT_TRUE(PollUntil(&first, [&] { return results_.size() == 1; }));
+    ASSERT_TRUE(AnnounceUntilResults(&first, path, 40, 1));
   }
   // The restarted service gets a bus of its own, as a new process would.
   Bus bus2(MemqConfig());
@@ -453,7 +474,7 @@ TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsTheHistoryAndIgnoresRepeats) 
   for (int i = 0; i < 10; ++i) second.Poll(5);
   EXPECT_EQ(second.duplicates_ignored(), 1);
   EXPECT_EQ(second.checkpoints_scored(), 0);
-  const std::string html = ReadFile(second.report_dir() + "/index.html");
+  const std::string html = ReportHtml(second);
   EXPECT_EQ(CountOccurrences(html, "<td>ckpt_40.bin</td>"), 1);
 }
 
@@ -465,12 +486,9 @@ TEST_F(EvaluatorServiceTest, ProgressLinesGoToTheGivenStream) {
     Announce(WriteCheckpoint(5), 5);
     ASSERT_TRUE(PollUntil(&service, [&] { return !results_.empty(); }));
   }
-  std::rewind(out);
-  std::string text;
-  for (int ch; (ch = std::fgetc(out)) != EOF;) text += static_cast<char>(ch);
-  std::fclose(out);
-  EXPECT_NE(text.find("evaluator: update 5, env steps 20"), std::string::npos) << text;
-  EXPECT_NE(text.find("mean "), std::string::npos) << text;
+  const std::string text = ReadAndClose(out);
+  EXPECT_TRUE(Contains(text, "evaluator: update 5, env steps 20"));
+  EXPECT_TRUE(Contains(text, "mean "));
 }
 
 // The screen decides which checkpoints get the full evaluation; every score published or written
@@ -478,13 +496,11 @@ TEST_F(EvaluatorServiceTest, ProgressLinesGoToTheGivenStream) {
 TEST_F(EvaluatorServiceTest, AScreenedOutCheckpointIsNeverScoredAndOneThatPassesGetsTheFullCount) {
   std::FILE* out = std::tmpfile();
   ASSERT_NE(out, nullptr);
-  EvaluatorConfig config = Config();
-  config.screen_episodes = 2;
+  EvaluatorConfig config = ScreenConfig();
   config.screen_margin = 50;
   EvaluatorService service(config, &bus_, out);
   // The first checkpoint has no best to be screened against: full evaluation.
-  Announce(WriteBalancingCheckpoint(100), 100);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  ASSERT_TRUE(AnnounceUntilResults(&service, Save(BalancingCheckpoint(100)), 100, 1));
   const double best = results_.back().mean;
   ASSERT_GT(best, 100.0);  // far above the always-left policy's nine steps
   // Always left lasts about nine steps: below best - 50 on the screen, so not scored.
@@ -496,9 +512,8 @@ TEST_F(EvaluatorServiceTest, AScreenedOutCheckpointIsNeverScoredAndOneThatPasses
   EXPECT_EQ(JsonLines(service).size(), 1U);
   // A balancing checkpoint passes the screen and gets all 5 episodes, the same score as
   // unscreened (the same seeds from the first).
-  const std::string passing = WriteBalancingCheckpoint(300);
-  Announce(passing, 300);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 2; }));
+  const std::string passing = Save(BalancingCheckpoint(300));
+  ASSERT_TRUE(AnnounceUntilResults(&service, passing, 300, 2));
   EXPECT_EQ(results_.back().update, 300);
   EXPECT_EQ(results_.back().episodes, 5);
   const EvalRecord unscreened = ScoreCheckpointFile(passing, config.env_id, config.episodes,
@@ -513,31 +528,23 @@ TEST_F(EvaluatorServiceTest, AScreenedOutCheckpointIsNeverScoredAndOneThatPasses
     EXPECT_NE(rec.update, 200);
     EXPECT_EQ(rec.episodes, config.episodes);
   }
-  std::rewind(out);
-  std::string text;
-  for (int ch; (ch = std::fgetc(out)) != EOF;) text += static_cast<char>(ch);
-  std::fclose(out);
-  EXPECT_NE(text.find("evaluator: update 200, env steps 800: screened out, not scored (mean of 2 "
-                      "episodes"),
-            std::string::npos)
-      << text;
+  EXPECT_TRUE(Contains(ReadAndClose(out),
+                       "evaluator: update 200, env steps 800: screened out, not scored (mean of 2 "
+                       "episodes"));
 }
 
 TEST_F(EvaluatorServiceTest, AfterTheMostScreenFailuresInARowTheNextCheckpointIsScoredInFull) {
-  EvaluatorConfig config = Config();
-  config.screen_episodes = 2;
+  EvaluatorConfig config = ScreenConfig();
   config.screen_max_rejects = 2;
   EvaluatorService service(config, &bus_, nullptr);
-  Announce(WriteBalancingCheckpoint(100), 100);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 1; }));
+  ASSERT_TRUE(AnnounceUntilResults(&service, Save(BalancingCheckpoint(100)), 100, 1));
   for (int64_t update : {200, 300}) {
     Announce(WriteCheckpoint(update), update);
     ASSERT_TRUE(PollUntil(&service,
                           [&] { return service.checkpoints_screened_out() == update / 100 - 1; }));
   }
   // Two failures in a row: the third always-left checkpoint is evaluated in full, unscreened.
-  Announce(WriteCheckpoint(400), 400);
-  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 2; }));
+  ASSERT_TRUE(AnnounceUntilResults(&service, WriteCheckpoint(400), 400, 2));
   EXPECT_EQ(results_.back().update, 400);
   EXPECT_EQ(results_.back().episodes, 5);
   EXPECT_LT(results_.back().mean, 20.0);
@@ -605,8 +612,7 @@ TEST(ScoreCheckpointFileTest, ReadsTheMetadataAndRefusesATruncatedFile) {
   nn::SaveCheckpoint(path, AlwaysLeftCheckpoint(9));
   const EvalRecord r = ScoreCheckpointFile(path, "CartPole-v1", 3, 0.0, 1000);
   EXPECT_EQ(r.checkpoint, "c.bin");
-  EXPECT_EQ(r.update, 9);
-  EXPECT_EQ(r.env_steps, 36);
+  ExpectMetadataOfUpdate(r, 9);
   EXPECT_EQ(r.episodes, 3);
   // The network's values of the actions taken, against the returns of the (short) episodes.
   EXPECT_GT(r.value_steps, 3);

@@ -30,15 +30,25 @@ ReportInfo Info(double goal) {
   return info;
 }
 
-TEST(ReportTest, WritesIndexWithOneRowPerCheckpointNewestFirstAndBothCurves) {
-  TempDir dir;
-  const std::string report = dir / "report";
+// Writes the report of `records` into `folder` (WriteReport) and returns its index.html.
+std::string WriteAndRead(const std::string& folder, const std::vector<EvalRecord>& records,
+                         const ReportInfo& info) {
+  WriteReport(folder, records, info);
+  return ReadFile(folder + "/index.html");
+}
+
+// Each test writes its reports into a folder of its own.
+class ReportTest : public ::testing::Test {
+ protected:
+  TempDir dir_;
+};
+
+TEST_F(ReportTest, WritesIndexWithOneRowPerCheckpointNewestFirstAndBothCurves) {
+  const std::string report = dir_ / "report";
   const std::vector<EvalRecord> records = {Record("ckpt_a.bin", 1000, 20.0),
                                            Record("ckpt_b.bin", 2000, 180.0),
                                            Record("ckpt_c.bin", 3000, 90.0)};
-  WriteReport(report, records, Info(475));
-
-  const std::string html = ReadFile(report + "/index.html");
+  const std::string html = WriteAndRead(report, records, Info(475));
   ASSERT_FALSE(html.empty());
   EXPECT_NE(html.find("<title>"), std::string::npos);
   EXPECT_NE(html.find("CartPole-v1"), std::string::npos);
@@ -77,11 +87,9 @@ TEST(ReportTest, WritesIndexWithOneRowPerCheckpointNewestFirstAndBothCurves) {
   }
 }
 
-TEST(ReportTest, ShowsValueEstimatesOnlyWhenMeasuredAndSmallScoresWithTwoDecimals) {
-  TempDir dir;
-  const std::string report = dir / "report";
-  WriteReport(report, {Record("a.bin", 1000, 0.36)}, Info(0.6));
-  std::string html = ReadFile(report + "/index.html");
+TEST_F(ReportTest, ShowsValueEstimatesOnlyWhenMeasuredAndSmallScoresWithTwoDecimals) {
+  const std::string report = dir_ / "report";
+  std::string html = WriteAndRead(report, {Record("a.bin", 1000, 0.36)}, Info(0.6));
   EXPECT_NE(html.find(">0.36<"), std::string::npos);  // not rounded to 0.4
   EXPECT_EQ(html.find("<th>Q</th>"), std::string::npos);
 
@@ -90,31 +98,26 @@ TEST(ReportTest, ShowsValueEstimatesOnlyWhenMeasuredAndSmallScoresWithTwoDecimal
   r.value_estimate = 0.412;
   r.value_return = 0.305;
   r.value_correlation = 0.2349;
-  WriteReport(report, {Record("a.bin", 1000, 0.36), r}, Info(0.6));
-  html = ReadFile(report + "/index.html");
+  html = WriteAndRead(report, {Record("a.bin", 1000, 0.36), r}, Info(0.6));
   EXPECT_NE(html.find("<th>Q</th><th>G</th><th>r</th>"), std::string::npos);
   EXPECT_NE(html.find("<td>0.41</td><td>0.30</td><td>0.23</td>"), std::string::npos);
   EXPECT_NE(html.find("van Hasselt"), std::string::npos);
 }
 
-TEST(ReportTest, SaysWhenAndWhereTheGoalWasFirstReached) {
-  TempDir dir;
+TEST_F(ReportTest, SaysWhenAndWhereTheGoalWasFirstReached) {
   const std::vector<EvalRecord> records = {
       Record("a.bin", 1000, 100.0), Record("b.bin", 2000, 480.0), Record("c.bin", 3000, 500.0)};
-  WriteReport(dir.path(), records, Info(475));
-  const std::string html = ReadFile(dir / "index.html");
+  const std::string html = WriteAndRead(dir_.path(), records, Info(475));
   EXPECT_NE(html.find("badge yes\">reached"), std::string::npos);
   EXPECT_NE(html.find("first at update 2,000"), std::string::npos);
   EXPECT_EQ(html.find("not reached"), std::string::npos);
 }
 
-TEST(ReportTest, EscapesTheConfigAndCheckpointNames) {
-  TempDir dir;
+TEST_F(ReportTest, EscapesTheConfigAndCheckpointNames) {
   ReportInfo info = Info(475);
   info.run_config = "note = a<b & \"c\" </pre><script>alert(1)</script>";
   info.run_name = "<b>run</b>";
-  WriteReport(dir.path(), {Record("<img src=x>.bin", 5, 1.0)}, info);
-  const std::string html = ReadFile(dir / "index.html");
+  const std::string html = WriteAndRead(dir_.path(), {Record("<img src=x>.bin", 5, 1.0)}, info);
   EXPECT_NE(html.find("note = a&lt;b &amp; &quot;c&quot; &lt;/pre&gt;&lt;script&gt;alert(1)"
                       "&lt;/script&gt;"),
             std::string::npos);
@@ -124,57 +127,50 @@ TEST(ReportTest, EscapesTheConfigAndCheckpointNames) {
   EXPECT_EQ(HtmlEscape("'&'"), "&#39;&amp;&#39;");
 }
 
-TEST(ReportTest, ShowsTheTsneMapWithItsCaptionOnlyWhenGiven) {
-  TempDir dir;
-  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, Info(475));
-  EXPECT_EQ(ReadFile(dir / "index.html").find("t-SNE"), std::string::npos);
+TEST_F(ReportTest, ShowsTheTsneMapWithItsCaptionOnlyWhenGiven) {
+  EXPECT_EQ(WriteAndRead(dir_.path(), {Record("a.bin", 1, 1.0)}, Info(475)).find("t-SNE"),
+            std::string::npos);
   ReportInfo info = Info(475);
   info.tsne_file = kTsneMap;
   info.tsne_caption = "Colour: max_a Q(s, a) <of> the state.";
-  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, info);
-  const std::string html = ReadFile(dir / "index.html");
+  const std::string html = WriteAndRead(dir_.path(), {Record("a.bin", 1, 1.0)}, info);
   EXPECT_NE(html.find("<h2>Last hidden layer (t-SNE)</h2>"), std::string::npos);
   EXPECT_NE(html.find("<img src=\"tsne.png\""), std::string::npos);
   EXPECT_NE(html.find("Colour: max_a Q(s, a) &lt;of&gt; the state."), std::string::npos);
 }
 
-TEST(ReportTest, ListsTheRestartsOfTheRunsProcesses) {
-  TempDir dir;
+TEST_F(ReportTest, ListsTheRestartsOfTheRunsProcesses) {
   ReportInfo info = Info(475);
-  info.restarts_file = dir / "restarts";
-  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, info);  // no file yet: no section
-  EXPECT_EQ(ReadFile(dir / "index.html").find("Restarts"), std::string::npos);
+  info.restarts_file = dir_ / "restarts";
+  // No file yet: no section.
+  EXPECT_EQ(WriteAndRead(dir_.path(), {Record("a.bin", 1, 1.0)}, info).find("Restarts"),
+            std::string::npos);
   std::ofstream(info.restarts_file) << "2026-11-25T12:00:01+00:00 learner status 137 restart 1\n"
                                        "torn line\n"
                                        "2026-11-25T12:00:09+00:00 replay status 137 restart 1\n"
                                        "2026-11-25T12:01:00+00:00 learner status 134 restart 2\n";
-  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, info);
-  const std::string html = ReadFile(dir / "index.html");
+  const std::string html = WriteAndRead(dir_.path(), {Record("a.bin", 1, 1.0)}, info);
   EXPECT_NE(html.find("<h2>Restarts</h2>"), std::string::npos);
   EXPECT_NE(html.find("3 process restarts (learner 2, replay 1)"), std::string::npos);
   EXPECT_NE(html.find("<td>learner</td><td>134</td><td>2</td>"), std::string::npos);
   // An actor whose Slurm node was lost: not restarted.
   std::ofstream(info.restarts_file, std::ios::app)
       << "2026-11-25T12:02:00+00:00 actor-3 status 0 lost 0\n";
-  WriteReport(dir.path(), {Record("a.bin", 1, 1.0)}, info);
-  EXPECT_NE(ReadFile(dir / "index.html").find("<td>actor-3</td><td>0</td><td>node lost</td>"),
+  EXPECT_NE(WriteAndRead(dir_.path(), {Record("a.bin", 1, 1.0)}, info)
+                .find("<td>actor-3</td><td>0</td><td>node lost</td>"),
             std::string::npos);
 }
 
-TEST(ReportTest, AnEmptyHistoryStillGivesAReportAndCurves) {
-  TempDir dir;
-  WriteReport(dir / "report", {}, Info(475));
-  const std::string html = ReadFile(dir / "report/index.html");
+TEST_F(ReportTest, AnEmptyHistoryStillGivesAReportAndCurves) {
+  const std::string html = WriteAndRead(dir_ / "report", {}, Info(475));
   EXPECT_NE(html.find("No checkpoint scored yet"), std::string::npos);
-  EXPECT_TRUE(std::filesystem::exists(dir / "report/curve_env_steps.svg"));
-  EXPECT_TRUE(std::filesystem::exists(dir / "report/curve_wall_time.svg"));
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "report/curve_env_steps.svg"));
+  EXPECT_TRUE(std::filesystem::exists(dir_ / "report/curve_wall_time.svg"));
 }
 
-TEST(ReportTest, RewritingReplacesTheOldReport) {
-  TempDir dir;
-  WriteReport(dir.path(), {Record("first.bin", 1, 1.0)}, Info(475));
-  WriteReport(dir.path(), {Record("second.bin", 2, 2.0)}, Info(475));
-  const std::string html = ReadFile(dir / "index.html");
+TEST_F(ReportTest, RewritingReplacesTheOldReport) {
+  WriteReport(dir_.path(), {Record("first.bin", 1, 1.0)}, Info(475));
+  const std::string html = WriteAndRead(dir_.path(), {Record("second.bin", 2, 2.0)}, Info(475));
   EXPECT_EQ(html.find("first.bin"), std::string::npos);
   EXPECT_NE(html.find("second.bin"), std::string::npos);
 }

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <numeric>
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -144,72 +146,59 @@ TEST(TsneTest, IsDeterministicForASeedAndDiffersForAnother) {
   EXPECT_GE(SameClusterFraction(other, kNeighbours), 0.95);
 }
 
+// Calls call() and returns the what() of the std::invalid_argument it throws, or "no exception"
+// (any other exception goes through).
+template <class Call>
+std::string InvalidArgumentOf(const Call& call) {
+  try {
+    call();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "no exception";
+}
+
 TEST(TsneTest, RefusesTooFewPointsTooLargeAPerplexityAndValuesThatAreNotFinite) {
-  auto message = [](const auto& call) {
-    try {
-      call();
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string("no exception");
-  };
   const TsneConfig c;
-  EXPECT_NE(message([&] { Tsne(Eigen::MatrixXf::Random(3, 4), c); }).find("at least 5 points"),
-            std::string::npos);
+  EXPECT_NE(
+      InvalidArgumentOf([&] { Tsne(Eigen::MatrixXf::Random(3, 4), c); }).find("at least 5 points"),
+      std::string::npos);
   // Perplexity 30 needs 91 points; 90 are refused, and so is a perplexity of N or more.
-  EXPECT_NE(message([&] { Tsne(Eigen::MatrixXf::Random(3, 90), c); }).find("perplexity"),
+  EXPECT_NE(InvalidArgumentOf([&] { Tsne(Eigen::MatrixXf::Random(3, 90), c); }).find("perplexity"),
             std::string::npos);
   TsneConfig big;
   big.perplexity = 10;
   EXPECT_THROW(Tsne(Eigen::MatrixXf::Random(3, 10), big), std::invalid_argument);
   Eigen::MatrixXf x = Eigen::MatrixXf::Random(3, 100);
   x(1, 42) = std::nanf("");
-  EXPECT_NE(message([&] { Tsne(x, c); }).find("point 42"), std::string::npos);
+  EXPECT_NE(InvalidArgumentOf([&] { Tsne(x, c); }).find("point 42"), std::string::npos);
   x(1, 42) = INFINITY;
   EXPECT_THROW(Tsne(x, c), std::invalid_argument);
   EXPECT_THROW(Tsne(Eigen::MatrixXf::Random(3, 100), c, {}, 0), std::invalid_argument);
 }
 
 TEST(TsneTest, ConfigValidateNamesTheField) {
-  auto field_of = [](TsneConfig c) {
-    try {
-      c.Validate();
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string("valid");
+  EXPECT_EQ(InvalidArgumentOf([] { TsneConfig().Validate(); }), "no exception");
+  // One value out of range each, and the field the error must name.
+  const std::pair<const char*, void (*)(TsneConfig*)> cases[] = {
+      {"perplexity", [](TsneConfig* c) { c->perplexity = 0.5; }},
+      {"perplexity", [](TsneConfig* c) { c->perplexity = INFINITY; }},
+      {"iterations", [](TsneConfig* c) { c->iterations = 0; }},
+      {"learning_rate", [](TsneConfig* c) { c->learning_rate = -1; }},
+      {"exaggeration", [](TsneConfig* c) { c->exaggeration = 0.5; }},
+      {"exaggeration_iterations", [](TsneConfig* c) { c->exaggeration_iterations = -1; }},
+      {"initial_momentum", [](TsneConfig* c) { c->initial_momentum = 1; }},
+      {"final_momentum", [](TsneConfig* c) { c->final_momentum = -0.1; }},
+      {"momentum_switch_iteration", [](TsneConfig* c) { c->momentum_switch_iteration = -5; }},
+      {"min_gain", [](TsneConfig* c) { c->min_gain = 0; }},
   };
-  EXPECT_EQ(field_of(TsneConfig()), "valid");
-  TsneConfig c;
-  c.perplexity = 0.5;
-  EXPECT_NE(field_of(c).find("perplexity"), std::string::npos);
-  c = TsneConfig();
-  c.perplexity = INFINITY;
-  EXPECT_NE(field_of(c).find("perplexity"), std::string::npos);
-  c = TsneConfig();
-  c.iterations = 0;
-  EXPECT_NE(field_of(c).find("iterations"), std::string::npos);
-  c = TsneConfig();
-  c.learning_rate = -1;
-  EXPECT_NE(field_of(c).find("learning_rate"), std::string::npos);
-  c = TsneConfig();
-  c.exaggeration = 0.5;
-  EXPECT_NE(field_of(c).find("exaggeration"), std::string::npos);
-  c = TsneConfig();
-  c.exaggeration_iterations = -1;
-  EXPECT_NE(field_of(c).find("exaggeration_iterations"), std::string::npos);
-  c = TsneConfig();
-  c.initial_momentum = 1;
-  EXPECT_NE(field_of(c).find("initial_momentum"), std::string::npos);
-  c = TsneConfig();
-  c.final_momentum = -0.1;
-  EXPECT_NE(field_of(c).find("final_momentum"), std::string::npos);
-  c = TsneConfig();
-  c.momentum_switch_iteration = -5;
-  EXPECT_NE(field_of(c).find("momentum_switch_iteration"), std::string::npos);
-  c = TsneConfig();
-  c.min_gain = 0;
-  EXPECT_NE(field_of(c).find("min_gain"), std::string::npos);
+  for (size_t i = 0; i < std::size(cases); ++i) {
+    const auto& [field, set_bad_value] = cases[i];
+    SCOPED_TRACE(::testing::Message() << "case " << i << ": " << field);
+    TsneConfig c;
+    set_bad_value(&c);
+    EXPECT_NE(InvalidArgumentOf([&] { c.Validate(); }).find(field), std::string::npos);
+  }
 }
 
 double Entropy(const std::vector<double>& p) {

@@ -4,24 +4,14 @@
 # last checkpoint (its update count carries on from there), weight versions never go back, and
 # the run still reaches the CartPole goal.
 source "$(dirname "$0")/lib.sh"
+source "$(dirname "$0")/launch_lib.sh"
 isolate "$@"
 scratch
-launch cartpole --out "$dir/run" --actors 2 --seed 3 --time-budget 240 > "$dir/launch.log" 2>&1 &
-launch_pid=$!
+start_cartpole "$dir/launch.log" --actors 2 --seed 3 --time-budget 240
 # Mid-run: the learner has written its state with its first checkpoint.
-wait_line "$dir/launch.log" "running; logs in" 60
 wait_learner_state "$dir/run"
-for role in learner replay evaluator actor-1; do
-  victim=$(awk -v r="$role" '$1 == r {p = $2} END {print p}' "$dir/run/pids")
-  [ -n "$victim" ] || fail "no pid for $role"
-  kill -KILL "$victim"
-  echo "killed $role (pid $victim)"
-done
-set +e
-wait "$launch_pid"
-status=$?
-set -e
-tail -8 "$dir/launch.log"
+for role in learner replay evaluator actor-1; do kill_role "$role"; done
+wait_launch "$dir/launch.log"
 [ "$status" -eq 0 ] || fail "launch exited with $status after the kills"
 for role in learner replay evaluator actor-1; do
   grep -q " $role status 137 restart 1$" "$dir/run/restarts" || fail "$role was not restarted"

@@ -4,19 +4,15 @@
 # its snapshot; update counts, env steps and the evaluation history carry on; and the resumed run
 # reaches the CartPole goal.
 source "$(dirname "$0")/lib.sh"
+source "$(dirname "$0")/launch_lib.sh"
 isolate "$@"
 scratch
 # First part: an unreachable goal, stopped by a signal once an evaluation has been written.
-# (launch.sh itself in the background, not lib.sh's function: its pid is the one to signal.)
-"$root/scripts/launch.sh" cartpole --no-setup --build-dir "$build_dir" --out "$dir/run" \
-  --actors 2 --seed 4 --goal 100000 --time-budget 240 > "$dir/first.log" 2>&1 &
-launch_pid=$!
-wait_line "$dir/first.log" "running; logs in" 60
+start_cartpole "$dir/first.log" --actors 2 --seed 4 --goal 100000 --time-budget 240
 wait_line "$dir/run/eval.jsonl" '"update"' 120
 wait_learner_state "$dir/run"
 kill -TERM "$launch_pid"
-status=0
-wait "$launch_pid" || status=$?
+wait_launch "$dir/first.log"
 [ "$status" -eq 130 ] || fail "the stopped launch exited with $status, not 130"
 run_id=$(run_setting "$dir/run" run-id)
 evals_before=$(wc -l < "$dir/run/eval.jsonl")

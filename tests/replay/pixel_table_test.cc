@@ -110,6 +110,12 @@ class FakeActor {
     b->AddFrame(f);
     current_.assign(static_cast<size_t>(stack_), f);
   }
+  // A new batch that starts an episode.
+  OwnedPixelBatch NewEpisode(int height = kHeight, int width = kWidth) {
+    OwnedPixelBatch b = NewBatch(height, width);
+    Reset(&b);
+    return b;
+  }
   // One step: sends a new frame and the transition; returns what it must read back as.
   Expected Step(OwnedPixelBatch* b, bool terminal = false, float priority = 0.0f) {
     const int64_t f = next_id_++;
@@ -148,13 +154,11 @@ class FakeActor {
 
 PixelTableOptions Options(int64_t capacity, int64_t frame_capacity = 0, int height = 0,
                           int width = 0, int stack = 0) {
-  PixelTableOptions o;
-  o.capacity = capacity;
-  o.frame_capacity = frame_capacity;
-  o.height = height;
-  o.width = width;
-  o.stack = stack;
-  return o;
+  return {.capacity = capacity,
+          .frame_capacity = frame_capacity,
+          .height = height,
+          .width = width,
+          .stack = stack};
 }
 
 // Checks sampled transition i against `e`, byte for byte.
@@ -174,13 +178,34 @@ void ExpectTransition(const PixelSampleBatch& s, size_t i, const Expected& e) {
   EXPECT_EQ(s.discount[i], e.discount);
 }
 
+// Inserts into `table` a batch of `actor` that starts an episode and takes `steps` steps; returns
+// what Insert() returns.
+const char* InsertEpisode(PixelTable* table, FakeActor* actor, int steps) {
+  OwnedPixelBatch b = actor->NewEpisode();
+  for (int step = 0; step < steps; ++step) actor->Step(&b);
+  return table->Insert(b.view());
+}
+
+// A batch of `count` stacks of the table's geometry.
+PixelSampleBatch BatchFor(const PixelTable& table, int count) {
+  PixelSampleBatch s;
+  s.Resize(count, table.height(), table.width(), table.stack(), table.action_width());
+  return s;
+}
+
+// Resizes `s` to `count` stacks of the table's geometry and draws them with a generator seeded
+// with `seed`; returns what Sample() returns.
+bool Draw(PixelTable* table, int count, uint64_t seed, PixelSampleBatch* s) {
+  std::mt19937_64 rng(seed);
+  *s = BatchFor(*table, count);
+  return table->Sample(count, &rng, s->spans());
+}
+
 // Samples `count` transitions and checks each against log[index]; returns the indices seen.
 std::set<int64_t> SampleAndCheck(PixelTable* table, const std::vector<Expected>& log, int count,
                                  uint64_t seed) {
-  std::mt19937_64 rng(seed);
   PixelSampleBatch s;
-  s.Resize(count, table->height(), table->width(), table->stack());
-  EXPECT_TRUE(table->Sample(count, &rng, s.spans()));
+  EXPECT_TRUE(Draw(table, count, seed, &s));
   std::set<int64_t> seen;
   for (size_t i = 0; i < static_cast<size_t>(count); ++i) {
     const int64_t index = s.index[i];
@@ -221,8 +246,7 @@ TEST(PixelTableTest, StoresEachFrameOnceAndReportsItsMemory) {
   // many transitions name each frame.
   FakeActor actor(0, 4);
   for (int episode = 0; episode < 15; ++episode) {
-    OwnedPixelBatch b = actor.NewBatch(84, 84);
-    actor.Reset(&b);
+    OwnedPixelBatch b = actor.NewEpisode(84, 84);
     for (int step = 0; step < 100; ++step) actor.Step(&b, step == 99);
     ASSERT_EQ(table.Insert(b.view()), nullptr);
   }
@@ -243,8 +267,7 @@ TEST(PixelTableTest, CostsAboutOneFrameAndUnder200BytesPerTransition) {
   PixelTable prioritized(Options(kCapacity, kCapacity, 84, 84, 4),
                          std::make_unique<PrioritizedSampler>(kCapacity, 0.6));
   FakeActor actor(0, 4);
-  OwnedPixelBatch b = actor.NewBatch(84, 84);
-  actor.Reset(&b);
+  OwnedPixelBatch b = actor.NewEpisode(84, 84);
   for (int step = 0; step < 200; ++step) actor.Step(&b);
   ASSERT_EQ(uniform.Insert(b.view()), nullptr);
   ASSERT_EQ(prioritized.Insert(b.view()), nullptr);
@@ -261,8 +284,7 @@ TEST(PixelTableTest, RebuildsStacksExactlyAcrossBatchesAndEpisodes) {
   FakeActor actor(1, kStack);
   std::vector<Expected> log;
   // Episodes of 4, 1 and 7 steps, in batches that name frames of earlier batches.
-  OwnedPixelBatch b = actor.NewBatch();
-  actor.Reset(&b);
+  OwnedPixelBatch b = actor.NewEpisode();
   log.push_back(actor.Step(&b));
   log.push_back(actor.Step(&b));
   ASSERT_EQ(table.Insert(b.view()), nullptr);
@@ -272,8 +294,7 @@ TEST(PixelTableTest, RebuildsStacksExactlyAcrossBatchesAndEpisodes) {
   actor.Reset(&b);
   log.push_back(actor.Step(&b, /*terminal=*/true));
   ASSERT_EQ(table.Insert(b.view()), nullptr);
-  b = actor.NewBatch();
-  actor.Reset(&b);  // a batch of one frame and no transition
+  b = actor.NewEpisode();  // a batch of one frame and no transition
   ASSERT_EQ(table.Insert(b.view()), nullptr);
   for (int step = 0; step < 7; ++step) {
     b = actor.NewBatch();
@@ -297,16 +318,13 @@ TEST(PixelTableTest, RebuildsStacksExactlyAcrossBatchesAndEpisodes) {
 TEST(PixelTableTest, AStackOfTheRepeatedFirstFrameReadsBackAsThatFrame) {
   PixelTable table(Options(10));
   FakeActor actor(2, kStack);
-  OwnedPixelBatch b = actor.NewBatch();
-  actor.Reset(&b);
+  OwnedPixelBatch b = actor.NewEpisode();
   const Expected e = actor.Step(&b, /*terminal=*/true);
   ASSERT_EQ(e.obs, (std::vector<int64_t>{0, 0, 0}));
   ASSERT_EQ(e.next_obs, (std::vector<int64_t>{0, 0, 1}));
   ASSERT_EQ(table.Insert(b.view()), nullptr);
-  std::mt19937_64 rng(2);
   PixelSampleBatch s;
-  s.Resize(4, kHeight, kWidth, kStack);
-  ASSERT_TRUE(table.Sample(4, &rng, s.spans()));
+  ASSERT_TRUE(Draw(&table, 4, /*seed=*/2, &s));
   for (size_t i = 0; i < 4; ++i) ExpectTransition(s, i, e);
   // The three frames of obs are the same bytes.
   const auto frame = static_cast<std::ptrdiff_t>(kHeight) * kWidth;
@@ -318,10 +336,8 @@ TEST(PixelTableTest, KeepsTheFramesOfInterleavedActorsApartDespiteEqualLocalIds)
   FakeActor a(3, kStack);
   FakeActor b(7, kStack);
   std::vector<Expected> log;
-  OwnedPixelBatch ba = a.NewBatch();
-  OwnedPixelBatch bb = b.NewBatch();
-  a.Reset(&ba);
-  b.Reset(&bb);
+  OwnedPixelBatch ba = a.NewEpisode();
+  OwnedPixelBatch bb = b.NewEpisode();
   for (int round = 0; round < 10; ++round) {
     // Both actors' ids run 0, 1, 2, ...; their batches alternate.
     for (int step = 0; step <= round % 3; ++step) log.push_back(a.Step(&ba));
@@ -339,15 +355,13 @@ TEST(PixelTableTest, KeepsTheFramesOfInterleavedActorsApartDespiteEqualLocalIds)
 TEST(PixelTableTest, SkipsOnlyTheTransitionsThatNameAnUnknownFrame) {
   PixelTable table(Options(50));
   FakeActor actor(1, kStack);
-  std::vector<Expected> log;
-  OwnedPixelBatch b = actor.NewBatch();
-  actor.Reset(&b);
-  log.push_back(actor.Step(&b));
+  OwnedPixelBatch b = actor.NewEpisode();
   // A transition naming a frame that was never sent, between two good ones.
-  Expected bad = log.back();
+  const Expected good = actor.Step(&b);
+  Expected bad = good;
   bad.next_obs.back() = 999;
   FakeActor::AddTransition(&b, bad);
-  log.push_back(actor.Step(&b));
+  std::vector<Expected> log = {good, actor.Step(&b)};
   ASSERT_EQ(table.Insert(b.view()), nullptr);
   EXPECT_EQ(table.size(), 2);
   EXPECT_EQ(table.transitions_missing_frames(), 1);
@@ -395,17 +409,13 @@ TEST(PixelTableTest, ForgetsIdsOlderThanTheActorsWindow) {
 TEST(PixelTableTest, ARestartedActorsOldIdsAreForgotten) {
   PixelTable table(Options(50));
   FakeActor first(4, kStack, /*key=*/40);
-  OwnedPixelBatch b = first.NewBatch();
-  first.Reset(&b);
-  for (int step = 0; step < 5; ++step) first.Step(&b);
-  ASSERT_EQ(table.Insert(b.view()), nullptr);
+  ASSERT_EQ(InsertEpisode(&table, &first, 5), nullptr);
   ASSERT_EQ(table.size(), 5);
 
   // The same actor id starts again from frame 0, with other frames.
   FakeActor second(4, kStack, /*key=*/41);
   std::vector<Expected> log(5);
-  b = second.NewBatch();
-  second.Reset(&b);
+  OwnedPixelBatch b = second.NewEpisode();
   log.push_back(second.Step(&b));
   // Frame 4 was the first incarnation's; the second never sent it.
   FakeActor::AddTransition(&b, Expected{41, {0, 0, 4}, {0, 4, 1}, 0, 0.0f, 1.0f});
@@ -413,10 +423,8 @@ TEST(PixelTableTest, ARestartedActorsOldIdsAreForgotten) {
   EXPECT_EQ(table.size(), 6);
   EXPECT_EQ(table.transitions_missing_frames(), 1);
   // Transition 5 reads back with the new frames.
-  std::mt19937_64 rng(5);
   PixelSampleBatch s;
-  s.Resize(200, kHeight, kWidth, kStack);
-  ASSERT_TRUE(table.Sample(200, &rng, s.spans()));
+  ASSERT_TRUE(Draw(&table, 200, /*seed=*/5, &s));
   int checked = 0;
   for (size_t i = 0; i < 200; ++i) {
     if (s.index[i] != 5) continue;
@@ -432,8 +440,7 @@ TEST(PixelTableTest, DrawsAgainInsteadOfReturningOverwrittenFrames) {
   PixelTable table(Options(100, 20));
   FakeActor actor(0, kStack);
   std::vector<Expected> log;
-  OwnedPixelBatch b = actor.NewBatch();
-  actor.Reset(&b);
+  OwnedPixelBatch b = actor.NewEpisode();
   for (int batch = 0; batch < 6; ++batch) {
     for (int step = 0; step < 5; ++step) log.push_back(actor.Step(&b));
     ASSERT_EQ(table.Insert(b.view()), nullptr);
@@ -467,8 +474,7 @@ TEST(PixelTableTest, SweepsAwayStaleTransitionsWhenMostOfTheMassIsStale) {
   PixelTable table(Options(200, 3, 2, 2, 1));
   FakeActor actor(0, 1);
   std::vector<Expected> log;
-  OwnedPixelBatch b = actor.NewBatch(2, 2);
-  actor.Reset(&b);
+  OwnedPixelBatch b = actor.NewEpisode(2, 2);
   ASSERT_EQ(table.Insert(b.view()), nullptr);
   for (int step = 0; step < 200; ++step) {
     b = actor.NewBatch(2, 2);
@@ -485,19 +491,15 @@ TEST(PixelTableTest, SweepsAwayStaleTransitionsWhenMostOfTheMassIsStale) {
 TEST(PixelTableTest, SampleReturnsFalseAndWritesNothingWhenEveryTransitionIsStale) {
   PixelTable table(Options(10, 8, kHeight, kWidth, 2));
   FakeActor actor(0, 2);
-  OwnedPixelBatch b = actor.NewBatch();
-  actor.Reset(&b);
-  for (int step = 0; step < 3; ++step) actor.Step(&b);
-  ASSERT_EQ(table.Insert(b.view()), nullptr);
+  ASSERT_EQ(InsertEpisode(&table, &actor, 3), nullptr);
   // Eight more frames overwrite all four.
-  b = actor.NewBatch();
+  OwnedPixelBatch b = actor.NewBatch();
   for (int i = 0; i < 8; ++i) b.AddFrame(actor.next_id() + i);
   ASSERT_EQ(table.Insert(b.view()), nullptr);
   ASSERT_EQ(table.size(), 3);
 
   std::mt19937_64 rng(8);
-  PixelSampleBatch s;
-  s.Resize(5, kHeight, kWidth, 2);
+  PixelSampleBatch s = BatchFor(table, 5);
   std::fill(s.obs.begin(), s.obs.end(), 0xAB);
   std::fill(s.index.begin(), s.index.end(), -7);
   EXPECT_FALSE(table.Sample(5, &rng, s.spans()));
@@ -512,10 +514,7 @@ TEST(PixelTableTest, SampleReturnsFalseAndWritesNothingWhenEveryTransitionIsStal
 TEST(PixelTableTest, RefusesBadBatchesAndStoresNoneOfThem) {
   PixelTable table(Options(50));
   FakeActor actor(1, kStack);
-  OwnedPixelBatch good = actor.NewBatch();
-  actor.Reset(&good);
-  actor.Step(&good);
-  ASSERT_EQ(table.Insert(good.view()), nullptr);
+  ASSERT_EQ(InsertEpisode(&table, &actor, 1), nullptr);
   const int64_t frames = table.total_frames();
 
   auto refused = [&](const TransitionBatchView& view, const char* what) {
@@ -586,8 +585,7 @@ TEST(PixelTableTest, RefusesBadBatchesAndStoresNoneOfThem) {
 TEST(PixelTableTest, RefusesAGeometryOtherThanTheConfiguredOneBeforeTheFirstBatch) {
   PixelTable table(Options(10, 0, kHeight, 0, 0));
   FakeActor actor(1, kStack);
-  OwnedPixelBatch b = actor.NewBatch(kHeight + 2, kWidth);
-  actor.Reset(&b);
+  OwnedPixelBatch b = actor.NewEpisode(kHeight + 2, kWidth);
   EXPECT_NE(table.Insert(b.view()), nullptr);
   EXPECT_EQ(table.height(), 0);
   EXPECT_EQ(table.memory_bytes(), 10 * 16);  // only the sampler so far
@@ -599,14 +597,12 @@ TEST(PixelTableTest, WorksWithThePrioritizedSampler) {
   PixelTable table(Options(8), std::make_unique<PrioritizedSampler>(8, 1.0, 1e-9));
   FakeActor actor(0, kStack);
   std::vector<Expected> log;
-  OwnedPixelBatch b = actor.NewBatch();
-  actor.Reset(&b);
+  OwnedPixelBatch b = actor.NewEpisode();
   for (float priority : {1.0f, 2.0f, 5.0f}) log.push_back(actor.Step(&b, false, priority));
   ASSERT_EQ(table.Insert(b.view()), nullptr);
 
   std::mt19937_64 rng(9);
-  PixelSampleBatch s;
-  s.Resize(8000, kHeight, kWidth, kStack);
+  PixelSampleBatch s = BatchFor(table, 8000);
   ASSERT_TRUE(table.Sample(8000, &rng, s.spans()));
   std::vector<int> hits(3, 0);
   const float weight[3] = {1.0f, 0.5f, 0.2f};
@@ -636,10 +632,7 @@ TEST(PixelTableTest, UpdatePrioritiesSkipsOverwrittenTransitions) {
   // Capacity 4 after 6 transitions: 2 .. 5 are stored.
   PixelTable table(Options(4), std::make_unique<PrioritizedSampler>(4, 1.0, 1e-9));
   FakeActor actor(0, kStack);
-  OwnedPixelBatch b = actor.NewBatch();
-  actor.Reset(&b);
-  for (int step = 0; step < 6; ++step) actor.Step(&b);
-  ASSERT_EQ(table.Insert(b.view()), nullptr);
+  ASSERT_EQ(InsertEpisode(&table, &actor, 6), nullptr);
   const std::vector<int64_t> index = {0, 1, 2, 5, 6};
   EXPECT_EQ(table.UpdatePriorities(index, std::vector<float>{7, 7, 7, 7, 7}), 2);
   EXPECT_THROW(table.set_importance_exponent(2.0), std::invalid_argument);
@@ -648,13 +641,9 @@ TEST(PixelTableTest, UpdatePrioritiesSkipsOverwrittenTransitions) {
 TEST(PixelTableDeathTest, AbortsWhenTheOutputHasTheWrongSize) {
   PixelTable table(Options(10));
   FakeActor actor(0, kStack);
-  OwnedPixelBatch b = actor.NewBatch();
-  actor.Reset(&b);
-  actor.Step(&b);
-  ASSERT_EQ(table.Insert(b.view()), nullptr);
+  ASSERT_EQ(InsertEpisode(&table, &actor, 1), nullptr);
   std::mt19937_64 rng(1);
-  PixelSampleBatch s;
-  s.Resize(4, kHeight, kWidth, kStack);
+  PixelSampleBatch s = BatchFor(table, 4);
   EXPECT_DEATH(table.Sample(5, &rng, s.spans()), "batch_size");
 }
 

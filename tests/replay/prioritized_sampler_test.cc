@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/replay/sampler_draws.h"
+
 namespace rl::replay {
 namespace {
 
@@ -215,13 +217,7 @@ TEST(PrioritizedSamplerTest, SameSeedSameDraws) {
     a.Insert(slot, 0.1 * static_cast<double>(slot));
     b.Insert(slot, 0.1 * static_cast<double>(slot));
   }
-  std::mt19937_64 rng_a(3);
-  std::mt19937_64 rng_b(3);
-  std::vector<SampledItem> from_a(40);
-  std::vector<SampledItem> from_b(40);
-  a.Sample(&rng_a, from_a);
-  b.Sample(&rng_b, from_b);
-  for (size_t i = 0; i < from_a.size(); ++i) EXPECT_EQ(from_a[i].slot, from_b[i].slot);
+  EXPECT_EQ(DrawSlots(&a, 40, /*seed=*/3), DrawSlots(&b, 40, /*seed=*/3));
 }
 
 TEST(PrioritizedSamplerTest, ReportsTheMemoryOfItsTree) {

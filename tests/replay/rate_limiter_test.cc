@@ -1,5 +1,6 @@
 #include "replay/rate_limiter.h"
 
+#include <cstdint>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -13,6 +14,19 @@ RateLimiterOptions Options(double spi, int64_t min_size, double error_buffer) {
   o.min_size_to_sample = min_size;
   o.error_buffer = error_buffer;
   return o;
+}
+
+// The largest batch up to 100 that the limiter admits now: CanInsert(n) (CanSample(n)) holds for
+// n = 1 .. the result and not for the next n; 0 when it holds for none.
+int64_t LargestInsert(const RateLimiter& limiter) {
+  int64_t n = 0;
+  while (n < 100 && limiter.CanInsert(n + 1)) ++n;
+  return n;
+}
+int64_t LargestSample(const RateLimiter& limiter) {
+  int64_t n = 0;
+  while (n < 100 && limiter.CanSample(n + 1)) ++n;
+  return n;
 }
 
 TEST(RateLimiterTest, DefaultOptionsAreValid) { EXPECT_NO_THROW(RateLimiterOptions{}.Validate()); }
@@ -32,9 +46,7 @@ TEST(RateLimiterTest, BlocksSamplesUntilMinInsertsReached) {
   EXPECT_FALSE(limiter.CanSample(1));
   EXPECT_TRUE(limiter.CanInsert(1));
   limiter.Insert(1);
-  EXPECT_TRUE(limiter.CanSample(1));
-  EXPECT_TRUE(limiter.CanSample(5));   // diff 10 - 5 >= min_diff 5
-  EXPECT_FALSE(limiter.CanSample(6));  // diff 10 - 6 < 5
+  EXPECT_EQ(LargestSample(limiter), 5);  // diff 10 - 5 >= min_diff 5, 10 - 6 < 5
 }
 
 TEST(RateLimiterTest, AllowsEveryInsertBeforeMinSize) {
@@ -44,38 +56,38 @@ TEST(RateLimiterTest, AllowsEveryInsertBeforeMinSize) {
   EXPECT_TRUE(limiter.CanInsert(1000));
 }
 
-TEST(RateLimiterTest, BlocksInsertsWhenTooFarAheadOfSamples) {
-  // max_diff = 2 * 10 + 6 = 26: inserts may go on while diff + 2 <= 26.
-  RateLimiter limiter(Options(2.0, 10, 6));
-  limiter.Insert(10);                  // diff 20
-  EXPECT_TRUE(limiter.CanInsert(3));   // 26
-  EXPECT_FALSE(limiter.CanInsert(4));  // 28
-  limiter.Insert(3);                   // diff 26
-  EXPECT_FALSE(limiter.CanInsert(1));
-  EXPECT_DOUBLE_EQ(limiter.diff(), 26.0);
+// Two samples per insert, a min size of 10 and an error buffer of 6: an insert of n is allowed
+// while diff + 2 n <= max_diff = 2 * 10 + 6 = 26, a sample of n while diff - n >= min_diff =
+// 2 * 10 - 6 = 14.
+class RateLimiterBandTest : public ::testing::Test {
+ protected:
+  RateLimiter limiter_{Options(2.0, 10, 6)};
+};
+
+TEST_F(RateLimiterBandTest, BlocksInsertsWhenTooFarAheadOfSamples) {
+  limiter_.Insert(10);                    // diff 20
+  EXPECT_EQ(LargestInsert(limiter_), 3);  // 26, not 28
+  limiter_.Insert(3);                     // diff 26
+  EXPECT_EQ(LargestInsert(limiter_), 0);
+  EXPECT_DOUBLE_EQ(limiter_.diff(), 26.0);
 }
 
-TEST(RateLimiterTest, AllowsInsertsAgainAfterSamples) {
-  RateLimiter limiter(Options(2.0, 10, 6));
-  limiter.Insert(13);  // diff 26 = max_diff
-  ASSERT_FALSE(limiter.CanInsert(1));
-  ASSERT_TRUE(limiter.CanSample(1));
-  limiter.Sample(1);  // diff 25
-  EXPECT_FALSE(limiter.CanInsert(1));
-  limiter.Sample(1);  // diff 24
-  EXPECT_TRUE(limiter.CanInsert(1));
-  EXPECT_FALSE(limiter.CanInsert(2));
+TEST_F(RateLimiterBandTest, AllowsInsertsAgainAfterSamples) {
+  limiter_.Insert(13);  // diff 26 = max_diff
+  ASSERT_EQ(LargestInsert(limiter_), 0);
+  ASSERT_TRUE(limiter_.CanSample(1));
+  limiter_.Sample(1);  // diff 25
+  EXPECT_EQ(LargestInsert(limiter_), 0);
+  limiter_.Sample(1);  // diff 24
+  EXPECT_EQ(LargestInsert(limiter_), 1);
 }
 
-TEST(RateLimiterTest, BlocksSamplesWhenTooFarAheadOfInserts) {
-  // min_diff = 2 * 10 - 6 = 14.
-  RateLimiter limiter(Options(2.0, 10, 6));
-  limiter.Insert(10);  // diff 20
-  limiter.Sample(6);   // diff 14
-  EXPECT_FALSE(limiter.CanSample(1));
-  limiter.Insert(1);  // diff 16
-  EXPECT_TRUE(limiter.CanSample(2));
-  EXPECT_FALSE(limiter.CanSample(3));
+TEST_F(RateLimiterBandTest, BlocksSamplesWhenTooFarAheadOfInserts) {
+  limiter_.Insert(10);  // diff 20
+  limiter_.Sample(6);   // diff 14
+  EXPECT_EQ(LargestSample(limiter_), 0);
+  limiter_.Insert(1);  // diff 16
+  EXPECT_EQ(LargestSample(limiter_), 2);
 }
 
 TEST(RateLimiterTest, NeverBlocksBothSidesForBatchesUpToTheLimit) {

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "common/channels.h"
+#include "common/clock.h"
 #include "common/lcm_bus.h"
 #include "common/message_examples.h"
 
@@ -92,6 +93,27 @@ class ReplayServiceTest : public ::testing::Test {
     bus_.Handle(0);
   }
 
+  // Lets the service publish what is due at time `now` (seconds) and delivers it.
+  void TickAndDeliver(double now) {
+    service_->Tick(now);
+    bus_.Handle(0);
+  }
+
+  // The request ids of the replies so far, in order.
+  std::vector<int64_t> ReplyIds() const {
+    std::vector<int64_t> ids;
+    for (const rlmsg::sample_batch_t& r : replies_) ids.push_back(r.request_id);
+    return ids;
+  }
+
+  // Checks that `r` is the replay's answer to learner-0's request `request_id` of `count`.
+  static void ExpectReplyTo(const rlmsg::sample_batch_t& r, int64_t request_id, int count) {
+    EXPECT_EQ(r.header.sender, "replay");
+    EXPECT_EQ(r.requester, "learner-0");
+    EXPECT_EQ(r.request_id, request_id);
+    EXPECT_EQ(r.count, count);
+  }
+
   Bus bus_;
   std::unique_ptr<ReplayService> service_;
   std::map<std::pair<std::string, std::string>, int64_t> next_seq_;
@@ -135,10 +157,7 @@ TEST_F(ReplayServiceTest, HoldsARequestUntilMinSizeThenAnswersIt) {
   ASSERT_EQ(replies_.size(), 1U);
   EXPECT_EQ(service_->pending_requests(), 0);
   const rlmsg::sample_batch_t& r = replies_[0];
-  EXPECT_EQ(r.header.sender, "replay");
-  EXPECT_EQ(r.requester, "learner-0");
-  EXPECT_EQ(r.request_id, 7);
-  EXPECT_EQ(r.count, 16);
+  ExpectReplyTo(r, 7, 16);
   EXPECT_EQ(r.obs_size, 4);
   EXPECT_EQ(r.num_values, 64);
   EXPECT_EQ(r.replay_size, 50);
@@ -172,9 +191,7 @@ TEST_F(ReplayServiceTest, HoldsARetriedRequestOnceAndAnswersItOnce) {
   EXPECT_EQ(service_->pending_requests(), 2);
   SendTransitions(0, 50);
   Pump();
-  ASSERT_EQ(replies_.size(), 2U);
-  EXPECT_EQ(replies_[0].request_id, 7);
-  EXPECT_EQ(replies_[1].request_id, 8);
+  ASSERT_EQ(ReplyIds(), (std::vector<int64_t>{7, 8}));
 }
 
 TEST_F(ReplayServiceTest, AnswersSeveralRequestsInOrderAsTheLimiterAllows) {
@@ -186,14 +203,11 @@ TEST_F(ReplayServiceTest, AnswersSeveralRequestsInOrderAsTheLimiterAllows) {
   SendRequest(3, 2);
   Pump();
   // The first fits; the second must wait (diff 4 - 6 < 0) and holds up the third.
-  ASSERT_EQ(replies_.size(), 1U);
-  EXPECT_EQ(replies_[0].request_id, 1);
+  ASSERT_EQ(ReplyIds(), (std::vector<int64_t>{1}));
   EXPECT_EQ(service_->pending_requests(), 2);
   SendTransitions(10, 4);  // diff 8
   Pump();
-  ASSERT_EQ(replies_.size(), 3U);
-  EXPECT_EQ(replies_[1].request_id, 2);
-  EXPECT_EQ(replies_[2].request_id, 3);
+  ASSERT_EQ(ReplyIds(), (std::vector<int64_t>{1, 2, 3}));
 }
 
 TEST_F(ReplayServiceTest, FlowControlPausesActorsThatRunAheadAndResumesThemAfterSamples) {
@@ -258,8 +272,7 @@ TEST_F(ReplayServiceTest, DropsForeignAndNonFiniteBatchesAndKeepsWorking) {
   Pump();
   EXPECT_EQ(service_->table().size(), 5);
   ASSERT_EQ(replies_.size(), 1U);
-  service_->Tick(100.0);
-  bus_.Handle(0);
+  TickAndDeliver(100.0);
   ASSERT_EQ(stats_.size(), 1U);
   EXPECT_EQ(stats_[0].dropped_foreign, 1);
   EXPECT_EQ(stats_[0].dropped_invalid, 1);
@@ -276,8 +289,7 @@ TEST_F(ReplayServiceTest, RefusesABatchOfAnotherObsSizeAndCountsItAsInvalid) {
   EXPECT_EQ(service_->counters().batches_refused, 1);
   // The limiter counts only what was stored.
   EXPECT_EQ(service_->limiter().inserts(), 10);
-  service_->Tick(100.0);
-  bus_.Handle(0);
+  TickAndDeliver(100.0);
   ASSERT_EQ(stats_.size(), 1U);
   EXPECT_EQ(stats_[0].dropped_invalid, 1);
 }
@@ -292,8 +304,7 @@ TEST_F(ReplayServiceTest, DropsTheOldestRequestWhenTheQueueIsFull) {
   EXPECT_EQ(service_->counters().requests_dropped, 2);
   SendTransitions(0, 10);
   Pump();
-  ASSERT_EQ(replies_.size(), 4U);
-  for (size_t i = 0; i < 4; ++i) EXPECT_EQ(replies_[i].request_id, static_cast<int64_t>(i) + 2);
+  ASSERT_EQ(ReplyIds(), (std::vector<int64_t>{2, 3, 4, 5}));
 }
 
 TEST_F(ReplayServiceTest, RefusesRequestsThatCouldNeverBeAnswered) {
@@ -314,8 +325,7 @@ TEST_F(ReplayServiceTest, RefusesRequestsThatCouldNeverBeAnswered) {
   // A small one still goes through.
   SendRequest(3, 4);
   Pump();
-  ASSERT_EQ(replies_.size(), 1U);
-  EXPECT_EQ(replies_[0].request_id, 3);
+  ASSERT_EQ(ReplyIds(), (std::vector<int64_t>{3}));
 }
 
 TEST_F(ReplayServiceTest, TickPublishesFlowAndStatsAtTheirRates) {
@@ -325,22 +335,18 @@ TEST_F(ReplayServiceTest, TickPublishesFlowAndStatsAtTheirRates) {
   Start(o);
   SendTransitions(0, 8);
   Pump();
-  service_->Tick(10.0);
-  bus_.Handle(0);
+  TickAndDeliver(10.0);
   EXPECT_EQ(flows_.size(), 1U);
   EXPECT_EQ(stats_.size(), 1U);
-  service_->Tick(10.01);
-  bus_.Handle(0);
+  TickAndDeliver(10.01);
   EXPECT_EQ(flows_.size(), 1U);
   EXPECT_EQ(stats_.size(), 1U);
-  service_->Tick(10.06);
-  bus_.Handle(0);
+  TickAndDeliver(10.06);
   EXPECT_EQ(flows_.size(), 2U);
   EXPECT_EQ(stats_.size(), 1U);
   SendTransitions(8, 12);
   Pump();
-  service_->Tick(10.5);
-  bus_.Handle(0);
+  TickAndDeliver(10.5);
   EXPECT_EQ(flows_.size(), 3U);
   ASSERT_EQ(stats_.size(), 2U);
 
@@ -374,8 +380,7 @@ TEST_F(ReplayServiceTest, StoresPixelTransitionsAndAnswersWithRebuiltStacks) {
   EXPECT_EQ(service_->size(), 20);
   ASSERT_EQ(replies.size(), 1U);
   const rlmsg::sample_batch_t& r = replies[0];
-  EXPECT_EQ(r.request_id, 1);
-  EXPECT_EQ(r.count, 16);
+  ExpectReplyTo(r, 1, 16);
   EXPECT_EQ(r.stack, 2);
   EXPECT_EQ(r.obs_size, 0);
   EXPECT_TRUE(r.obs.empty());
@@ -466,6 +471,7 @@ TEST_F(ReplayServiceTest, StoresActionVectorsAndRefusesBatchesWithBadActions) {
   Pump();
   ASSERT_EQ(replies_.size(), 1U);
   const rlmsg::sample_batch_t& r = replies_[0];
+  ExpectReplyTo(r, 1, 32);
   EXPECT_EQ(r.action_width, 3);
   ASSERT_EQ(r.action.size(), 96U);
   for (size_t i = 0; i < 32; ++i) {
@@ -474,8 +480,7 @@ TEST_F(ReplayServiceTest, StoresActionVectorsAndRefusesBatchesWithBadActions) {
     EXPECT_EQ(r.action[3 * i + 1], 0.5f);
     EXPECT_EQ(r.action[3 * i + 2], 0.25f);
   }
-  service_->Tick(1.0);
-  bus_.Handle(0);
+  TickAndDeliver(1.0);
   ASSERT_FALSE(stats_.empty());
   EXPECT_GE(stats_.back().dropped_invalid, 2);
 }
@@ -520,8 +525,7 @@ TEST_F(ReplayServiceTest, PrioritizedSamplingFollowsThePrioritiesTheLearnerSends
   }
   // P(3) = 100 / (100 + 9 * 0.01) = 0.9991: nearly every draw.
   EXPECT_GE(threes, 190);
-  service_->Tick(1.0);
-  bus_.Handle(0);
+  TickAndDeliver(1.0);
   ASSERT_FALSE(stats_.empty());
   EXPECT_EQ(stats_.back().prioritized, 1);
   EXPECT_DOUBLE_EQ(stats_.back().beta, 0.5);
@@ -535,8 +539,7 @@ TEST_F(ReplayServiceTest, RunServesUntilAskedToStop) {
   SendRequest(5, 8);
   int rounds = 0;
   service_->Run([&] { return !replies_.empty() || ++rounds > 500; });
-  ASSERT_EQ(replies_.size(), 1U);
-  EXPECT_EQ(replies_[0].request_id, 5);
+  ASSERT_EQ(ReplyIds(), (std::vector<int64_t>{5}));
   // Run leaves a last flow and stats message behind.
   bus_.Handle(0);
   ASSERT_FALSE(flows_.empty());
@@ -567,8 +570,7 @@ TEST_F(ReplayServiceTest, RefusesActorIdsFromMaxActorsOn) {
   Pump();
   EXPECT_EQ(service_->total_inserts(), 5);
   EXPECT_EQ(service_->counters().batches_refused, 2);
-  service_->Tick();
-  bus_.Handle(0);
+  TickAndDeliver(MonoSeconds());
   ASSERT_FALSE(flows_.empty());
   EXPECT_EQ(flows_.back().actor_id, std::vector<int32_t>{3});
   o.max_actors = 0;

@@ -94,6 +94,37 @@ void ExpectConsistentButWeight(const SampleBatch& s, int i) {
   EXPECT_EQ(s.reward[k], 2.0f * v);
 }
 
+// A batch of `count` transitions of the table's shapes.
+SampleBatch BatchFor(const ReplayTable& table, int count) {
+  SampleBatch s;
+  s.Resize(count, table.obs_size(), table.action_width());
+  return s;
+}
+
+// Resizes `s` to `count` transitions of the table's shapes and draws them with a generator seeded
+// with `seed`; returns what Sample() returns.
+bool Draw(ReplayTable* table, int count, uint64_t seed, SampleBatch* s) {
+  std::mt19937_64 rng(seed);
+  *s = BatchFor(*table, count);
+  return table->Sample(count, &rng, s->spans());
+}
+
+// Draws `count` transitions (Draw()) and checks each with ExpectConsistent() and that its index
+// is its insert number; returns the numbers drawn.
+std::set<int> DrawAndCheck(ReplayTable* table, int count, uint64_t seed) {
+  SampleBatch s;
+  EXPECT_TRUE(Draw(table, count, seed, &s));
+  std::set<int> seen;
+  for (int i = 0; i < count; ++i) {
+    ExpectConsistent(s, i);
+    const auto v =
+        static_cast<int>(s.obs[static_cast<size_t>(i) * static_cast<size_t>(s.obs_size)]);
+    EXPECT_EQ(s.index[static_cast<size_t>(i)], v);
+    seen.insert(v);
+  }
+  return seen;
+}
+
 TEST(ReplayTableTest, DefaultOptionsAreValid) { EXPECT_NO_THROW(ReplayTableOptions{}.Validate()); }
 
 TEST(ReplayTableTest, RefusesBadOptions) {
@@ -111,42 +142,23 @@ TEST(ReplayTableTest, StoresABatchAndReportsItsSize) {
 }
 
 TEST(ReplayTableTest, OverwritesTheOldestWhenFull) {
-  constexpr int kCapacity = 8;
-  constexpr int kExtra = 3;
-  ReplayTable table(Options(kCapacity));
-  // Insert in uneven batches so that one batch wraps around the end.
+  ReplayTable table(Options(8));
+  // 11 transitions in uneven batches, so that one batch wraps around the end.
   ASSERT_EQ(table.Insert(MakeBatch(0, 5, 2).view()), nullptr);
   ASSERT_EQ(table.Insert(MakeBatch(5, 5, 2).view()), nullptr);
   ASSERT_EQ(table.Insert(MakeBatch(10, 1, 2).view()), nullptr);
-  EXPECT_EQ(table.size(), kCapacity);
-  EXPECT_EQ(table.total_inserts(), kCapacity + kExtra);
-
-  std::mt19937_64 rng(1);
-  SampleBatch s;
-  s.Resize(500, table.obs_size());
-  ASSERT_TRUE(table.Sample(500, &rng, s.spans()));
-  std::set<int> seen;
-  for (int i = 0; i < 500; ++i) {
-    ExpectConsistent(s, i);
-    const int v = static_cast<int>(s.obs[static_cast<size_t>(i) * 2]);
-    // The index is the transition's insert number.
-    EXPECT_EQ(s.index[static_cast<size_t>(i)], v);
-    seen.insert(v);
-  }
-  // The first kExtra are gone, all the others are there.
-  std::set<int> expected;
-  for (int v = kExtra; v < kCapacity + kExtra; ++v) expected.insert(v);
-  EXPECT_EQ(seen, expected);
+  EXPECT_EQ(table.size(), 8);
+  EXPECT_EQ(table.total_inserts(), 11);
+  // The first 3 are gone, all the others are there.
+  EXPECT_EQ(DrawAndCheck(&table, 500, /*seed=*/1), (std::set<int>{3, 4, 5, 6, 7, 8, 9, 10}));
 }
 
 TEST(ReplayTableTest, ABatchLargerThanTheCapacityKeepsItsNewestTransitions) {
   ReplayTable table(Options(4));
   ASSERT_EQ(table.Insert(MakeBatch(0, 10, 1).view()), nullptr);
   EXPECT_EQ(table.size(), 4);
-  std::mt19937_64 rng(2);
   SampleBatch s;
-  s.Resize(200, 1);
-  ASSERT_TRUE(table.Sample(200, &rng, s.spans()));
+  ASSERT_TRUE(Draw(&table, 200, /*seed=*/2, &s));
   std::set<float> seen(s.obs.begin(), s.obs.end());
   EXPECT_EQ(seen, (std::set<float>{6, 7, 8, 9}));
 }
@@ -193,10 +205,8 @@ TEST(ReplayTableTest, StoresMinusOneWhenEpisodeIdsAreMissing) {
   b.episode_id.clear();
   b.priority.clear();
   ASSERT_EQ(table.Insert(b.view()), nullptr);
-  std::mt19937_64 rng(3);
   SampleBatch s;
-  s.Resize(10, 1);
-  ASSERT_TRUE(table.Sample(10, &rng, s.spans()));
+  ASSERT_TRUE(Draw(&table, 10, /*seed=*/3, &s));
   for (int64_t id : s.episode_id) EXPECT_EQ(id, -1);
 }
 
@@ -212,16 +222,7 @@ TEST(ReplayTableTest, SampleOnAnEmptyTableReturnsFalse) {
 TEST(ReplayTableTest, SamplesOnlyStoredTransitionsBeforeTheBufferIsFull) {
   ReplayTable table(Options(1000));
   ASSERT_EQ(table.Insert(MakeBatch(0, 5, 3).view()), nullptr);
-  std::mt19937_64 rng(5);
-  SampleBatch s;
-  s.Resize(2000, 3);
-  ASSERT_TRUE(table.Sample(2000, &rng, s.spans()));
-  std::set<int> seen;
-  for (int i = 0; i < 2000; ++i) {
-    ExpectConsistent(s, i);
-    seen.insert(static_cast<int>(s.obs[static_cast<size_t>(i) * 3]));
-  }
-  EXPECT_EQ(seen, (std::set<int>{0, 1, 2, 3, 4}));
+  EXPECT_EQ(DrawAndCheck(&table, 2000, /*seed=*/5), (std::set<int>{0, 1, 2, 3, 4}));
   EXPECT_EQ(table.total_samples(), 2000);
 }
 
@@ -234,8 +235,7 @@ TEST(ReplayTableTest, SamplesUniformly) {
   ReplayTable table(Options(kCapacity));
   ASSERT_EQ(table.Insert(MakeBatch(0, 27, 1).view()), nullptr);
   std::mt19937_64 rng(6);
-  SampleBatch s;
-  s.Resize(1000, 1);
+  SampleBatch s = BatchFor(table, 1000);
   std::vector<int> hits(27, 0);
   for (int round = 0; round < kDraws / 1000; ++round) {
     ASSERT_TRUE(table.Sample(1000, &rng, s.spans()));
@@ -258,14 +258,10 @@ TEST(ReplayTableTest, SameSeedSameSamples) {
   ReplayTable b(Options(50));
   ASSERT_EQ(a.Insert(MakeBatch(0, 30, 2).view()), nullptr);
   ASSERT_EQ(b.Insert(MakeBatch(0, 30, 2).view()), nullptr);
-  std::mt19937_64 rng_a(9);
-  std::mt19937_64 rng_b(9);
   SampleBatch sa;
   SampleBatch sb;
-  sa.Resize(64, 2);
-  sb.Resize(64, 2);
-  ASSERT_TRUE(a.Sample(64, &rng_a, sa.spans()));
-  ASSERT_TRUE(b.Sample(64, &rng_b, sb.spans()));
+  ASSERT_TRUE(Draw(&a, 64, /*seed=*/9, &sa));
+  ASSERT_TRUE(Draw(&b, 64, /*seed=*/9, &sb));
   EXPECT_EQ(sa.index, sb.index);
 }
 
@@ -273,8 +269,7 @@ TEST(ReplayTableTest, UniformWeightsAreOneForAnyExponent) {
   ReplayTable table(Options(10));
   ASSERT_EQ(table.Insert(MakeBatch(0, 7, 1).view()), nullptr);
   std::mt19937_64 rng(12);
-  SampleBatch s;
-  s.Resize(50, 1);
+  SampleBatch s = BatchFor(table, 50);
   for (double beta : {0.0, 0.4, 1.0}) {
     table.set_importance_exponent(beta);
     ASSERT_TRUE(table.Sample(50, &rng, s.spans()));
@@ -312,8 +307,7 @@ TEST(ReplayTableTest, ImportanceWeightsOfThreeTransitionsMatchAHandComputation) 
   b.priority = {1.0f, 2.0f, 5.0f};
   ASSERT_EQ(table.Insert(b.view()), nullptr);
   std::mt19937_64 rng(13);
-  SampleBatch s;
-  s.Resize(8000, 2);
+  SampleBatch s = BatchFor(table, 8000);
   for (const Case& c : cases) {
     table.set_importance_exponent(c.beta);
     ASSERT_TRUE(table.Sample(8000, &rng, s.spans()));
@@ -355,8 +349,7 @@ TEST(ReplayTableTest, UpdatePrioritiesOfSampledTransitionsSteersTheSampler) {
   ReplayTable table(Options(16), std::make_unique<PrioritizedSampler>(16, 1.0, 1e-6));
   ASSERT_EQ(table.Insert(MakeBatch(0, 16, 1).view()), nullptr);
   std::mt19937_64 rng(14);
-  SampleBatch s;
-  s.Resize(16, 1);
+  SampleBatch s = BatchFor(table, 16);
   ASSERT_TRUE(table.Sample(16, &rng, s.spans()));
   // The learner finds every TD error 0 except that of transition 7.
   std::vector<float> priority(16, 0.0f);
@@ -403,10 +396,8 @@ TEST(ReplayTableTest, StoresActionVectorsOfTheTablesWidth) {
   b.action.pop_back();
   EXPECT_STREQ(table.Insert(b.view()), "action size is not count * action_width");
   EXPECT_EQ(table.size(), 5);
-  std::mt19937_64 rng(3);
   SampleBatch s;
-  s.Resize(20, 2, 3);
-  ASSERT_TRUE(table.Sample(20, &rng, s.spans()));
+  ASSERT_TRUE(Draw(&table, 20, /*seed=*/3, &s));
   for (size_t i = 0; i < 20; ++i) {
     const float v = s.obs[2 * i];
     EXPECT_EQ(s.action[3 * i], v);
@@ -419,8 +410,7 @@ TEST(ReplayTableDeathTest, AbortsWhenTheOutputHasTheWrongSize) {
   ReplayTable table(Options(10));
   ASSERT_EQ(table.Insert(MakeBatch(0, 3, 2).view()), nullptr);
   std::mt19937_64 rng(1);
-  SampleBatch s;
-  s.Resize(4, 2);
+  SampleBatch s = BatchFor(table, 4);
   EXPECT_DEATH(table.Sample(5, &rng, s.spans()), "batch_size");
 }
 

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/replay/sampler_draws.h"
+
 namespace rl::replay {
 namespace {
 
@@ -84,13 +86,7 @@ TEST(UniformSamplerTest, SameSeedSameDraws) {
     a.Insert(slot, 0.0);
     b.Insert(slot, 0.0);
   }
-  std::mt19937_64 rng_a(3);
-  std::mt19937_64 rng_b(3);
-  std::vector<SampledItem> from_a(50);
-  std::vector<SampledItem> from_b(50);
-  a.Sample(&rng_a, from_a);
-  b.Sample(&rng_b, from_b);
-  for (size_t i = 0; i < from_a.size(); ++i) EXPECT_EQ(from_a[i].slot, from_b[i].slot);
+  EXPECT_EQ(DrawSlots(&a, 50, /*seed=*/3), DrawSlots(&b, 50, /*seed=*/3));
 }
 
 }  // namespace
