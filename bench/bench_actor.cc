@@ -12,8 +12,12 @@
 #include "nn/sequential.h"
 
 int main(int argc, char** argv) {
-  const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
-  const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
+  const rl::bench::Args args(argc, argv,
+                             "usage: bench_actor [REPEATS (5)] [SECONDS per repeat (1)]\nThe "
+                             "actor's own loop, steps/s (JSON lines).",
+                             2);
+  const int repeats = args.Int(0, 5);
+  const double seconds = args.Number(1, 1.0);
   rl::Bus bus(rl::InProcessBusConfig(1, "actor-0"));
   rl::actor::ActorConfig c;
   c.exploration.mode = "constant";

@@ -512,12 +512,18 @@ void BenchConvPasses(const NetSpec& spec, const Sequential& net, rl::nn::Precisi
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
-  const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
-  const std::vector<int> thread_counts = ParseThreads(argc > 3 ? argv[3] : "1,2");
-  if (repeats < 1 || seconds <= 0 || thread_counts.empty()) {
-    std::fprintf(stderr, "usage: bench_cnn [repeats] [seconds] [threads, e.g. 1,2]\n");
-    return 2;
+  const rl::bench::Args args(
+      argc, argv,
+      "usage: bench_cnn [REPEATS (5)] [SECONDS per repeat (1)] [THREADS (1,2)]\n"
+      "Pixel networks' updates/s, latency and GFLOP/s against the machine's "
+      "peaks (JSON lines).",
+      3);
+  const int repeats = args.Int(0, 5);
+  const double seconds = args.Number(1, 1.0);
+  const std::vector<int> thread_counts = ParseThreads(args.Text(2, "1,2").c_str());
+  if (thread_counts.empty() ||
+      std::any_of(thread_counts.begin(), thread_counts.end(), [](int t) { return t < 1; })) {
+    args.Fail("THREADS is a list of thread counts, e.g. 1,2");
   }
   const std::vector<NetSpec> nets = {
       {"nature_cnn", "nature_cnn",

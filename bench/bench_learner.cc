@@ -136,8 +136,12 @@ const rl::nn::Precision kPrecisions[] = {rl::nn::Precision::kFp32, rl::nn::Preci
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
-  const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
+  const rl::bench::Args args(argc, argv,
+                             "usage: bench_learner [REPEATS (5)] [SECONDS per repeat (1)]\nLearner "
+                             "updates/s, fp32 and bf16 (JSON lines).",
+                             2);
+  const int repeats = args.Int(0, 5);
+  const double seconds = args.Number(1, 1.0);
   for (const rl::nn::Precision precision : kPrecisions) {
     for (int batch : {32, 64, 128}) {
       rl::learner::DqnConfig c;

@@ -432,6 +432,49 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
   return true;
 }
 
+// One service of pixel_replay_insert_cpu, keyed or not, and what its windows measured.
+struct PixelInsertSide {
+  std::string key;
+  int port = 0;
+  ServiceProbe* probe = nullptr;
+  pid_t pid = -1;
+  std::vector<double> capacity, cpu_us, thread_cpu_us, lost, mac_share;
+};
+
+// The two rows of pixel_replay_insert_cpu (below): the unkeyed service's, then the keyed one's.
+void EmitPixelInsertCpu(const PixelInsertSide (&sides)[2], const std::vector<double>& mac_cost,
+                        int repeats, double seconds, double rate, bool pin) {
+  for (int i = 0; i < 2; ++i) {
+    const PixelInsertSide& side = sides[i];
+    const auto cpu = rl::bench::Summarize(side.cpu_us);
+    const auto lost = rl::bench::Summarize(side.lost);
+    char extra[1024];
+    int n = std::snprintf(
+        extra, sizeof(extra),
+        "\"batch\": %d, \"frame\": \"%dx%d\", \"stack\": %d, \"transport\": \"udpm\", "
+        "\"offered_transitions_per_s\": %.0f, \"seconds\": %.1f, \"replay\": \"own process\", "
+        "\"replay_cpu_us_per_transition_median\": %.3f, \"replay_cpu_us_per_transition_min\": "
+        "%.3f, \"replay_cpu_us_per_transition_max\": %.3f, \"lost_fraction_median\": %.4f, "
+        "\"lost_fraction_max\": %.4f, \"service_thread_cpu_us_per_transition_median\": %.3f, "
+        "\"service_thread_cpu_us_per_transition_min\": %.3f, \"pinned\": %s, \"mac\": \"%s\"",
+        kBatch, kHeight, kWidth, kStack, rate, seconds, cpu.median, cpu.min, cpu.max, lost.median,
+        lost.max, rl::bench::Summarize(side.thread_cpu_us).median,
+        rl::bench::Summarize(side.thread_cpu_us).min, pin ? "true" : "false", MacName(side.key));
+    if (i == 1) {
+      const auto cost = rl::bench::Summarize(mac_cost);
+      const auto share = rl::bench::Summarize(side.mac_share);
+      std::snprintf(extra + n, sizeof(extra) - static_cast<size_t>(n),
+                    ", \"mac_cost_fraction_median\": %.4f, \"mac_cost_fraction_min\": %.4f, "
+                    "\"mac_cost_fraction_max\": %.4f, \"mac_share_of_replay_cpu_median\": %.4f, "
+                    "\"mac_share_of_replay_cpu_min\": %.4f, \"mac_share_of_replay_cpu_max\": %.4f",
+                    cost.median, cost.min, cost.max, share.median, share.min, share.max);
+    }
+    rl::bench::Emit(i == 0 ? "pixel_replay_insert_cpu" : "pixel_replay_insert_cpu_mac",
+                    "transitions per replay CPU-second", rl::bench::Summarize(side.capacity),
+                    repeats, extra);
+  }
+}
+
 // pixel_replay_insert_cpu, pixel_replay_insert_cpu_mac: what storing a pixel transition costs the
 // replay, which is what bounds its insert throughput, without and with the run's key. Two replay
 // services, each in a process of its own (forked before this process starts any thread), so that
@@ -447,13 +490,6 @@ bool PixelInsert(rl::Bus* bus, const ServiceProbe& probe, int repeats, double se
 // lost against the unkeyed window of the same pair (mac_cost_fraction, which the machine's noise
 // widens).
 int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
-  struct Side {
-    std::string key;
-    int port = 0;
-    ServiceProbe* probe = nullptr;
-    pid_t pid = -1;
-    std::vector<double> capacity, cpu_us, thread_cpu_us, lost, mac_share;
-  };
   // The first and the last of this process's CPUs (given back at the end), for the actors and
   // the services.
   cpu_set_t all_cpus;
@@ -470,12 +506,12 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
   // bytes) and drops it, so that the actor's load on the machine is the same on both sides.
   LooseGmac unkeyed_signer;
   int64_t unkeyed_seq = 0;
-  Side sides[2];
+  PixelInsertSide sides[2];
   sides[0].port = port;
   sides[1].key = std::string(rl::kKeyBytes, 'k');
   sides[1].port = port + 2;
   auto stop = [&] {
-    for (Side& side : sides) {
+    for (PixelInsertSide& side : sides) {
       if (side.probe == nullptr) continue;
       side.probe->stop = true;
       if (side.pid > 0) waitpid(side.pid, nullptr, 0);
@@ -484,7 +520,7 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
     }
     if (pin) sched_setaffinity(0, sizeof(all_cpus), &all_cpus);
   };
-  for (Side& side : sides) {
+  for (PixelInsertSide& side : sides) {
     void* shared = mmap(nullptr, sizeof(ServiceProbe), PROT_READ | PROT_WRITE,
                         MAP_SHARED | MAP_ANONYMOUS, -1, 0);
     if (shared == MAP_FAILED) {
@@ -533,7 +569,7 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
     // after the other side's than before it (a few %, on this machine with no key on either side).
     for (int k = 0; k < 2; ++k) {
       const int i = r % 2 == 0 ? k : 1 - k;
-      Side& side = sides[i];
+      PixelInsertSide& side = sides[i];
       rl::Bus* bus = buses[i].get();
       const int64_t before = side.probe->inserts.load();
       const double cpu_before = side.probe->process_cpu_seconds.load();
@@ -569,35 +605,7 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
   }
   stop();
 
-  for (int i = 0; i < 2; ++i) {
-    const Side& side = sides[i];
-    const auto cpu = rl::bench::Summarize(side.cpu_us);
-    const auto lost = rl::bench::Summarize(side.lost);
-    char extra[1024];
-    int n = std::snprintf(
-        extra, sizeof(extra),
-        "\"batch\": %d, \"frame\": \"%dx%d\", \"stack\": %d, \"transport\": \"udpm\", "
-        "\"offered_transitions_per_s\": %.0f, \"seconds\": %.1f, \"replay\": \"own process\", "
-        "\"replay_cpu_us_per_transition_median\": %.3f, \"replay_cpu_us_per_transition_min\": "
-        "%.3f, \"replay_cpu_us_per_transition_max\": %.3f, \"lost_fraction_median\": %.4f, "
-        "\"lost_fraction_max\": %.4f, \"service_thread_cpu_us_per_transition_median\": %.3f, "
-        "\"service_thread_cpu_us_per_transition_min\": %.3f, \"pinned\": %s, \"mac\": \"%s\"",
-        kBatch, kHeight, kWidth, kStack, rate, seconds, cpu.median, cpu.min, cpu.max, lost.median,
-        lost.max, rl::bench::Summarize(side.thread_cpu_us).median,
-        rl::bench::Summarize(side.thread_cpu_us).min, pin ? "true" : "false", MacName(side.key));
-    if (i == 1) {
-      const auto cost = rl::bench::Summarize(mac_cost);
-      const auto share = rl::bench::Summarize(side.mac_share);
-      std::snprintf(extra + n, sizeof(extra) - static_cast<size_t>(n),
-                    ", \"mac_cost_fraction_median\": %.4f, \"mac_cost_fraction_min\": %.4f, "
-                    "\"mac_cost_fraction_max\": %.4f, \"mac_share_of_replay_cpu_median\": %.4f, "
-                    "\"mac_share_of_replay_cpu_min\": %.4f, \"mac_share_of_replay_cpu_max\": %.4f",
-                    cost.median, cost.min, cost.max, share.median, share.min, share.max);
-    }
-    rl::bench::Emit(i == 0 ? "pixel_replay_insert_cpu" : "pixel_replay_insert_cpu_mac",
-                    "transitions per replay CPU-second", rl::bench::Summarize(side.capacity),
-                    repeats, extra);
-  }
+  EmitPixelInsertCpu(sides, mac_cost, repeats, seconds, rate, pin);
   return 0;
 }
 
@@ -1135,11 +1143,21 @@ void BusReceiveRows(int repeats) {
 constexpr double kInsertCpuRate = 100'000;
 
 int main(int argc, char** argv) {
-  if (argc > 1 && std::string(argv[1]) == "--mac") {
+  const std::string mode = argc > 1 ? argv[1] : "";
+  const bool has_mode = mode == "--mac" || mode == "--snapshots";
+  const rl::bench::Args args(
+      argc, argv,
+      "usage: bench_replay [REPEATS (5)] [SECONDS per repeat (1)] [PORT (17667; up to PORT+7)]\n"
+      "       bench_replay --mac [REPEATS] [SECONDS] [PORT]\n"
+      "       bench_replay --snapshots [REPEATS]\n"
+      "The replay through LCM, its memory, the MAC's cost (--mac) or the snapshots' "
+      "(--snapshots) (JSON lines).",
+      mode == "--snapshots" ? 1 : 3, has_mode ? 2 : 1);
+  const int repeats = args.Int(0, 5);
+  if (mode == "--mac") {
     // The MAC's cost alone: its throughput, and pixel inserts without and with it.
-    const int repeats = argc > 2 ? std::atoi(argv[2]) : 5;
-    const double seconds = argc > 3 ? std::atof(argv[3]) : 1.0;
-    const int port = argc > 4 ? std::atoi(argv[4]) : 17667;
+    const double seconds = args.Number(1, 1.0);
+    const int port = args.Int(2, 17667);
     // Forks its replay processes, so it runs first, while this process has no other thread.
     if (const int rc = PixelInsertCpu(repeats, 2 * seconds, port + 6, kInsertCpuRate); rc != 0) {
       return rc;
@@ -1151,15 +1169,13 @@ int main(int argc, char** argv) {
     }
     return RunPixelLcm(repeats, seconds, port + 4, std::string(rl::kKeyBytes, 'k'));
   }
-  if (argc > 1 && std::string(argv[1]) == "--snapshots") {
-    const int repeats = argc > 2 ? std::atoi(argv[2]) : 5;
+  if (mode == "--snapshots") {
     FlatSnapshots(repeats);
     PixelSnapshots(repeats);
     return 0;
   }
-  const int repeats = argc > 1 ? std::atoi(argv[1]) : 5;
-  const double seconds = argc > 2 ? std::atof(argv[2]) : 1.0;
-  const int port = argc > 3 ? std::atoi(argv[3]) : 17667;
+  const double seconds = args.Number(1, 1.0);
+  const int port = args.Int(2, 17667);
 
   // Forks its replay processes, so it runs first, while this process has no other thread.
   if (const int rc = PixelInsertCpu(repeats, 2 * seconds, port + 6, kInsertCpuRate); rc != 0) {

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rl::bench {
@@ -81,5 +82,53 @@ inline void Emit(const std::string& name, const std::string& unit, const Summary
       extra.empty() ? "" : ", ", extra.c_str(), CpuClock() ? ", \"clock\": \"process_cpu\"" : "");
   std::fflush(stdout);
 }
+
+// The positional arguments of a benchmark, named by its usage line ("bench_x [REPEATS] ...").
+// -h or --help anywhere prints the usage and exits 0. More arguments than the usage names, or one
+// read as a number that is not a positive number, print an error and the usage and exit 2.
+// Arguments are counted from `first` (1, or 2 after a mode such as bench_replay's --mac).
+class Args {
+ public:
+  Args(int argc, char** argv, std::string usage, int max_count, int first = 1)
+      : usage_(std::move(usage)) {
+    for (int i = 1; i < argc; ++i) {
+      if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
+        std::printf("%s\n", usage_.c_str());
+        std::exit(0);
+      }
+    }
+    for (int i = first; i < argc; ++i) args_.emplace_back(argv[i]);
+    if (static_cast<int>(args_.size()) > max_count) Fail("too many arguments");
+  }
+
+  // The i-th argument (from 0) as a positive number, `fallback` when it is not given.
+  double Number(size_t i, double fallback) const {
+    if (i >= args_.size()) return fallback;
+    char* end = nullptr;
+    const double v = std::strtod(args_[i].c_str(), &end);
+    if (end == args_[i].c_str() || *end != '\0' || !(v > 0)) {
+      Fail("'" + args_[i] + "' is not a positive number");
+    }
+    return v;
+  }
+  int Int(size_t i, int fallback) const {
+    const double v = Number(i, fallback);
+    if (v != static_cast<int>(v)) Fail("'" + args_[i] + "' is not a whole number");
+    return static_cast<int>(v);
+  }
+  // The i-th argument as given, `fallback` when it is not given.
+  std::string Text(size_t i, const std::string& fallback) const {
+    return i < args_.size() ? args_[i] : fallback;
+  }
+
+  [[noreturn]] void Fail(const std::string& why) const {
+    std::fprintf(stderr, "error: %s\n%s\n", why.c_str(), usage_.c_str());
+    std::exit(2);
+  }
+
+ private:
+  std::string usage_;
+  std::vector<std::string> args_;
+};
 
 }  // namespace rl::bench

@@ -337,6 +337,115 @@ int CheckReplayed(rl::Bus& bus, const std::string& log_path, double timeout) {
   return ok ? 0 : 1;
 }
 
+// Sends `count` messages of each bad kind on every target's channel (the top of this file says
+// which), paced (1 ms apart) so that nothing is lost on the way. Messages that pass the MAC check
+// take the channel's next sequence number; the others reuse it, so that no receiver counts a gap.
+// Returns how many it sent.
+int SendBadMessages(rl::Bus& bus, int64_t run_id, int count, uint64_t seed) {
+  const bool keyed = !bus.config().key.empty();
+  std::unique_ptr<rl::MessageAuthenticator> auth, other;
+  if (keyed) {
+    auth = std::make_unique<rl::MessageAuthenticator>(bus.config().key);
+    other = std::make_unique<rl::MessageAuthenticator>(std::string(rl::kKeyBytes, '\x5a'));
+  }
+  rlmsg::header_t header{};
+  header.run_id = run_id;
+  header.sender = "inject";
+  header.incarnation = rl::WallMicros();
+  const size_t mac_at = rl::MacOffset(header.sender.size());
+  std::map<std::string, int64_t> next_seq;
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<int> byte(0, 255), length(1, 300);
+  int sent = 0;
+  for (const Target& t : Targets()) {
+    auto send = [&](const std::vector<uint8_t>& bytes) {
+      bus.PublishRaw(t.channel, bytes.data(), bytes.size());
+      ++sent;
+    };
+    for (int k = 0; k < count; ++k) {
+      header.run_id = run_id;
+      header.seq = next_seq[t.channel];
+      header.utime = rl::WallMicros();
+      std::vector<uint8_t> junk(static_cast<size_t>(length(rng)));
+      for (auto& b : junk) b = static_cast<uint8_t>(byte(rng));
+      send(junk);
+      std::vector<uint8_t> good = t.good(header);
+      good.resize(good.size() / 2);
+      send(good);
+      if (keyed) {
+        send(t.good(header));  // no MAC
+        std::vector<uint8_t> forged = t.good(header);
+        other->Sign(t.channel, forged.data(), forged.size(), mac_at);
+        send(forged);  // another key's MAC
+        // Signed as a later incarnation of ours (that sends nothing else), so that this MAC's
+        // nonce is not the one of the invalid message below (common/message_auth.h).
+        rlmsg::header_t later = header;
+        later.incarnation = header.incarnation + 1;
+        std::vector<uint8_t> flipped = t.good(later);
+        auth->Sign(t.channel, flipped.data(), flipped.size(), mac_at);
+        flipped[mac_at - 9] ^= 0x10;  // in header.utime: still decodes
+        send(flipped);                // changed after signing
+      }
+      header.run_id = run_id ^ 0x5A5A5A5A5A5ALL;
+      send(t.good(header));  // another run's
+      header.run_id = run_id;
+      header.seq = next_seq[t.channel]++;
+      std::vector<uint8_t> invalid = t.invalid(header);
+      if (keyed) auth->Sign(t.channel, invalid.data(), invalid.size(), mac_at);
+      send(invalid);
+      send(invalid);  // the same again: replayed
+      bus.Handle(1);
+    }
+  }
+  return sent;
+}
+
+// Waits up to `timeout` s for every role in `expected` to report the drops of each kind that the
+// channels it subscribes to imply, prints a line per role, and returns 0 if all did, 1 if not.
+int CheckDrops(rl::Bus& bus, const RoleDrops& drops, const std::set<std::string>& expected,
+               int count, bool keyed, double timeout) {
+  auto enough = [&](const std::string& role, const Drops& d) {
+    const int64_t n = count * static_cast<int64_t>(RoleChannels().at(role).size());
+    // A truncated copy whose header is whole fails the MAC check before it is decoded, where
+    // there is a key: malformed or unauthenticated.
+    return d.malformed >= n && d.malformed + d.unauthenticated >= (keyed ? 5 : 2) * n &&
+           d.foreign >= n && d.invalid >= n && d.replayed >= n &&
+           d.unauthenticated >= (keyed ? 3 * n : 0);
+  };
+  const double deadline = rl::MonoSeconds() + timeout;
+  const double sent_at = rl::MonoSeconds();
+  while (rl::MonoSeconds() < deadline && !rl::StopRequested()) {
+    bus.Handle(100);
+    const auto by_role = drops.ByRole();
+    bool all = true;
+    for (const std::string& role : expected) {
+      const auto it = by_role.find(role);
+      if (it == by_role.end() || it->second.seen < sent_at || !enough(role, it->second)) {
+        all = false;
+      }
+    }
+    if (all) break;
+  }
+  int status = 0;
+  const auto by_role = drops.ByRole();
+  for (const std::string& role : expected) {
+    const int64_t n = count * static_cast<int64_t>(RoleChannels().at(role).size());
+    const Drops d = by_role.count(role) ? by_role.at(role) : Drops{};
+    const bool ok = enough(role, d);
+    std::printf(
+        "inject: %-9s malformed %lld/%lld foreign %lld/%lld invalid %lld/%lld replayed %lld/%lld "
+        "unauthenticated %lld/%lld %s\n",
+        role.c_str(), static_cast<long long>(d.malformed), static_cast<long long>(n),
+        static_cast<long long>(d.foreign), static_cast<long long>(n),
+        static_cast<long long>(d.invalid), static_cast<long long>(n),
+        static_cast<long long>(d.replayed), static_cast<long long>(n),
+        static_cast<long long>(d.unauthenticated), static_cast<long long>(keyed ? 3 * n : 0),
+        ok ? "ok" : "MISSING");
+    if (!ok) status = 1;
+  }
+  return status;
+}
+
 int Main(int argc, char** argv) {
   rl::CommonOptions common;
   int count = 20;
@@ -385,111 +494,12 @@ int Main(int argc, char** argv) {
         (spec.action_low[static_cast<size_t>(d)] + spec.action_high[static_cast<size_t>(d)]) / 2;
   }
   RoleDrops drops(&bus);
-
-  // Send, paced (1 ms apart), so that nothing is lost on the way. Messages that pass the MAC
-  // check take the channel's next sequence number; the others reuse it, so that no receiver
-  // counts a gap.
   const bool keyed = !bus.config().key.empty();
-  std::unique_ptr<rl::MessageAuthenticator> auth, other;
-  if (keyed) {
-    auth = std::make_unique<rl::MessageAuthenticator>(bus.config().key);
-    other = std::make_unique<rl::MessageAuthenticator>(std::string(rl::kKeyBytes, '\x5a'));
-  }
-  rlmsg::header_t header{};
-  header.run_id = common.run_id;
-  header.sender = "inject";
-  header.incarnation = rl::WallMicros();
-  const size_t mac_at = rl::MacOffset(header.sender.size());
-  std::map<std::string, int64_t> next_seq;
-  std::mt19937_64 rng(seed);
-  std::uniform_int_distribution<int> byte(0, 255), length(1, 300);
-  int sent = 0;
-  for (const Target& t : Targets()) {
-    auto send = [&](const std::vector<uint8_t>& bytes) {
-      bus.PublishRaw(t.channel, bytes.data(), bytes.size());
-      ++sent;
-    };
-    for (int k = 0; k < count; ++k) {
-      header.run_id = common.run_id;
-      header.seq = next_seq[t.channel];
-      header.utime = rl::WallMicros();
-      std::vector<uint8_t> junk(static_cast<size_t>(length(rng)));
-      for (auto& b : junk) b = static_cast<uint8_t>(byte(rng));
-      send(junk);
-      std::vector<uint8_t> good = t.good(header);
-      good.resize(good.size() / 2);
-      send(good);
-      if (keyed) {
-        send(t.good(header));  // no MAC
-        std::vector<uint8_t> forged = t.good(header);
-        other->Sign(t.channel, forged.data(), forged.size(), mac_at);
-        send(forged);  // another key's MAC
-        // Signed as a later incarnation of ours (that sends nothing else), so that this MAC's
-        // nonce is not the one of the invalid message below (common/message_auth.h).
-        rlmsg::header_t later = header;
-        later.incarnation = header.incarnation + 1;
-        std::vector<uint8_t> flipped = t.good(later);
-        auth->Sign(t.channel, flipped.data(), flipped.size(), mac_at);
-        flipped[mac_at - 9] ^= 0x10;  // in header.utime: still decodes
-        send(flipped);                // changed after signing
-      }
-      header.run_id = common.run_id ^ 0x5A5A5A5A5A5ALL;
-      send(t.good(header));  // another run's
-      header.run_id = common.run_id;
-      header.seq = next_seq[t.channel]++;
-      std::vector<uint8_t> invalid = t.invalid(header);
-      if (keyed) auth->Sign(t.channel, invalid.data(), invalid.size(), mac_at);
-      send(invalid);
-      send(invalid);  // the same again: replayed
-      bus.Handle(1);
-    }
-  }
+  const int sent = SendBadMessages(bus, common.run_id, count, seed);
   std::printf("inject: sent %d bad messages%s\n", sent,
               keyed ? "" : " (no --key-file: none unauthenticated)");
   std::fflush(stdout);
-
-  // Wait for every role's counters to reach what its subscriptions imply.
-  const std::set<std::string> expected = SplitRoles(roles);
-  auto enough = [&](const std::string& role, const Drops& d) {
-    const int64_t n = count * static_cast<int64_t>(RoleChannels().at(role).size());
-    // A truncated copy whose header is whole fails the MAC check before it is decoded, where
-    // there is a key: malformed or unauthenticated.
-    return d.malformed >= n && d.malformed + d.unauthenticated >= (keyed ? 5 : 2) * n &&
-           d.foreign >= n && d.invalid >= n && d.replayed >= n &&
-           d.unauthenticated >= (keyed ? 3 * n : 0);
-  };
-  const double deadline = rl::MonoSeconds() + timeout;
-  const double sent_at = rl::MonoSeconds();
-  while (rl::MonoSeconds() < deadline && !rl::StopRequested()) {
-    bus.Handle(100);
-    const auto by_role = drops.ByRole();
-    bool all = true;
-    for (const std::string& role : expected) {
-      const auto it = by_role.find(role);
-      if (it == by_role.end() || it->second.seen < sent_at || !enough(role, it->second)) {
-        all = false;
-      }
-    }
-    if (all) break;
-  }
-  int status = 0;
-  const auto by_role = drops.ByRole();
-  for (const std::string& role : expected) {
-    const int64_t n = count * static_cast<int64_t>(RoleChannels().at(role).size());
-    const Drops d = by_role.count(role) ? by_role.at(role) : Drops{};
-    const bool ok = enough(role, d);
-    std::printf(
-        "inject: %-9s malformed %lld/%lld foreign %lld/%lld invalid %lld/%lld replayed %lld/%lld "
-        "unauthenticated %lld/%lld %s\n",
-        role.c_str(), static_cast<long long>(d.malformed), static_cast<long long>(n),
-        static_cast<long long>(d.foreign), static_cast<long long>(n),
-        static_cast<long long>(d.invalid), static_cast<long long>(n),
-        static_cast<long long>(d.replayed), static_cast<long long>(n),
-        static_cast<long long>(d.unauthenticated), static_cast<long long>(keyed ? 3 * n : 0),
-        ok ? "ok" : "MISSING");
-    if (!ok) status = 1;
-  }
-  return status;
+  return CheckDrops(bus, drops, SplitRoles(roles), count, keyed, timeout);
 }
 
 }  // namespace
