@@ -3,12 +3,15 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
+#include <string_view>
 
 #include "common/messages.h"
 #include "evaluator/json_line.h"
@@ -101,6 +104,34 @@ std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s, double age)
   return AddDrops(line, s, age).Done();
 }
 
+namespace {
+
+// The t of the last line of the file at `path` that is a JSON object with a number t, read from
+// its last 64 KB (many rows); 0 when there is none.
+double LastT(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return 0;
+  const std::streamoff size = in.tellg();
+  const std::streamoff from = std::max<std::streamoff>(0, size - (64 << 10));
+  in.seekg(from);
+  std::string tail(static_cast<size_t>(size - from), '\0');
+  in.read(tail.data(), static_cast<std::streamsize>(tail.size()));
+  tail.resize(static_cast<size_t>(in.gcount()));
+  size_t end = tail.size();
+  while (end > 0) {
+    const size_t begin = tail.rfind('\n', end - 1);
+    const size_t first = begin == std::string::npos ? 0 : begin + 1;
+    if (const auto object = ParseJsonLine(std::string_view(tail).substr(first, end - first))) {
+      if (const auto t = JsonNumberAt(*object, "t")) return *t;
+    }
+    if (begin == std::string::npos) break;
+    end = begin;
+  }
+  return 0;
+}
+
+}  // namespace
+
 MetricsLog::MetricsLog(const std::string& path, double dense_seconds, double dense_period,
                        double sparse_period)
     : path_(path),
@@ -114,6 +145,7 @@ MetricsLog::MetricsLog(const std::string& path, double dense_seconds, double den
   if (fd_ < 0) {
     throw std::runtime_error("cannot open metrics file " + path + ": " + std::strerror(errno));
   }
+  last_t_ = LastT(path);
 }
 
 MetricsLog::~MetricsLog() {

@@ -5,8 +5,10 @@
 //
 // Appending and crash-safe: each row (the lines of every role) is one write(2) to a file opened
 // with O_APPEND, so a process killed at any moment leaves whole lines, and a restarted writer
-// appends after them. Bounded for long runs: a row every second for the first hour, then every
-// ten seconds (about 4,000 rows in the first hour and 360 an hour after that, per role).
+// appends after them, its t carrying on from the last line's (last_t()), so that a resumed run's
+// rows follow the earlier parts' instead of starting again at 0. Bounded for long runs: a row every
+// second for the first hour, then every ten seconds (about 4,000 rows in the first hour and 360 an
+// hour after that, per role).
 #pragma once
 
 #include <string>
@@ -29,8 +31,9 @@ std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s, double age 
 
 class MetricsLog {
  public:
-  /// Opens `path` for appending (creating it). Throws std::runtime_error naming the path.
-  /// `dense_seconds` and the two periods set the row schedule (see the file comment).
+  /// Opens `path` for appending (creating it), and reads the t of its last line (last_t()).
+  /// Throws std::runtime_error naming the path. `dense_seconds` and the two periods set the row
+  /// schedule (see the file comment).
   explicit MetricsLog(const std::string& path, double dense_seconds = 3600, double dense_period = 1,
                       double sparse_period = 10);
   MetricsLog(const MetricsLog&) = delete;
@@ -43,6 +46,10 @@ class MetricsLog {
   /// std::runtime_error on a write error.
   void AppendRow(double t, const std::string& lines);
   int64_t rows() const { return rows_; }
+  /// The "t" of the file's last line when it was opened: 0 for a new or empty file. A writer of
+  /// a resumed run adds it to its own clock. (Lines that are not JSON with a number t, such as a
+  /// line cut short, are passed over.)
+  double last_t() const { return last_t_; }
 
  private:
   std::string path_;
@@ -52,6 +59,7 @@ class MetricsLog {
   double sparse_period_;
   double next_ = 0;
   int64_t rows_ = 0;
+  double last_t_ = 0;
 };
 
 }  // namespace rl::tools

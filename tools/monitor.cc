@@ -212,9 +212,11 @@ int Main(int argc, char** argv) {
       status = 3;
       break;
     }
-    if (metrics != nullptr && metrics->Due(elapsed)) {
-      const std::string row = MetricsRow(v, elapsed, now);
-      if (!row.empty()) metrics->AppendRow(elapsed, row);
+    // A resumed run's rows carry on from the earlier parts' (MetricsLog::last_t).
+    if (metrics != nullptr && metrics->Due(metrics->last_t() + elapsed)) {
+      const double t = metrics->last_t() + elapsed;
+      const std::string row = MetricsRow(v, t, now);
+      if (!row.empty()) metrics->AppendRow(t, row);
     }
     if (now >= next_print) {
       std::printf(tty ? "\r%s\033[K" : "%s\n",

@@ -11,6 +11,9 @@ scratch
 start_cartpole "$dir/first.log" --actors 2 --seed 4 --goal 100000 --time-budget 240
 wait_line "$dir/run/eval.jsonl" '"update"' 120
 wait_learner_state "$dir/run"
+# (and metrics rows 3 s into the run, so that rows of the resumed part that started again at 0
+# would be seen going back)
+wait_line "$dir/run/metrics.jsonl" '"t": [3-9]\.' 60
 kill -TERM "$launch_pid"
 wait_launch "$dir/first.log"
 [ "$status" -eq 130 ] || fail "the stopped launch exited with $status, not 130"
@@ -36,5 +39,9 @@ awk -F'"update": ' '{split($2, a, ","); u = a[1] + 0; if (u < prev) { print "upd
   "$dir/run/eval.jsonl" || fail "evaluation updates went back"
 awk -F'"env_steps": ' '{split($2, a, ","); s = a[1] + 0; if (s < prev) { print "env steps " s " after " prev; exit 1 } prev = s}' \
   "$dir/run/eval.jsonl" || fail "evaluation env steps went back"
+# The metrics' time carries on too: the resumed monitor's rows follow the first part's.
+grep -q '"t": ' "$dir/run/metrics.jsonl" || fail "no metrics rows"
+awk -F'"t": ' '{split($2, a, ","); t = a[1] + 0; if (t < prev) { print "metrics t " t " after " prev; exit 1 } prev = t}' \
+  "$dir/run/metrics.jsonl" || fail "the metrics' t went back at the resumption"
 expect_no_restarts "$dir/run"
 echo "PASS: stopped at update $last_update_before, resumed at $resumed, goal reached"

@@ -88,6 +88,7 @@ TEST_F(MetricsLogTest, RowsFollowTheScheduleAndAppendAfterARestart) {
   {
     MetricsLog log(path_.string(), /*dense_seconds=*/10, /*dense_period=*/1,
                    /*sparse_period=*/5);
+    EXPECT_EQ(log.last_t(), 0);  // a new file
     int rows = 0;
     for (double t = 0; t < 30; t += 0.25) {
       if (!log.Due(t)) continue;
@@ -100,11 +101,24 @@ TEST_F(MetricsLogTest, RowsFollowTheScheduleAndAppendAfterARestart) {
   }
   {
     MetricsLog again(path_.string());
+    EXPECT_EQ(again.last_t(), 25);  // the last row's: a resumed run's rows carry on from it
     again.AppendRow(31, "{\"t\": 31}\n");
   }
   const std::vector<std::string> lines = Lines(path_);
   ASSERT_EQ(lines.size(), 15u);
   EXPECT_EQ(lines.back(), "{\"t\": 31}");
+}
+
+TEST_F(MetricsLogTest, TheLastTPassesOverLinesThatAreNotWholeRows) {
+  {
+    std::ofstream out(path_);
+    out << "{\"t\": 7.5, \"role\": \"learner\"}\n"
+        << "{\"t\": 8.5, \"role\": \"replay\"}\n"
+        << "{\"role\": \"actor-0\"}\n"  // no t
+        << "not json\n"
+        << "{\"t\": 9.5, \"role\": \"lear";  // cut short
+  }
+  EXPECT_EQ(MetricsLog(path_.string()).last_t(), 8.5);
 }
 
 TEST_F(MetricsLogTest, AnUnwritablePathIsRefusedWithItsName) {
