@@ -12,12 +12,8 @@
 #include "nn/sequential.h"
 
 int main(int argc, char** argv) {
-  const rl::bench::Args args(argc, argv,
-                             "usage: bench_actor [REPEATS (5)] [SECONDS per repeat (1)]\nThe "
-                             "actor's own loop, steps/s (JSON lines).",
-                             2);
-  const int repeats = args.Int(0, 5);
-  const double seconds = args.Number(1, 1.0);
+  const auto [repeats, seconds] = rl::bench::ReadTiming(
+      argc, argv, "bench_actor", "The actor's own loop, steps/s (JSON lines).");
   rl::Bus bus(rl::InProcessBusConfig(1, "actor-0"));
   rl::actor::ActorConfig c;
   c.exploration.mode = "constant";

@@ -80,12 +80,8 @@ void BenchCarRacing(int repeats, double seconds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const rl::bench::Args args(argc, argv,
-                             "usage: bench_env [REPEATS (5)] [SECONDS per repeat (1)]\nEnv steps/s "
-                             "with a random policy (JSON lines).",
-                             2);
-  const int repeats = args.Int(0, 5);
-  const double seconds = args.Number(1, 1.0);
+  const auto [repeats, seconds] = rl::bench::ReadTiming(
+      argc, argv, "bench_env", "Env steps/s with a random policy (JSON lines).");
   for (const auto& [id, name] : {std::pair{"CartPole-v1", "cartpole_env_steps"},
                                  std::pair{"LunarLander-v3", "lunar_lander_env_steps"}}) {
     auto env = rl::envs::MakeEnv(id);

@@ -136,12 +136,8 @@ const rl::nn::Precision kPrecisions[] = {rl::nn::Precision::kFp32, rl::nn::Preci
 }  // namespace
 
 int main(int argc, char** argv) {
-  const rl::bench::Args args(argc, argv,
-                             "usage: bench_learner [REPEATS (5)] [SECONDS per repeat (1)]\nLearner "
-                             "updates/s, fp32 and bf16 (JSON lines).",
-                             2);
-  const int repeats = args.Int(0, 5);
-  const double seconds = args.Number(1, 1.0);
+  const auto [repeats, seconds] = rl::bench::ReadTiming(
+      argc, argv, "bench_learner", "Learner updates/s, fp32 and bf16 (JSON lines).");
   for (const rl::nn::Precision precision : kPrecisions) {
     for (int batch : {32, 64, 128}) {
       rl::learner::DqnConfig c;

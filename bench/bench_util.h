@@ -131,4 +131,17 @@ class Args {
   std::vector<std::string> args_;
 };
 
+// The arguments of most benchmarks: REPEATS (5) and SECONDS per repeat (1), read through Args
+// with a usage line naming `program` and saying `what` it measures.
+struct Timing {
+  int repeats;
+  double seconds;
+};
+inline Timing ReadTiming(int argc, char** argv, const std::string& program,
+                         const std::string& what) {
+  const Args args(argc, argv,
+                  "usage: " + program + " [REPEATS (5)] [SECONDS per repeat (1)]\n" + what, 2);
+  return {args.Int(0, 5), args.Number(1, 1.0)};
+}
+
 }  // namespace rl::bench
