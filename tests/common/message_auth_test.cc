@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 class KeyFileTest : public TempDirTest {
  protected:
   std::string Write(const std::string& bytes, mode_t mode) {
-    const std::string path = (dir_ / "key").string();
+    std::string path = (dir_ / "key").string();
     fs::remove(path);
     std::ofstream(path, std::ios::binary) << bytes;
     EXPECT_EQ(::chmod(path.c_str(), mode), 0);

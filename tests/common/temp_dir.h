@@ -1,8 +1,7 @@
 // A test fixture with an empty directory of its own.
 #pragma once
 
-#include <stdlib.h>
-
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
