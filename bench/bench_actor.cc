@@ -12,8 +12,10 @@
 #include "nn/sequential.h"
 
 int main(int argc, char** argv) {
-  const auto [repeats, seconds] = rl::bench::ReadTiming(
+  const rl::bench::Timing timing = rl::bench::ReadTiming(
       argc, argv, "bench_actor", "The actor's own loop, steps/s (JSON lines).");
+  const int repeats = timing.repeats;
+  const double seconds = timing.seconds;
   rl::Bus bus(rl::InProcessBusConfig(1, "actor-0"));
   rl::actor::ActorConfig c;
   c.exploration.mode = "constant";

@@ -80,8 +80,10 @@ void BenchCarRacing(int repeats, double seconds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto [repeats, seconds] = rl::bench::ReadTiming(
+  const rl::bench::Timing timing = rl::bench::ReadTiming(
       argc, argv, "bench_env", "Env steps/s with a random policy (JSON lines).");
+  const int repeats = timing.repeats;
+  const double seconds = timing.seconds;
   for (const auto& [id, name] : {std::pair{"CartPole-v1", "cartpole_env_steps"},
                                  std::pair{"LunarLander-v3", "lunar_lander_env_steps"}}) {
     auto env = rl::envs::MakeEnv(id);

@@ -136,8 +136,10 @@ const rl::nn::Precision kPrecisions[] = {rl::nn::Precision::kFp32, rl::nn::Preci
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto [repeats, seconds] = rl::bench::ReadTiming(
+  const rl::bench::Timing timing = rl::bench::ReadTiming(
       argc, argv, "bench_learner", "Learner updates/s, fp32 and bf16 (JSON lines).");
+  const int repeats = timing.repeats;
+  const double seconds = timing.seconds;
   for (const rl::nn::Precision precision : kPrecisions) {
     for (int batch : {32, 64, 128}) {
       rl::learner::DqnConfig c;
