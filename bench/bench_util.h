@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -113,7 +115,10 @@ class Args {
   }
   int Int(size_t i, int fallback) const {
     const double v = Number(i, fallback);
-    if (v != static_cast<int>(v)) Fail("'" + args_[i] + "' is not a whole number");
+    if (v > std::numeric_limits<int>::max() || v != std::floor(v)) {
+      Fail("'" + args_[i] + "' is not a whole number of at most " +
+           std::to_string(std::numeric_limits<int>::max()));
+    }
     return static_cast<int>(v);
   }
   // The i-th argument as given, `fallback` when it is not given.
