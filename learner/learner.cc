@@ -76,6 +76,7 @@ void LearnerConfig::Validate() const {
   if (weights_every < 1) throw std::invalid_argument("weights-every must be >= 1");
   if (checkpoint_every < 1) throw std::invalid_argument("checkpoint-every must be >= 1");
   if (keep_checkpoints < 0) throw std::invalid_argument("keep-checkpoints must be >= 0");
+  if (policy_average < 0) throw std::invalid_argument("policy-average must be >= 0");
   if (!(stats_hz > 0)) throw std::invalid_argument("stats-hz must be > 0");
   if (threads < 1 || threads > 64) throw std::invalid_argument("threads must be in [1, 64]");
   nn::ParsePrecision(precision);
@@ -90,6 +91,7 @@ Learner::Learner(LearnerConfig config, Bus* bus)
       weights_(bus),
       sender_(bus->config().sender) {
   nn::SetNumThreads(config_.threads);
+  if (config_.policy_average > 0) average_.emplace(config_.policy_average);
   std::filesystem::create_directories(std::filesystem::path(config_.out_dir) / "checkpoints");
   // An earlier life killed while it wrote a checkpoint or the state left its temporary file.
   RemoveStaleTemporaries((std::filesystem::path(config_.out_dir) / "checkpoints").string());
@@ -173,6 +175,10 @@ void Learner::TrainOn(const rlmsg::sample_batch_t& m) {
     return;
   }
   if (config_.prioritized) PublishPriorities(m.index);
+  if (average_) {
+    algorithm_->policy().GetFlat(&flat_);
+    average_->Add(flat_);
+  }
   loss_sum_ += r.loss;
   q_sum_ += r.mean_q;
   ++stat_updates_;
@@ -194,6 +200,7 @@ StateFile Learner::SaveState() const {
   // The last reply heard from each replay, so that a restarted learner refuses recorded replies
   // older than this state (common/lcm_bus.h).
   state.PutText("learner.bus_positions", bus_->SavePositions());
+  if (average_) average_->Save(&state, "learner.policy_average");
   algorithm_->SaveState(&state);
   return state;
 }
@@ -217,6 +224,10 @@ void Learner::LoadState(const StateFile& state) {
   GetRng(state, "learner.shift_rng", &decoder_.shift_rng());
   // States written before the bus kept positions have none.
   if (state.Has("learner.bus_positions")) bus_->LoadPositions(state.Text("learner.bus_positions"));
+  // A state saved without an average (the option was off) starts one at the next update.
+  if (average_) {
+    average_->Load(state, "learner.policy_average", algorithm_->policy().FlatSize());
+  }
 }
 
 std::string Learner::Checkpoint() {
@@ -231,7 +242,13 @@ std::string Learner::Checkpoint() {
   ckpt.meta.wall_seconds = MonoSeconds() - start_time_;
   ckpt.meta.run_id = static_cast<uint64_t>(bus_->config().run_id);
   ckpt.meta.note = "env = " + config_.env_id + "\nprecision = " + config_.precision;
-  algorithm_->policy().GetFlat(&ckpt.params);
+  if (!average_ || average_->values().empty()) {
+    algorithm_->policy().GetFlat(&ckpt.params);
+  } else {
+    ckpt.params = average_->values();
+    ckpt.meta.note +=
+        "\npolicy = the average of about " + std::to_string(config_.policy_average) + " updates";
+  }
   nn::SaveCheckpoint(path, ckpt);
   SaveState().Save(StatePath());
   // Keep the newest keep_checkpoints files (this life's last, earlier lives' before them); older

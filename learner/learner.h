@@ -12,6 +12,7 @@
 #include <deque>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
 
@@ -21,6 +22,7 @@
 #include "learner/algorithm.h"
 #include "learner/algorithms.h"
 #include "learner/batch_decoder.h"
+#include "learner/parameter_average.h"
 #include "learner/weights_publisher.h"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_batch_t.hpp"
@@ -43,7 +45,11 @@ struct LearnerConfig {
   int keep_checkpoints = 0;      // newest checkpoint files kept on disk, earlier lives' included
                                  // (0: all)
   bool prioritized = false;      // publish |TD errors| as priorities after every update
-  int threads = 1;               // compute threads of the network library (nn::SetNumThreads)
+  // Checkpoints (what the evaluator scores) hold an exponential moving average of the policy's
+  // parameters over about this many updates instead of its current ones; the actors still get
+  // the current ones. 0: no average.
+  int policy_average = 0;
+  int threads = 1;  // compute threads of the network library (nn::SetNumThreads)
   // The networks' matrix products, "fp32" or "bf16" (nn/precision.h); kept in the learner state.
   std::string precision = "fp32";
   std::string out_dir = ".";  // checkpoints go to <out_dir>/checkpoints/
@@ -128,6 +134,8 @@ class Learner {
   int64_t request_timeouts_ = 0;
   int64_t stale_replies_ = 0;
   std::vector<float> flat_;
+  // The policy's parameters averaged over about policy_average updates (when that is > 0).
+  std::optional<ParameterAverage> average_;
   // Checkpoint files on disk, oldest first: those of earlier lives found at the start (by
   // update), then this life's.
   std::deque<std::string> written_;

@@ -86,6 +86,10 @@ int Main(int argc, char** argv) {
       ("keep-checkpoints", rl::po::value(&c.keep_checkpoints)->default_value(c.keep_checkpoints),
        "newest checkpoint files kept on disk, those earlier lives of the learner left in the "
        "folder included (0: all)")  //
+      ("policy-average", rl::po::value(&c.policy_average)->default_value(c.policy_average),
+       "checkpoints, and so the evaluator's scores, hold an exponential moving average of the "
+       "policy's parameters over about this many updates (the actors still explore with the "
+       "current ones); 0: the current parameters")  //
       ("precision", rl::po::value(&c.precision)->default_value(c.precision),
        "the networks' matrix products: fp32, or bf16 (inputs rounded to bfloat16, sums in fp32; "
        "weights, optimizer, activations and losses stay fp32). bf16 is fast on CPUs with "
@@ -158,8 +162,12 @@ int Main(int argc, char** argv) {
   } else if (c.resume) {
     resumed = ", nothing to resume: starting afresh";
   }
-  std::printf("learner: ready (%s)%s, %s%s\n", learner.algorithm().Describe().c_str(),
-              shifts.c_str(), kernels.c_str(), resumed.c_str());
+  const std::string average =
+      c.policy_average > 0
+          ? ", checkpoints average the policy over " + std::to_string(c.policy_average) + " updates"
+          : "";
+  std::printf("learner: ready (%s)%s, %s%s%s\n", learner.algorithm().Describe().c_str(),
+              shifts.c_str(), kernels.c_str(), average.c_str(), resumed.c_str());
   std::fflush(stdout);
   learner.Run();
   std::printf("learner: stopped after %lld updates\n", static_cast<long long>(learner.updates()));
