@@ -1,7 +1,7 @@
 // Helpers of the benchmarks: repeated measurements and one JSON object per line.
 #pragma once
 
-#include <time.h>
+#include <time.h>  // NOLINT(modernize-deprecated-headers): POSIX clock_gettime, not in <ctime>
 
 #include <algorithm>
 #include <chrono>
