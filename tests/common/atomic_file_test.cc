@@ -4,12 +4,12 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "tests/common/read_file.h"
 #include "tests/common/temp_dir.h"
 
 namespace rl {
@@ -17,23 +17,15 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class AtomicFileTest : public TempDirTest {
- protected:
-  static std::string Read(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream s;
-    s << in.rdbuf();
-    return s.str();
-  }
-};
+class AtomicFileTest : public TempDirTest {};
 
 TEST_F(AtomicFileTest, WritesReplacesAndLeavesNoTemporaryFile) {
   const std::string path = (dir_ / "a.bin").string();
   const std::string first("one\0two", 7);  // bytes, NUL included
   WriteFileAtomically(path, first);
-  EXPECT_EQ(Read(path), first);
+  EXPECT_EQ(ReadFile(path), first);
   WriteFileAtomically(path, "replaced");
-  EXPECT_EQ(Read(path), "replaced");
+  EXPECT_EQ(ReadFile(path), "replaced");
   EXPECT_FALSE(fs::exists(TemporaryPathFor(path)));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator{}), 1);
 }
@@ -61,7 +53,7 @@ TEST_F(AtomicFileTest, RenameIntoPlaceCommitsAFileWrittenElsewhere) {
   std::ofstream(tmp) << "frames";
   const std::string path = (dir_ / "video.webm").string();
   RenameIntoPlace(tmp.string(), path, "video");
-  EXPECT_EQ(Read(path), "frames");
+  EXPECT_EQ(ReadFile(path), "frames");
   EXPECT_FALSE(fs::exists(tmp));
   EXPECT_THROW(RenameIntoPlace(tmp.string(), path, "video"), std::runtime_error);  // gone
 }
@@ -75,18 +67,18 @@ TEST_F(AtomicFileTest, AStreamCommitsWholeOrLeavesTheOldFile) {
     EXPECT_STREQ(out.temporary_path(), TemporaryPathFor(path).c_str());
     ASSERT_TRUE(out.Write("new ", 4));
     ASSERT_TRUE(out.Write("bytes", 5));
-    EXPECT_EQ(Read(path), "old");  // not yet
+    EXPECT_EQ(ReadFile(path), "old");  // not yet
     ASSERT_TRUE(out.Commit());
     EXPECT_EQ(out.bytes_written(), 9);
   }
-  EXPECT_EQ(Read(path), "new bytes");
+  EXPECT_EQ(ReadFile(path), "new bytes");
   {
     // Abandoned: the temporary file goes, the file stays.
     AtomicFileStream out(path);
     ASSERT_TRUE(out.Open());
     ASSERT_TRUE(out.Write("partial", 7));
   }
-  EXPECT_EQ(Read(path), "new bytes");
+  EXPECT_EQ(ReadFile(path), "new bytes");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator{}), 1);
   // A failure names the step, the file and the reason.
   const std::string missing = (dir_ / "no_such_dir" / "s.bin").string();

@@ -1,7 +1,5 @@
 #include "common/options.h"
 
-#include <unistd.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/common/error_of.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl {
 namespace {
@@ -27,8 +26,8 @@ struct Parsed {
   int episodes = 0;
 };
 Parsed Parse(const std::string& ini, std::vector<std::string> args = {}) {
-  const fs::path path =
-      fs::temp_directory_path() / ("options_" + std::to_string(getpid()) + ".ini");
+  const TempDir dir;
+  const fs::path path = dir / "options.ini";
   std::ofstream(path) << ini;
   CommonOptions common;
   Parsed p;
@@ -41,7 +40,6 @@ Parsed Parse(const std::string& ini, std::vector<std::string> args = {}) {
   for (std::string& a : args) argv.push_back(a.data());
   po::variables_map vm;
   ParseOptions(static_cast<int>(argv.size()), argv.data(), "evaluator", "usage", desc, &vm);
-  fs::remove(path);
   return p;
 }
 

@@ -1,11 +1,10 @@
 #include "common/state_file.h"
 
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 
 #include "common/atomic_file.h"
 #include "tests/common/error_of.h"
+#include "tests/common/temp_dir.h"
 
 #include <filesystem>
 #include <fstream>
@@ -28,10 +27,10 @@ StateFile Sample() {
 }
 
 TEST(StateFileTest, RoundTripsEverySectionThroughAFile) {
-  const fs::path path = fs::temp_directory_path() / ("state_file_test_" + std::to_string(getpid()));
+  const TempDir dir;
+  const fs::path path = dir / "state.bin";
   Sample().Save(path.string());
   const StateFile s = StateFile::Load(path.string(), "learner td3");
-  fs::remove(path);
   EXPECT_EQ(std::vector<float>(s.Floats("net").begin(), s.Floats("net").end()),
             (std::vector<float>{1.5f, -2.0f, 3.25f}));
   EXPECT_EQ(s.Int("updates"), 42);
@@ -123,8 +122,8 @@ TEST(StateStreamTest, WritesTheSameFormatWithoutCopyingAndParsesInPlace) {
 }
 
 TEST(StateStreamTest, AMappedFileIsCheckedAsBytesAre) {
-  const fs::path path =
-      fs::temp_directory_path() / ("state_stream_test_" + std::to_string(getpid()));
+  const TempDir dir;
+  const fs::path path = dir / "state.bin";
   StateStream out("replay snapshot");
   out.PutInt("size", 7);
   AtomicFileStream file(path.string());

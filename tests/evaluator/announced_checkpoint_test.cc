@@ -11,16 +11,16 @@
 
 #include <gtest/gtest.h>
 
+#include "file_helpers.h"
 #include "nn/checkpoint.h"
 #include "nn/sequential.h"
-#include "temp_dir.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
 namespace {
 
 namespace fs = std::filesystem;
 using testing::FifoUnblocker;
-using testing::TempDir;
 
 nn::Checkpoint SmallCheckpoint(int64_t update) {
   std::mt19937 rng(3);
@@ -68,9 +68,9 @@ TEST_F(AnnouncedCheckpointTest, ReadsACheckpointOfTheFolderByAnyPathThatLeadsThe
 
 TEST_F(AnnouncedCheckpointTest, RefusesFilesOutsideTheFolderHoweverNamed) {
   for (const std::string& path :
-       {dir_ / "elsewhere.bin", folder_ + "/../../elsewhere.bin", std::string("/dev/zero"),
-        std::string("/proc/self/mem"), folder_ + "/../checkpoints", folder_ + "/.", folder_ + "/",
-        std::string("ckpt-000000100.bin")}) {
+       {(dir_ / "elsewhere.bin").string(), folder_ + "/../../elsewhere.bin",
+        std::string("/dev/zero"), std::string("/proc/self/mem"), folder_ + "/../checkpoints",
+        folder_ + "/.", folder_ + "/", std::string("ckpt-000000100.bin")}) {
     const std::string why = Refusal(path, folder_);
     EXPECT_FALSE(why.empty()) << path << " was read";
   }

@@ -8,13 +8,13 @@
 
 #include <gtest/gtest.h>
 
+#include "file_helpers.h"
 #include "sample_record.h"
-#include "temp_dir.h"
+#include "tests/common/read_file.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
 namespace {
-
-using testing::TempDir;
 
 // A record with plausible numbers.
 constexpr auto& Record = testing::SampleRecord;
@@ -40,7 +40,7 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   d.second_std = -0.5;
   for (const EvalRecord& r : {a, b, c, d}) AppendJsonLine(path, r);
 
-  const std::string text = testing::ReadFile(path);
+  const std::string text = ReadFile(path);
   EXPECT_EQ(testing::CountOccurrences(text, "\n"), 4);
   EXPECT_EQ(testing::CountOccurrences(text, "\"second_mean\": 642.125"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"value_correlation\": null"), 1);

@@ -15,18 +15,18 @@
 
 #include "common/channels.h"
 #include "common/lcm_bus.h"
+#include "file_helpers.h"
 #include "nn/checkpoint.h"
 #include "nn/linear.h"
 #include "nn/sequential.h"
-#include "temp_dir.h"
+#include "tests/common/read_file.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
 namespace {
 
 using testing::CountOccurrences;
 using testing::FifoUnblocker;
-using testing::ReadFile;
-using testing::TempDir;
 
 BusConfig MemqConfig() { return InProcessBusConfig(77, "evaluator"); }
 
@@ -118,7 +118,7 @@ class EvaluatorServiceTest : public ::testing::Test {
   EvaluatorConfig Config() const {
     EvaluatorConfig c;
     c.episodes = 5;
-    c.out_dir = dir_.path() + "/run-a";
+    c.out_dir = (dir_ / "run-a").string();
     c.run_config_text = "env = CartPole-v1\n";
     return c;
   }

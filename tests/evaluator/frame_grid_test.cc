@@ -11,6 +11,7 @@
 
 #include "envs/registry.h"
 #include "nn/sequential.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
 namespace {
@@ -19,15 +20,7 @@ namespace fs = std::filesystem;
 
 constexpr char kCatchPixels[] = "Catch-v0+pixels(width=5,height=10,stack=2)";
 
-class FrameGridTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("frame_grid_test_" + std::to_string(getpid()));
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-};
+class FrameGridTest : public TempDirTest {};
 
 // A network with random weights whose input is a Catch stack of 2 frames of 10 x 5.
 nn::Sequential CatchNetwork() {

@@ -7,15 +7,15 @@
 
 #include <gtest/gtest.h>
 
+#include "file_helpers.h"
 #include "sample_record.h"
-#include "temp_dir.h"
+#include "tests/common/read_file.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
 namespace {
 
 using testing::CountOccurrences;
-using testing::ReadFile;
-using testing::TempDir;
 
 // A record with plausible numbers.
 constexpr auto& Record = testing::SampleRecord;

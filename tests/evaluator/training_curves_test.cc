@@ -7,13 +7,11 @@
 #include <gtest/gtest.h>
 
 #include "evaluator/report.h"
-#include "temp_dir.h"
+#include "tests/common/read_file.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
 namespace {
-
-using testing::ReadFile;
-using testing::TempDir;
 
 // Two rows of two actors, a learner and a replay, then a torn line.
 void WriteMetrics(const std::string& path) {

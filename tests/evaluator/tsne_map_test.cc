@@ -14,7 +14,7 @@
 #include "envs/registry.h"
 #include "nn/linear.h"
 #include "nn/sequential.h"
-#include "temp_dir.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
 namespace {
@@ -179,7 +179,7 @@ TEST(TsneMapTest, IdenticalActivationsMergeIntoOneStateWithTheMeanValue) {
 }
 
 TEST(TsneMapTest, WritesAPngWithTheScatterThumbnailsAndColourBar) {
-  testing::TempDir dir;
+  TempDir dir;
   nn::Sequential net = Build("linear(100,16),relu,linear(16,3)", 4);
   const StateSamples s = CollectStates(&net, kCatchPixels, 150, 1000, 0.99);
   TsneConfig c;

@@ -8,6 +8,7 @@
 #include <opencv2/videoio.hpp>
 
 #include "nn/sequential.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
 namespace {
@@ -26,16 +27,10 @@ nn::Sequential PushesRight() {
   return net;
 }
 
-// A fresh folder of this test process.
-fs::path ScratchDir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / (name + "_" + std::to_string(getpid()));
-  fs::create_directories(dir);
-  return dir;
-}
+class VideoTest : public TempDirTest {};
 
-TEST(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
-  const fs::path dir = ScratchDir("video_test");
-  const std::string path = (dir / "best.webm").string();
+TEST_F(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
+  const std::string path = (dir_ / "best.webm").string();
   nn::Sequential net = PushesRight();
   int ticks = 0;
   const VideoResult v =
@@ -66,13 +61,11 @@ TEST(VideoTest, WritesAPlayableWebmOfOneGreedyEpisode) {
     ++frames;
   }
   EXPECT_EQ(frames, v.frames);
-  fs::remove_all(dir);
 }
 
 // A stop during the episode (the tick throws) leaves neither the video nor its temporary file.
-TEST(VideoTest, AStopDuringTheEpisodeLeavesNoFile) {
-  const fs::path dir = ScratchDir("video_stop");
-  const std::string path = (dir / "best.webm").string();
+TEST_F(VideoTest, AStopDuringTheEpisodeLeavesNoFile) {
+  const std::string path = (dir_ / "best.webm").string();
   nn::Sequential net = PushesRight();
   int ticks = 0;
   EXPECT_THROW(RecordGreedyVideo(&net, "CartPole-v1", 7, 120, 81, 30, path,
@@ -83,14 +76,14 @@ TEST(VideoTest, AStopDuringTheEpisodeLeavesNoFile) {
   EXPECT_EQ(ticks, 3);
   EXPECT_FALSE(fs::exists(path));
   EXPECT_FALSE(fs::exists(path + ".tmp.webm"));
-  fs::remove_all(dir);
 }
 
-TEST(VideoTest, RefusesANetworkThatDoesNotFitTheEnv) {
+TEST_F(VideoTest, RefusesANetworkThatDoesNotFitTheEnv) {
   std::mt19937 rng(1);
   nn::Sequential net = nn::MakeMlp(3, {8}, 2, &rng);
-  EXPECT_THROW(RecordGreedyVideo(&net, "CartPole-v1", 1, 64, 64, 30, "/tmp/never.webm"),
-               std::invalid_argument);
+  const std::string path = (dir_ / "never.webm").string();
+  EXPECT_THROW(RecordGreedyVideo(&net, "CartPole-v1", 1, 64, 64, 30, path), std::invalid_argument);
+  EXPECT_FALSE(fs::exists(path));
 }
 
 }  // namespace

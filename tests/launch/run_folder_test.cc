@@ -13,34 +13,24 @@
 
 #include "launch/launch_options.h"
 #include "launch/proc.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::launch {
 namespace {
 
 namespace fs = std::filesystem;
 
-class RunFolderTest : public ::testing::Test {
- protected:
-  void SetUp() override {
-    base_ = fs::temp_directory_path() /
-            ("launch_test_" + std::to_string(getpid()) + "_" +
-             ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(base_);
-    fs::create_directories(base_);
-  }
-  void TearDown() override { fs::remove_all(base_); }
-  fs::path base_;
-};
+class RunFolderTest : public TempDirTest {};
 
 TEST_F(RunFolderTest, ADefaultNameThatIsTakenGetsASuffix) {
-  const std::string wanted = (base_ / "runs" / "cartpole-20261122-101500").string();
+  const std::string wanted = (dir_ / "runs" / "cartpole-20261122-101500").string();
   EXPECT_EQ(CreateRunFolder(wanted, true), wanted);  // parents made too
   EXPECT_EQ(CreateRunFolder(wanted, true), wanted + "-2");
   EXPECT_EQ(CreateRunFolder(wanted, true), wanted + "-3");
 }
 
 TEST_F(RunFolderTest, LaunchesAtTheSameMomentGetFoldersOfTheirOwn) {
-  const std::string wanted = (base_ / "cartpole-20261122-101500").string();
+  const std::string wanted = (dir_ / "cartpole-20261122-101500").string();
   constexpr int kLaunches = 8;
   int pipes[kLaunches][2];
   for (auto& p : pipes) ASSERT_EQ(pipe(p), 0);
@@ -71,7 +61,7 @@ TEST_F(RunFolderTest, LaunchesAtTheSameMomentGetFoldersOfTheirOwn) {
 }
 
 TEST_F(RunFolderTest, AGivenFolderMustBeNewOrEmpty) {
-  const std::string given = (base_ / "mine").string();
+  const std::string given = (dir_ / "mine").string();
   fs::create_directories(given);
   EXPECT_EQ(CreateRunFolder(given, false), given);  // empty: taken as it is
   std::ofstream(given + "/config.ini") << "x";
@@ -87,8 +77,8 @@ TEST_F(RunFolderTest, AGivenFolderMustBeNewOrEmpty) {
 }
 
 TEST_F(RunFolderTest, AFolderThatCannotBeMadeIsOneClearLine) {
-  std::ofstream(base_ / "file") << "x";
-  const std::string bad = (base_ / "file" / "run").string();
+  std::ofstream(dir_ / "file") << "x";
+  const std::string bad = (dir_ / "file" / "run").string();
   try {
     CreateRunFolder(bad, false);
     FAIL() << "no error";
@@ -98,7 +88,7 @@ TEST_F(RunFolderTest, AFolderThatCannotBeMadeIsOneClearLine) {
 }
 
 TEST_F(RunFolderTest, OneLauncherPerRunFolder) {
-  const std::string dir = base_.string();
+  const std::string dir = dir_.string();
   std::ofstream(dir + "/launch.pid") << getpid() << " " << ProcessStartTime(getpid()) << "\n";
   {
     RunLock first(dir);
@@ -115,7 +105,7 @@ TEST_F(RunFolderTest, OneLauncherPerRunFolder) {
 }
 
 TEST_F(RunFolderTest, LaunchPidNamesALivingLauncherOnly) {
-  const std::string dir = base_.string();
+  const std::string dir = dir_.string();
   EXPECT_FALSE(RunningLauncher(dir));  // no file
   WriteLaunchPid(dir);
   EXPECT_EQ(RunningLauncher(dir), getpid());
@@ -161,7 +151,7 @@ TEST_F(RunFolderTest, TheHeaderReadsBackAsWritten) {
 }
 
 TEST_F(RunFolderTest, TheKeyIsPrivateAndKept) {
-  const std::string key = (base_ / "key").string();
+  const std::string key = (dir_ / "key").string();
   EnsureKeyFile(key);
   struct stat st {};
   ASSERT_EQ(stat(key.c_str(), &st), 0);

@@ -22,33 +22,22 @@
 #include "launch/placement.h"
 #include "launch/proc.h"
 #include "launch/watchdog.h"
+#include "tests/common/read_file.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::launch {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 class SupervisorTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = (fs::temp_directory_path() /
-            ("supervisor_test_" + std::to_string(getpid()) + "_" +
-             ::testing::UnitTest::GetInstance()->current_test_info()->name()))
-               .string();
-    fs::remove_all(dir_);
     fs::create_directories(dir_ + "/logs");
     plan_.identity.run_dir = dir_;
     plan_.settings.limits.first_backoff = 0.1;
     plan_.settings.limits.ready_timeout = 10;
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   // A process running `script` with /bin/sh; ready when it prints "ROLE: ready".
   void AddShell(const std::string& role, const std::string& script) {
@@ -141,7 +130,9 @@ class SupervisorTest : public ::testing::Test {
     return false;
   }
 
-  std::string dir_;
+  TempDir temp_dir_;
+  // The run folder.
+  const std::string dir_ = temp_dir_.path().string();
   RunPlan plan_;
   LocalPlacement placement_;
 };

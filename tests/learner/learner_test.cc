@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <set>
 #include <utility>
@@ -11,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "common/channels.h"
+#include "learner/parameter_average.h"
 #include "nn/checkpoint.h"
 #include "nn/parallel.h"
 #include "rlmsg/checkpoint_t.hpp"
@@ -18,6 +20,7 @@
 #include "rlmsg/sample_request_t.hpp"
 #include "rlmsg/stats_learner_t.hpp"
 #include "rlmsg/weights_chunk_t.hpp"
+#include "tests/common/temp_dir.h"
 
 namespace rl::learner {
 namespace {
@@ -27,7 +30,7 @@ namespace fs = std::filesystem;
 // Runs a Learner against a stand-in replay on the same in-process bus: every request is answered
 // with random CartPole-shaped transitions. The first delivery of request 0 is "lost", and no
 // request is answered until the learner has sent request 0 again, so the retry must happen.
-class LearnerTest : public ::testing::Test {
+class LearnerTest : public TempDirTest {
  protected:
   // A short run against this fixture's replay: `max_updates` updates on batches of `batch_size`,
   // a checkpoint every `checkpoint_every` updates into the scratch folder, lost replies retried
@@ -54,8 +57,7 @@ class LearnerTest : public ::testing::Test {
     return c;
   }
 
-  LearnerTest() : dir_(fs::temp_directory_path() / ("learner_test_" + std::to_string(getpid()))) {
-    fs::remove_all(dir_);
+  LearnerTest() {
     bus_ = std::make_unique<Bus>(InProcessBusConfig(9, "learner"));
     bus_->Subscribe<rlmsg::sample_request_t>(
         channels::kSampleRequest, [this](const rlmsg::sample_request_t& r) { Answer(r); });
@@ -66,7 +68,6 @@ class LearnerTest : public ::testing::Test {
         channels::kWeights,
         [this](const rlmsg::weights_chunk_t& m) { versions_.insert(m.version); }, Port::kBulk);
   }
-  ~LearnerTest() override { fs::remove_all(dir_); }
 
   void Answer(const rlmsg::sample_request_t& r) {
     ++requests_seen_;
@@ -159,7 +160,6 @@ class LearnerTest : public ::testing::Test {
   int action_width_ = 1;
   int bad_replies_ = 0;
   bool continuous_ = false;
-  fs::path dir_;
   std::unique_ptr<Bus> bus_;
   std::mt19937 rng_{1};
   bool dropped_first_ = false;
@@ -298,6 +298,9 @@ TEST(LearnerConfigTest, RefusesBadSettings) {
   LearnerConfig c;
   c.requests_in_flight = 0;
   EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = LearnerConfig{};
+  c.policy_average = -1;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
 }
 
 TEST_F(LearnerTest, RefusesRandomShiftsForAnEnvWithoutPixels) {
@@ -345,7 +348,8 @@ TEST(LearnerConfigTest, RefusesAlgorithmsThatDoNotFitTheEnv) {
   Bus bus(InProcessBusConfig(0, "learner"));
   LearnerConfig c;
   c.algorithm = "td3";  // CartPole-v1 is discrete
-  c.out_dir = (fs::temp_directory_path() / "learner_config_test").string();
+  const TempDir dir;
+  c.out_dir = (dir / "run").string();
   EXPECT_THROW(Learner(c, &bus), std::invalid_argument);
   c.algorithm = "dqn";
   c.env_id = "Pendulum-v1";  // continuous
@@ -477,6 +481,54 @@ TEST_F(LearnerTest, AResumedLearnerRefusesRecordedRepliesOlderThanItsState) {
   }
   EXPECT_EQ(restarted.counters().replayed, static_cast<int64_t>(before_state));
   EXPECT_EQ(restarted.counters().received, static_cast<int64_t>(recorded.size() - before_state));
+}
+
+// With policy_average, checkpoints hold the average of the policies after each update (the
+// weights broadcast with every update here, the current ones), and say so; a resumed learner
+// continues the average from its state.
+TEST_F(LearnerTest, CheckpointsHoldThePolicysAverageAndAResumeContinuesIt) {
+  std::map<int64_t, std::vector<float>> broadcast;  // by version; the CartPole net is one chunk
+  bus_->Subscribe<rlmsg::weights_chunk_t>(
+      channels::kWeights,
+      [&broadcast](const rlmsg::weights_chunk_t& m) {
+        ASSERT_EQ(m.num_chunks, 1);
+        broadcast[m.version] = m.data;
+      },
+      Port::kBulk);
+  LearnerConfig c = ShortRun(16, 30, 10);
+  c.weights_every = 1;
+  c.policy_average = 5;
+  Learner first(c, bus_.get());  // alive to the end: the bus keeps its handler
+  first.Run();
+  bus_->Handle(0);
+  // The average the checkpoints should hold: of every version broadcast up to `last`.
+  ParameterAverage expected(5);
+  int64_t added = 0;
+  const auto average_up_to = [&](int64_t last) {
+    while (added < last) {
+      ++added;
+      ASSERT_TRUE(broadcast.count(added)) << "version " << added;
+      expected.Add(broadcast[added]);
+    }
+  };
+  average_up_to(30);
+  const nn::Checkpoint last = nn::LoadCheckpoint(announced_.back());
+  EXPECT_EQ(last.meta.update, 30);
+  EXPECT_EQ(last.params, expected.values());
+  EXPECT_NE(last.params, broadcast[30]);
+  EXPECT_NE(last.meta.note.find("policy = the average of about 5 updates"), std::string::npos)
+      << last.meta.note;
+
+  c.resume = true;
+  c.max_updates = 35;
+  Learner second(c, bus_.get());
+  ASSERT_TRUE(second.resumed());
+  second.Run();
+  bus_->Handle(0);
+  average_up_to(35);
+  const nn::Checkpoint resumed = nn::LoadCheckpoint(announced_.back());
+  EXPECT_EQ(resumed.meta.update, 35);
+  EXPECT_EQ(resumed.params, expected.values());
 }
 
 }  // namespace

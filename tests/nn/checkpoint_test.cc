@@ -25,11 +25,6 @@ namespace fs = std::filesystem;
 
 class CheckpointTest : public TempDirTest {
  protected:
-  void SetUp() override {
-    TempDirTest::SetUp();
-    path_ = (dir_ / "model.ckpt").string();
-  }
-
   static Checkpoint MakeCheckpoint() {
     std::mt19937 rng(17);
     const Sequential net = MakeMlp(4, {16}, 2, &rng);
@@ -65,7 +60,7 @@ class CheckpointTest : public TempDirTest {
     return ErrorOf([this] { LoadCheckpoint(path_); });
   }
 
-  std::string path_;
+  const std::string path_ = (dir_ / "model.ckpt").string();
 };
 
 TEST_F(CheckpointTest, RoundTripsEveryField) {

@@ -1,7 +1,5 @@
 // Snapshots of the replay: a restored service serves as the saved one did, a written file loads,
 // and every bad file is refused with a clear error.
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
@@ -26,6 +24,7 @@
 #include "replay/replay_service.h"
 #include "replay/snapshotter.h"
 #include "tests/common/error_of.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::replay {
 namespace {
@@ -168,15 +167,8 @@ void ExpectSameState(ReplayService& a, ReplayService& b) {
   EXPECT_EQ(a.insert_allowed(), b.insert_allowed());
 }
 
-class ReplaySnapshotTest : public ::testing::Test {
+class ReplaySnapshotTest : public TempDirTest {
  protected:
-  ReplaySnapshotTest()
-      : dir_(fs::temp_directory_path() / ("replay_snapshot_" + std::to_string(getpid()))) {
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  ~ReplaySnapshotTest() override { fs::remove_all(dir_); }
-
   std::string Write(const std::string& name, const std::string& bytes) const {
     std::string path = (dir_ / name).string();
     std::ofstream(path, std::ios::binary) << bytes;
@@ -191,8 +183,6 @@ class ReplaySnapshotTest : public ::testing::Test {
     EXPECT_NE(error.find(path), std::string::npos) << "the error does not name the file: " << error;
     return error;
   }
-
-  fs::path dir_;
 };
 
 TEST_F(ReplaySnapshotTest, ARestoredPrioritizedFlatReplaySamplesAsTheSavedOne) {

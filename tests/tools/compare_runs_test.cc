@@ -1,11 +1,8 @@
 #include "tools/compare_runs.h"
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -14,6 +11,8 @@
 
 #include "evaluator/report.h"
 #include "tests/common/error_of.h"
+#include "tests/common/read_file.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::tools {
 namespace {
@@ -22,21 +21,12 @@ namespace fs = std::filesystem;
 using evaluator::EvalRecord;
 
 // A scratch folder with run folders as scripts/launch.sh leaves them (config.ini, eval.jsonl).
-class CompareRunsTest : public ::testing::Test {
+class CompareRunsTest : public TempDirTest {
  protected:
-  CompareRunsTest()
-      : root_(fs::temp_directory_path() /
-              ("compare_runs_" + std::to_string(getpid()) + "_" +
-               ::testing::UnitTest::GetInstance()->current_test_info()->name())) {
-    fs::remove_all(root_);
-    fs::create_directories(root_);
-  }
-  ~CompareRunsTest() override { fs::remove_all(root_); }
-
-  // Writes root/name/config.ini (launch.sh's header lines and a preset body).
+  // Writes dir_/name/config.ini (launch.sh's header lines and a preset body).
   std::string MakeRun(const std::string& name, const std::string& preset, const std::string& env,
                       int seed, double goal) {
-    const fs::path dir = root_ / name;
+    const fs::path dir = dir_ / name;
     fs::create_directories(dir);
     std::ofstream config(dir / "config.ini");
     config << "# Run of preset '" << preset << "', started 2026-11-22T10:15:00+00:00\n"
@@ -77,13 +67,6 @@ class CompareRunsTest : public ::testing::Test {
     }
   }
 
-  static std::string Read(const fs::path& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  }
-
   static int Count(const std::string& text, const std::string& what) {
     int n = 0;
     for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
@@ -119,8 +102,6 @@ class CompareRunsTest : public ::testing::Test {
     }
     return cells;
   }
-
-  fs::path root_;
 };
 
 TEST_F(CompareRunsTest, LoadsThePresetEnvGoalSeedAndEvaluations) {
@@ -142,19 +123,19 @@ TEST_F(CompareRunsTest, RefusesFoldersThatAreNotScoredRuns) {
     EXPECT_THROW(LoadCompareRun(dir), std::runtime_error) << dir;
     return ErrorOf([&] { LoadCompareRun(dir); });
   };
-  EXPECT_NE(message((root_ / "missing").string()).find("not a folder"), std::string::npos);
-  fs::create_directories(root_ / "bare");
-  EXPECT_NE(message((root_ / "bare").string()).find("no config.ini"), std::string::npos);
+  EXPECT_NE(message((dir_ / "missing").string()).find("not a folder"), std::string::npos);
+  fs::create_directories(dir_ / "bare");
+  EXPECT_NE(message((dir_ / "bare").string()).find("no config.ini"), std::string::npos);
   const std::string unscored = MakeRun("unscored", "cartpole", "CartPole-v1", 1, 475);
   EXPECT_NE(message(unscored).find("no eval.jsonl"), std::string::npos);
   std::ofstream(unscored + "/eval.jsonl") << "{\"checkpoint\": \"ckpt-1.bin\", \"upd";
   const std::string torn = message(unscored);
   EXPECT_NE(torn.find("no evaluation"), std::string::npos) << torn;
   EXPECT_EQ(torn.find('\n'), std::string::npos) << "one line: " << torn;
-  fs::create_directories(root_ / "foreign");
-  std::ofstream(root_ / "foreign" / "config.ini") << "env = CartPole-v1\n";
-  std::ofstream(root_ / "foreign" / "eval.jsonl") << "\n";
-  EXPECT_NE(message((root_ / "foreign").string()).find("no \"# Run of preset\" line"),
+  fs::create_directories(dir_ / "foreign");
+  std::ofstream(dir_ / "foreign" / "config.ini") << "env = CartPole-v1\n";
+  std::ofstream(dir_ / "foreign" / "eval.jsonl") << "\n";
+  EXPECT_NE(message((dir_ / "foreign").string()).find("no \"# Run of preset\" line"),
             std::string::npos);
 }
 
@@ -209,12 +190,12 @@ TEST_F(CompareRunsTest, SummarizesBestFinalAndTheFirstEvaluationAtTheGoal) {
 
 TEST_F(CompareRunsTest, LabelsRunsOfTheSameNameByTheirParentFolders) {
   std::vector<CompareRun> runs(3);
-  fs::create_directories(root_ / "x" / "run");
-  fs::create_directories(root_ / "y" / "run");
-  fs::create_directories(root_ / "z");
-  runs[0].dir = (root_ / "x" / "run").string();
-  runs[1].dir = (root_ / "y" / "run").string() + "/";
-  runs[2].dir = (root_ / "z").string();
+  fs::create_directories(dir_ / "x" / "run");
+  fs::create_directories(dir_ / "y" / "run");
+  fs::create_directories(dir_ / "z");
+  runs[0].dir = (dir_ / "x" / "run").string();
+  runs[1].dir = (dir_ / "y" / "run").string() + "/";
+  runs[2].dir = (dir_ / "z").string();
   MakeLabelsUnique(&runs);
   EXPECT_EQ(runs[0].label, "x/run");
   EXPECT_EQ(runs[1].label, "y/run");
@@ -231,9 +212,9 @@ TEST_F(CompareRunsTest, PageOfTwoRunsShowsBothRunsTheirGroupAndTheirSummaryNumbe
   std::ofstream(one + "/report/index.html") << "<!DOCTYPE html>\n";
   std::vector<CompareRun> runs = {LoadCompareRun(one), LoadCompareRun(two)};
   MakeLabelsUnique(&runs);
-  const fs::path page = root_ / "compare.html";
+  const fs::path page = dir_ / "compare.html";
   WriteComparePage(page.string(), runs);
-  const std::string html = Read(page);
+  const std::string html = ReadFile(page);
   ASSERT_FALSE(html.empty());
 
   // Self-contained: inline SVG, nothing fetched, no script.

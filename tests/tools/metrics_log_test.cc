@@ -1,7 +1,5 @@
 #include "tools/metrics_log.h"
 
-#include <unistd.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "evaluator/json_line.h"
+#include "tests/common/temp_dir.h"
 
 namespace rl::tools {
 namespace {
@@ -74,14 +73,10 @@ TEST(MetricsLineTest, LinesReadBackAsJsonWithTenSignificantDigits) {
   EXPECT_EQ(JsonIntegerAt(*back, "paused"), 0);
 }
 
-class MetricsLogTest : public ::testing::Test {
+// `path_` names a file that does not exist yet, in a directory of the test's own.
+class MetricsLogTest : public TempDirTest {
  protected:
-  MetricsLogTest()
-      : path_(fs::temp_directory_path() / ("metrics_" + std::to_string(getpid()) + ".jsonl")) {
-    fs::remove(path_);
-  }
-  ~MetricsLogTest() override { fs::remove(path_); }
-  fs::path path_;
+  const fs::path path_ = dir_ / "metrics.jsonl";
 };
 
 TEST_F(MetricsLogTest, RowsFollowTheScheduleAndAppendAfterARestart) {
