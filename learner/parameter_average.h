@@ -27,7 +27,6 @@ class ParameterAverage {
   const std::vector<float>& values() const { return values_; }
   /// Vectors mixed in so far, counted up to the horizon.
   int64_t count() const { return count_; }
-  int horizon() const { return horizon_; }
 
   /// Sections "<name>" and "<name>_count" of a learner state; Load reads them when they are
   /// there (a state saved without an average leaves this one empty) and throws
