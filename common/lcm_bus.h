@@ -167,9 +167,13 @@ class Bus {
 
   // Calls handler(msg) for every good message of type Msg on `channel`, on the channel's port
   // (ChannelPort(): a channel of common/channels.h takes only its type). The subscription starts
-  // from the positions restored for its channel (LoadPositions()).
+  // from the positions restored for its channel (LoadPositions()). Each message of the channel
+  // decodes into one object that the subscription keeps, so its arrays are allocated once; a
+  // handler that keeps a message swaps its contents out (std::swap with an object of its own,
+  // best one used before) rather than copying them, and the next message decodes into what it
+  // left there.
   template <class Msg>
-  void Subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
+  void Subscribe(const std::string& channel, std::function<void(Msg&)> handler,
                  std::optional<Port> port = std::nullopt);
 
   // Handles `size` bytes as if LCM had received them on `channel` at recv_utime (microseconds
@@ -287,14 +291,14 @@ bool Bus::Publish(const std::string& channel, Msg* msg, std::optional<Port> port
 }
 
 template <class Msg>
-void Bus::Subscribe(const std::string& channel, std::function<void(const Msg&)> handler,
+void Bus::Subscribe(const std::string& channel, std::function<void(Msg&)> handler,
                     std::optional<Port> port) {
   auto decoded = std::make_shared<Msg>();
   SubscribeRaw(
       channel, ChannelPort(channel, Msg::getTypeName(), port), Msg::getHash(),
       [decoded](const uint8_t* data, size_t size) { return Decode(data, size, decoded.get()); },
       [this, channel, handler = std::move(handler), decoded] {
-        const Msg& msg = *decoded;
+        Msg& msg = *decoded;
         if (const char* why = Validate(msg)) {
           Drop(channel, &counters_.invalid, "invalid", why);
           return;

@@ -102,7 +102,7 @@ Learner::Learner(LearnerConfig config, Bus* bus)
     resumed_ = true;
   }
   bus_->Subscribe<rlmsg::sample_batch_t>(
-      channels::kSamples, [this](const rlmsg::sample_batch_t& m) { OnSamples(m); }, Port::kBulk);
+      channels::kSamples, [this](rlmsg::sample_batch_t& m) { OnSamples(m); }, Port::kBulk);
 }
 
 bool Learner::Accept(const std::string& requester, int64_t request_id, int64_t total_inserts) {
@@ -117,9 +117,15 @@ bool Learner::Accept(const std::string& requester, int64_t request_id, int64_t t
   return true;
 }
 
-void Learner::OnSamples(const rlmsg::sample_batch_t& m) {
+void Learner::OnSamples(rlmsg::sample_batch_t& m) {
   if (!Accept(m.requester, m.request_id, m.total_inserts)) return;
-  ready_.push_back(m);
+  if (spare_.empty()) {
+    ready_.emplace_back();
+  } else {
+    ready_.push_back(std::move(spare_.back()));
+    spare_.pop_back();
+  }
+  std::swap(ready_.back(), m);
 }
 
 void Learner::PublishPriorities(const std::vector<int64_t>& index) {
@@ -306,6 +312,7 @@ void Learner::Run() {
     TopUpRequests(now);
     if (!ready_.empty()) {
       TrainOn(ready_.front());
+      spare_.push_back(std::move(ready_.front()));
       ready_.pop_front();
       TopUpRequests(now);
       const int64_t u = algorithm_->updates();

@@ -102,7 +102,7 @@ class Learner {
   // Takes a reply if it answers one of our requests in flight; false for another learner's or a
   // duplicate.
   bool Accept(const std::string& requester, int64_t request_id, int64_t total_inserts);
-  void OnSamples(const rlmsg::sample_batch_t& m);
+  void OnSamples(rlmsg::sample_batch_t& m);
   void PublishPriorities(const std::vector<int64_t>& index);
   void TopUpRequests(double now);
   void SendRequest(int64_t id);
@@ -127,6 +127,10 @@ class Learner {
   std::map<int64_t, Request> in_flight_;  // by request id
   int64_t next_request_id_ = 0;
   std::deque<rlmsg::sample_batch_t> ready_;
+  // Batches trained on, kept for their arrays: a reply is swapped into one of them rather than
+  // copied (megabytes of pixels per update in a pixel run), and the subscription decodes the
+  // next reply into the arrays it got back.
+  std::vector<rlmsg::sample_batch_t> spare_;
   int64_t batches_refused_ = 0;
   rlmsg::priority_update_t priorities_{};
   int64_t priorities_sent_ = 0;

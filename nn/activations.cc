@@ -6,12 +6,19 @@
 #include <utility>
 
 #include "common/check.h"
+#include "nn/parallel.h"
 
 namespace rl::nn {
 
 const Matrix& ReLU::Forward(const Matrix& x) {
   own_output_.resize(x.rows(), x.cols());
-  own_output_.array() = x.array().max(0.0f);
+  const Eigen::Index batch = x.cols();
+  const int tasks = internal::TasksForElements(x.size(), batch);
+  internal::ParallelFor(tasks, [&](int task) {
+    const Eigen::Index begin = batch * task / tasks;
+    const Eigen::Index count = batch * (task + 1) / tasks - begin;
+    own_output_.middleCols(begin, count).array() = x.middleCols(begin, count).array().max(0.0f);
+  });
   adopted_output_ = nullptr;
   return own_output_;
 }
@@ -22,7 +29,15 @@ const Matrix& ReLU::Backward(const Matrix& grad_out) {
       << "relu: output gradient is " << grad_out.rows() << "x" << grad_out.cols() << ", output was "
       << y.rows() << "x" << y.cols();
   grad_input_.resize(grad_out.rows(), grad_out.cols());
-  grad_input_.array() = (y.array() > 0.0f).select(grad_out.array(), 0.0f);
+  const Eigen::Index batch = grad_out.cols();
+  const int tasks = internal::TasksForElements(grad_out.size(), batch);
+  internal::ParallelFor(tasks, [&](int task) {
+    const Eigen::Index begin = batch * task / tasks;
+    const Eigen::Index count = batch * (task + 1) / tasks - begin;
+    grad_input_.middleCols(begin, count).array() =
+        (y.middleCols(begin, count).array() > 0.0f)
+            .select(grad_out.middleCols(begin, count).array(), 0.0f);
+  });
   return grad_input_;
 }
 

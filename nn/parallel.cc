@@ -143,6 +143,10 @@ int TasksFor(int64_t work, int64_t max_pieces) {
   return static_cast<int>(std::max<int64_t>(pieces, 1));
 }
 
+int TasksForElements(int64_t elements, int64_t max_pieces) {
+  return TasksFor(elements * (kMinTaskWork / kMinTaskElements), max_pieces);
+}
+
 void RunTasks(int tasks, void (*fn)(void* ctx, int task), void* ctx) {
   if (tasks <= 0) return;
   // A nested section, or one while another thread uses the pool (or without a pool): the tasks

@@ -8,13 +8,13 @@ namespace rl::nn {
 
 /// How many threads, the calling one included, nn computations may use. 1 (the default) runs
 /// everything on the calling thread and starts no thread. n > 1 starts n - 1 worker threads,
-/// shared by the whole process; Conv2d then splits its batch over them and large matrix products
-/// (Gemm, the single-observation Gemv) split their rows. Results equal the single-threaded ones
-/// bit for bit, except the parameter gradients of Conv2d, which each thread sums over its share
-/// of the batch before they are added in a fixed order: they differ by rounding, and are the same
-/// from run to run for a given n. Call it while no nn computation runs (typically at start-up);
-/// it waits for a parallel section that is under way. Throws std::invalid_argument unless
-/// 1 <= n <= 64.
+/// shared by the whole process; Conv2d, Pool2d, ReLU and the pixel conversions (nn/pixels.h) then
+/// split their batch over them, and large matrix products (Gemm, the single-observation Gemv)
+/// split their rows. Results equal the single-threaded ones bit for bit, except the parameter
+/// gradients of Conv2d, which each thread sums over its share of the batch before they are added
+/// in a fixed order: they differ by rounding, and are the same from run to run for a given n.
+/// Call it while no nn computation runs (typically at start-up); it waits for a parallel section
+/// that is under way. Throws std::invalid_argument unless 1 <= n <= 64.
 void SetNumThreads(int n);
 /// The current setting of SetNumThreads().
 int NumThreads();
@@ -32,6 +32,14 @@ constexpr int64_t kMinTaskWork = int64_t{1} << 22;
 /// ParallelFor() (no nesting), or when the work is too small (kMinTaskWork per piece);
 /// otherwise up to NumThreads().
 int TasksFor(int64_t work, int64_t max_pieces);
+
+/// Elements of a pass that streams through memory (a pixel conversion, a pooling, a ReLU: 0.15
+/// to 1.7 ns each on one core of the development machine) below which a piece is not worth
+/// handing to another thread: 64K take 10-110 us.
+constexpr int64_t kMinTaskElements = int64_t{1} << 16;
+
+/// TasksFor() for a pass over `elements` elements (kMinTaskElements per piece).
+int TasksForElements(int64_t elements, int64_t max_pieces);
 
 /// Runs fn(ctx, i) for every i in [0, tasks) and returns when all are done: task 0 on the calling
 /// thread, the others on whichever of the pool's workers or the calling thread (once it is done

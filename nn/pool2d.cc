@@ -1,8 +1,10 @@
 #include "nn/pool2d.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "common/check.h"
+#include "nn/parallel.h"
 
 namespace rl::nn {
 namespace {
@@ -58,8 +60,16 @@ const Matrix& Pool2d::Forward(const Matrix& x) {
   batch_ = static_cast<int>(x.cols());
   output_.resize(out_.size(), batch_);
   if (mode_ == Mode::kMax) argmax_.resize(static_cast<size_t>(out_.size()) * batch_);
+  const int tasks = internal::TasksForElements(int64_t{in_.size()} * batch_, batch_);
+  internal::ParallelFor(tasks, [&](int task) {
+    ForwardSamples(x, batch_ * task / tasks, batch_ * (task + 1) / tasks);
+  });
+  return output_;
+}
+
+void Pool2d::ForwardSamples(const Matrix& x, int begin, int end) {
   const float scale = 1.0f / static_cast<float>(kernel_ * kernel_);
-  for (int n = 0; n < batch_; ++n) {
+  for (int n = begin; n < end; ++n) {
     const float* in = x.col(n).data();
     float* out = output_.col(n).data();
     int* arg = mode_ == Mode::kMax ? &argmax_[static_cast<size_t>(n) * out_.size()] : nullptr;
@@ -97,17 +107,25 @@ const Matrix& Pool2d::Forward(const Matrix& x) {
       }
     }
   }
-  return output_;
 }
 
 const Matrix& Pool2d::Backward(const Matrix& grad_out) {
   RL_CHECK(grad_out.rows() == out_.size() && grad_out.cols() == batch_)
       << Describe() << ": output gradient is " << grad_out.rows() << "x" << grad_out.cols();
-  grad_input_.setZero(in_.size(), batch_);
+  grad_input_.resize(in_.size(), batch_);
+  const int tasks = internal::TasksForElements(int64_t{in_.size()} * batch_, batch_);
+  internal::ParallelFor(tasks, [&](int task) {
+    BackwardSamples(grad_out, batch_ * task / tasks, batch_ * (task + 1) / tasks);
+  });
+  return grad_input_;
+}
+
+void Pool2d::BackwardSamples(const Matrix& grad_out, int begin, int end) {
   const float scale = 1.0f / static_cast<float>(kernel_ * kernel_);
-  for (int n = 0; n < batch_; ++n) {
+  for (int n = begin; n < end; ++n) {
     const float* g = grad_out.col(n).data();
     float* gi = grad_input_.col(n).data();
+    std::fill(gi, gi + in_.size(), 0.0f);
     if (mode_ == Mode::kMax) {
       const int* arg = &argmax_[static_cast<size_t>(n) * out_.size()];
       for (int o = 0; o < out_.size(); ++o) gi[arg[o]] += g[o];
@@ -126,7 +144,6 @@ const Matrix& Pool2d::Backward(const Matrix& grad_out) {
       }
     }
   }
-  return grad_input_;
 }
 
 }  // namespace rl::nn

@@ -33,6 +33,10 @@ class Pool2d : public Layer {
   ImageShape output_shape() const override { return out_; }
 
  private:
+  // Forward and Backward of samples [begin, end): a share of the batch for one thread.
+  void ForwardSamples(const Matrix& x, int begin, int end);
+  void BackwardSamples(const Matrix& grad_out, int begin, int end);
+
   Mode mode_;
   int kernel_;
   ImageShape in_, out_;

@@ -151,6 +151,37 @@ TEST_F(BusTest, CountsSequenceGapsAsLost) {
   EXPECT_EQ(bus_.counters().lost, 2 + 3);
 }
 
+// A handler may keep a message by swapping its contents out (the learner keeps its sample
+// replies so). The next message then decodes into what the handler left behind, here arrays of
+// other lengths and values, and must come out whole.
+TEST(BusSwapTest, AHandlerMaySwapAMessageOutAndTheNextDecodesIntoWhatItLeft) {
+  Bus bus(MemqConfig(42, "actor-1"));
+  std::vector<rlmsg::transition_batch_t> kept;
+  bus.Subscribe<rlmsg::transition_batch_t>(channels::kTransitions,
+                                           [&kept](rlmsg::transition_batch_t& m) {
+                                             rlmsg::transition_batch_t leftover = MakeBatch(5, 7);
+                                             leftover.obs.assign(1000, -1.0f);
+                                             kept.push_back(std::move(leftover));
+                                             std::swap(kept.back(), m);
+                                           });
+  std::vector<rlmsg::transition_batch_t> sent;
+  for (const auto& [first, count] : std::vector<std::pair<int, int>>{{0, 3}, {10, 2}, {20, 4}}) {
+    sent.push_back(examples::FlatTransitions(first, count, 4, 1, /*actor=*/1));
+    ASSERT_TRUE(bus.Publish(channels::kTransitions, &sent.back()));
+    bus.Handle(100);
+  }
+  ASSERT_EQ(kept.size(), sent.size());
+  for (size_t i = 0; i < sent.size(); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_EQ(kept[i].count, sent[i].count);
+    EXPECT_EQ(kept[i].obs, sent[i].obs);
+    EXPECT_EQ(kept[i].next_obs, sent[i].next_obs);
+    EXPECT_EQ(kept[i].reward, sent[i].reward);
+    EXPECT_EQ(kept[i].header.seq, static_cast<int64_t>(i));
+  }
+  EXPECT_EQ(bus.counters().received, 3);
+  EXPECT_EQ(bus.counters().invalid, 0);
+}
 // Authentication and freshness: a keyed bus, and messages made by hand as another process (or an
 // attacker, or a recording) would send them.
 const std::string kKey(kKeyBytes, 'k');

@@ -1,6 +1,7 @@
-// Intra-op threads (nn/parallel.h): the pool itself, and that products, convolutions and whole
-// networks give the single-threaded results with 2 and 3 threads: bit for bit, except the
-// parameter gradients of convolutions (summed per thread), which must agree to rounding.
+// Intra-op threads (nn/parallel.h): the pool itself, and that products, convolutions, pooling,
+// the pixel conversions and whole networks give the single-threaded results with 2 and 3 threads:
+// bit for bit, except the parameter gradients of convolutions (summed per thread), which must agree
+// to rounding.
 #include "nn/parallel.h"
 
 #include <algorithm>
@@ -13,9 +14,12 @@
 
 #include <gtest/gtest.h>
 
+#include "nn/activations.h"
 #include "nn/conv2d.h"
 #include "nn/gemm.h"
 #include "nn/gemv.h"
+#include "nn/pixels.h"
+#include "nn/pool2d.h"
 #include "nn/presets.h"
 #include "nn/sequential.h"
 #include "tests/nn/gradient_check.h"
@@ -135,6 +139,70 @@ void CheckGemm(const internal::ConstView& a, const internal::ConstView& b, int m
       internal::Gemm(a, b, internal::View(&got), accumulate, epilogue, &workspace, precision);
       EXPECT_EQ(MaxDiff(got, want), 0.0f) << m << "x" << n << "x" << a.cols << ", " << n_threads
                                           << " threads, " << PrecisionName(precision);
+    }
+  }
+}
+
+TEST(ParallelTest, TasksForElementsSplitsOnlyLongPasses) {
+  EXPECT_EQ(internal::TasksForElements(100 * internal::kMinTaskElements, 8), 1);  // One thread.
+  Threads threads(3);
+  EXPECT_EQ(internal::TasksForElements(100 * internal::kMinTaskElements, 8), 3);
+  EXPECT_EQ(internal::TasksForElements(2 * internal::kMinTaskElements, 8), 2);
+  EXPECT_EQ(internal::TasksForElements(internal::kMinTaskElements - 1, 8), 1);
+}
+
+// The pixel conversions, ReLU and both pooling layers, forward and backward, at about the
+// car_racing_td3 learner's sizes (batch 64 of 4 x 84 x 84 stacks; 32 channels of 41 x 41, twice
+// the car encoder's first pooling): the same bits with 2 and 3 threads as with one, and the pool
+// did run them.
+TEST(ParallelTest, PixelsReluAndPoolingGiveTheSameBitsWithThreads) {
+  constexpr int kBatch = 64, kPlanes = 4, kSide = 84;
+  std::mt19937 rng(5);
+  std::vector<uint8_t> pixels(static_cast<size_t>(kPlanes) * kSide * kSide * kBatch);
+  for (uint8_t& p : pixels) p = static_cast<uint8_t>(rng());
+  std::vector<int> dy(kBatch), dx(kBatch);
+  for (int j = 0; j < kBatch; ++j) {
+    dy[static_cast<size_t>(j)] = static_cast<int>(rng() % 9) - 4;
+    dx[static_cast<size_t>(j)] = static_cast<int>(rng() % 9) - 4;
+  }
+  const int features = kPlanes * kSide * kSide;
+  const Matrix x = RandomMatrix(32 * 41 * 41, kBatch, &rng);
+  // Many ties (values rounded to quarters) for the max mode's first-of-equal-maxima rule.
+  const Matrix tied = (x * 4.0f).array().round().matrix();
+  const Matrix dy_pool = RandomMatrix(32 * 20 * 20, kBatch, &rng);
+  struct Result {
+    Matrix plain, shifted;
+    std::vector<Matrix> pooled;
+  };
+  const auto run = [&] {
+    Result r;
+    PixelsToMatrix(pixels.data(), features, kBatch, &r.plain);
+    ShiftedPixelsToMatrix(pixels.data(), kPlanes, kSide, kSide, kBatch, dy.data(), dx.data(),
+                          &r.shifted);
+    ReLU relu;
+    r.pooled.push_back(relu.Forward(x));
+    r.pooled.push_back(relu.Backward(tied));
+    for (const Pool2d::Mode mode : {Pool2d::Mode::kMax, Pool2d::Mode::kAverage}) {
+      for (const Matrix* in : {&x, &tied}) {
+        Pool2d pool(mode, 32, 2, 41, 41);
+        r.pooled.push_back(pool.Forward(*in));
+        r.pooled.push_back(pool.Backward(dy_pool));
+      }
+    }
+    return r;
+  };
+  const Result want = run();
+  for (int n_threads : {2, 3}) {
+    Threads threads(n_threads);
+    const int64_t sections = internal::ParallelSections();
+    const Result got = run();
+    EXPECT_EQ(internal::ParallelSections() - sections, 2 + 2 + 2 * 2 * 2)
+        << n_threads << " threads";
+    EXPECT_EQ(MaxDiff(got.plain, want.plain), 0.0f) << n_threads << " threads";
+    EXPECT_EQ(MaxDiff(got.shifted, want.shifted), 0.0f) << n_threads << " threads";
+    ASSERT_EQ(got.pooled.size(), want.pooled.size());
+    for (size_t i = 0; i < got.pooled.size(); ++i) {
+      EXPECT_EQ(MaxDiff(got.pooled[i], want.pooled[i]), 0.0f) << i << ", " << n_threads;
     }
   }
 }
