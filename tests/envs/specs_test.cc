@@ -47,6 +47,8 @@ TEST(SpecsTest, SpecsHoldTheReferencesValues) {
       {"Pendulum-v1", 3, 0, 1, 200, -200.0, {-2.0f}, {2.0f}, 500, 500},
       {"LunarLander-v3", 8, 4, 0, 1000, 200.0, {}, {}, 600, 400},
       {"LunarLanderContinuous-v3", 8, 0, 2, 1000, 200.0, {-1.0f, -1.0f}, {1.0f, 1.0f}, 600, 400},
+      {"CarRacing-v3", 27648, 0, 3, 1000, 900.0, {-1.0f, 0.0f, 0.0f}, {1.0f, 1.0f, 1.0f}, 96, 96},
+      {"CarRacingDiscrete-v3", 27648, 5, 0, 1000, 900.0, {}, {}, 96, 96},
       {"KukaDiverseObjectGrasping-v0", 2, 7, 0, 15, 0.6, {}, {}, 48, 48},
       {"KukaDiverseObjectGraspingTest-v0", 2, 7, 0, 20, 0.6, {}, {}, 48, 48},
   };
