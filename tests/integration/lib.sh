@@ -28,12 +28,30 @@ scratch() {
 }
 cleanup() {
   local pids
+  # Processes a test froze (hold_learner_and_evaluator) go on, so that they can stop.
+  # shellcheck disable=SC2086
+  [ -z "${held:-}" ] || kill -CONT $held 2>/dev/null || true
   pids=$(jobs -p)
   [ -z "$pids" ] || kill $pids 2>/dev/null || true
   wait 2>/dev/null || true
   # Whatever a launch left behind (it stops its processes itself; this is the safety net).
   cat "$dir"/*/pids "$dir"/*/runs/*/pids 2>/dev/null | awk '{print $2}' | xargs -r kill -KILL 2>/dev/null || true
   [ -n "${RL_KEEP:-}" ] || rm -rf "$dir" 2>/dev/null || true
+}
+
+# Freezes the learner and the evaluator of the run in $run (SIGSTOP; their pids in $held), so
+# that the run cannot reach its goal before what the test waits for (CartPole may learn faster
+# than a process restarts). The test sends SIGCONT itself when it is time; cleanup does on exit.
+hold_learner_and_evaluator() {
+  local kind pid
+  held=""
+  for kind in learner evaluator; do
+    pid=$(pgrep -f "^$bin/$kind --config $run/config.ini " | head -1)
+    [ -n "$pid" ] || fail "no $kind process"
+    held+=" $pid"
+  done
+  # shellcheck disable=SC2086
+  kill -STOP $held
 }
 
 # The best evaluation mean in an eval.jsonl.

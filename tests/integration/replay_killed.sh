@@ -9,6 +9,9 @@
 #                           after messages that listed some), with no actor dropping a
 #                           flow-control message ("num_actors mismatch": a message whose arrays
 #                           shrank to nothing decoded into the object of the previous one)
+# CartPole may reach its goal within the second the replay waits to restart, and the run would
+# stop before the restarted replay said how it started; so the learner and the evaluator are held
+# (SIGSTOP) from before the kill until the restarted replay is ready, and let go then (SIGCONT).
 source "$(dirname "$0")/lib.sh"
 isolate "$@"
 mode=${1:-snapshot}
@@ -39,8 +42,13 @@ else
 fi
 victim=$(awk '$1 == "replay" {p = $2} END {print p}' "$run/pids")
 [ -n "$victim" ] || fail "no pid for the replay"
+hold_learner_and_evaluator
 kill -KILL "$victim"
 echo "killed the replay (pid $victim) $moment"
+timeout 30 bash -c 'until [ "$(grep -c "^replay: ready" "$0")" -ge 2 ]; do sleep 0.05; done' "$log" ||
+  fail "the replay was not ready again within 30 s"
+# shellcheck disable=SC2086
+kill -CONT $held
 status=0
 wait "$launch_pid" || status=$?
 tail -4 "$dir/launch.log"

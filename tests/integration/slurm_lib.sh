@@ -53,18 +53,9 @@ slurm_expect_goal() {
   expect_best_mean "$run" 475 --at-least
 }
 
-# Freezes the run's learner and evaluator (SIGSTOP; their pids in $held), so that the run cannot
-# reach its goal before what the test waits for; lets them go (SIGCONT) on exit, before
-# cluster_up's trap (cluster_down, then cleanup). The test sends SIGCONT itself when it is time.
+# hold_learner_and_evaluator (lib.sh), letting them go (SIGCONT) on exit before cluster_up's trap
+# (cluster_down, then cleanup).
 slurm_hold_learner_and_evaluator() {
-  local kind pid
-  held=""
-  for kind in learner evaluator; do
-    pid=$(pgrep -f "^$bin/$kind --config $run/config.ini " | head -1)
-    [ -n "$pid" ] || fail "no $kind process"
-    held+=" $pid"
-  done
-  # shellcheck disable=SC2086
-  kill -STOP $held
+  hold_learner_and_evaluator
   trap 'kill -CONT $held 2> /dev/null || true; cluster_down; cleanup' EXIT
 }
