@@ -12,12 +12,9 @@ namespace rl::nn {
 
 const Matrix& ReLU::Forward(const Matrix& x) {
   own_output_.resize(x.rows(), x.cols());
-  const Eigen::Index batch = x.cols();
-  const int tasks = internal::TasksForElements(x.size(), batch);
-  internal::ParallelFor(tasks, [&](int task) {
-    const Eigen::Index begin = batch * task / tasks;
-    const Eigen::Index count = batch * (task + 1) / tasks - begin;
-    own_output_.middleCols(begin, count).array() = x.middleCols(begin, count).array().max(0.0f);
+  internal::ParallelForColumns(x.cols(), x.size(), [&](int64_t begin, int64_t end) {
+    own_output_.middleCols(begin, end - begin).array() =
+        x.middleCols(begin, end - begin).array().max(0.0f);
   });
   adopted_output_ = nullptr;
   return own_output_;
@@ -29,11 +26,8 @@ const Matrix& ReLU::Backward(const Matrix& grad_out) {
       << "relu: output gradient is " << grad_out.rows() << "x" << grad_out.cols() << ", output was "
       << y.rows() << "x" << y.cols();
   grad_input_.resize(grad_out.rows(), grad_out.cols());
-  const Eigen::Index batch = grad_out.cols();
-  const int tasks = internal::TasksForElements(grad_out.size(), batch);
-  internal::ParallelFor(tasks, [&](int task) {
-    const Eigen::Index begin = batch * task / tasks;
-    const Eigen::Index count = batch * (task + 1) / tasks - begin;
+  internal::ParallelForColumns(grad_out.cols(), grad_out.size(), [&](int64_t begin, int64_t end) {
+    const int64_t count = end - begin;
     grad_input_.middleCols(begin, count).array() =
         (y.middleCols(begin, count).array() > 0.0f)
             .select(grad_out.middleCols(begin, count).array(), 0.0f);

@@ -64,5 +64,14 @@ void ParallelFor(int tasks, const F& f) {
       const_cast<void*>(static_cast<const void*>(&f)));
 }
 
+/// ParallelFor() over the columns (samples) of a pass over `elements` elements in all: f(begin,
+/// end) for each of TasksForElements(elements, batch) consecutive ranges that together cover
+/// [0, batch), the first range on the calling thread.
+template <class F>
+void ParallelForColumns(int64_t batch, int64_t elements, const F& f) {
+  const int tasks = TasksForElements(elements, batch);
+  ParallelFor(tasks, [&](int task) { f(batch * task / tasks, batch * (task + 1) / tasks); });
+}
+
 }  // namespace internal
 }  // namespace rl::nn

@@ -37,12 +37,9 @@ void PixelsToFloats(const uint8_t* pixels, int64_t count, float* out) {
 
 void PixelsToMatrix(const uint8_t* pixels, int features, int batch, Matrix* out) {
   out->resize(features, batch);
-  const int64_t size = int64_t{features} * batch;
-  const int tasks = internal::TasksForElements(size, batch);
-  internal::ParallelFor(tasks, [&](int task) {
-    const int64_t begin = int64_t{features} * (batch * task / tasks);
-    const int64_t end = int64_t{features} * (batch * (task + 1) / tasks);
-    PixelsToFloats(pixels + begin, end - begin, out->data() + begin);
+  internal::ParallelForColumns(batch, int64_t{features} * batch, [&](int64_t begin, int64_t end) {
+    PixelsToFloats(pixels + features * begin, features * (end - begin),
+                   out->data() + features * begin);
   });
 }
 
@@ -50,9 +47,8 @@ void ShiftedPixelsToMatrix(const uint8_t* pixels, int planes, int height, int wi
                            const int* dy, const int* dx, Matrix* out) {
   const int64_t features = int64_t{planes} * height * width;
   out->resize(features, batch);
-  const int tasks = internal::TasksForElements(features * batch, batch);
-  internal::ParallelFor(tasks, [&](int task) {
-    for (int j = batch * task / tasks; j < batch * (task + 1) / tasks; ++j) {
+  internal::ParallelForColumns(batch, features * batch, [&](int64_t begin, int64_t end) {
+    for (int64_t j = begin; j < end; ++j) {
       ShiftOne(pixels + j * features, planes, height, width, dy[j], dx[j],
                out->data() + j * features);
     }

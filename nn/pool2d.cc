@@ -60,10 +60,10 @@ const Matrix& Pool2d::Forward(const Matrix& x) {
   batch_ = static_cast<int>(x.cols());
   output_.resize(out_.size(), batch_);
   if (mode_ == Mode::kMax) argmax_.resize(static_cast<size_t>(out_.size()) * batch_);
-  const int tasks = internal::TasksForElements(int64_t{in_.size()} * batch_, batch_);
-  internal::ParallelFor(tasks, [&](int task) {
-    ForwardSamples(x, batch_ * task / tasks, batch_ * (task + 1) / tasks);
-  });
+  internal::ParallelForColumns(batch_, int64_t{in_.size()} * batch_,
+                               [&](int64_t begin, int64_t end) {
+                                 ForwardSamples(x, static_cast<int>(begin), static_cast<int>(end));
+                               });
   return output_;
 }
 
@@ -113,10 +113,10 @@ const Matrix& Pool2d::Backward(const Matrix& grad_out) {
   RL_CHECK(grad_out.rows() == out_.size() && grad_out.cols() == batch_)
       << Describe() << ": output gradient is " << grad_out.rows() << "x" << grad_out.cols();
   grad_input_.resize(in_.size(), batch_);
-  const int tasks = internal::TasksForElements(int64_t{in_.size()} * batch_, batch_);
-  internal::ParallelFor(tasks, [&](int task) {
-    BackwardSamples(grad_out, batch_ * task / tasks, batch_ * (task + 1) / tasks);
-  });
+  internal::ParallelForColumns(
+      batch_, int64_t{in_.size()} * batch_, [&](int64_t begin, int64_t end) {
+        BackwardSamples(grad_out, static_cast<int>(begin), static_cast<int>(end));
+      });
   return grad_input_;
 }
 

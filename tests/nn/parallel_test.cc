@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <random>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -149,6 +151,32 @@ TEST(ParallelTest, TasksForElementsSplitsOnlyLongPasses) {
   EXPECT_EQ(internal::TasksForElements(100 * internal::kMinTaskElements, 8), 3);
   EXPECT_EQ(internal::TasksForElements(2 * internal::kMinTaskElements, 8), 2);
   EXPECT_EQ(internal::TasksForElements(internal::kMinTaskElements - 1, 8), 1);
+}
+
+// Its ranges follow each other and cover the whole batch, cut as TasksForElements says.
+TEST(ParallelTest, ParallelForColumnsCoversTheBatchInConsecutiveRanges) {
+  Threads threads(3);
+  for (const int64_t batch : {1, 2, 7, 64}) {
+    for (const int64_t elements :
+         {int64_t{1}, 2 * internal::kMinTaskElements, 100 * internal::kMinTaskElements}) {
+      std::vector<std::pair<int64_t, int64_t>> ranges(8, {-1, -1});
+      std::atomic<int> calls{0};
+      internal::ParallelForColumns(batch, elements, [&](int64_t begin, int64_t end) {
+        ranges[static_cast<size_t>(calls.fetch_add(1))] = {begin, end};
+      });
+      const int tasks = internal::TasksForElements(elements, batch);
+      ASSERT_EQ(calls.load(), tasks) << "batch " << batch << ", elements " << elements;
+      ranges.resize(static_cast<size_t>(tasks));
+      std::sort(ranges.begin(), ranges.end());
+      int64_t next = 0;
+      for (const auto& [begin, end] : ranges) {
+        EXPECT_EQ(begin, next);
+        EXPECT_GT(end, begin);
+        next = end;
+      }
+      EXPECT_EQ(next, batch);
+    }
+  }
 }
 
 // The pixel conversions, ReLU and both pooling layers, forward and backward, at about the
