@@ -144,7 +144,9 @@ if [ "$skip_goal" -eq 0 ]; then
 fi
 
 # A whole pipeline (actors, replay, learner, evaluator) for SECONDS: episodes per hour and env
-# steps/s after the first minute (start-up, replay warm-up), from the monitor's progress lines.
+# steps/s after the first minute (start-up, replay warm-up), from the monitor's progress lines;
+# and the learner's updates/s over the same span, with every process of the run beside it (a
+# row of its own, BENCH_NAME with "episodes_per_hour" made "learner_updates_per_s").
 # pipeline_rate PRESET SECONDS BENCH_NAME
 pipeline_rate() {
   local preset="$1" seconds="$2" name="$3"
@@ -153,18 +155,22 @@ pipeline_rate() {
     --goal 1000000 --time-budget "$seconds" --out "$work/$preset" > "$work/$preset.log" 2>&1 || true
   local n_actors
   n_actors=$(sed -n 's/^# actors = \([0-9]*\).*/\1/p' "$work/$preset/config.ini" 2>/dev/null)
-  # Progress lines: "[  499.6s] steps 16,049  episodes 2,221  ...".
+  # Progress lines: "[  499.6s] steps 16,049  episodes 2,221  ...  learner 44 upd/s (9,120)  ...".
   tr -d ',' < "$work/$preset/logs/monitor.log" | awk -v actors="${n_actors:-null}" -v name="$name" '
     /^\[ *[0-9.]+s\] steps [0-9]+ +episodes [0-9]+/ {
       t = $0; sub(/^\[ */, "", t); sub(/s\].*/, "", t)
       match($0, /steps [0-9]+/); s = substr($0, RSTART + 6, RLENGTH - 6)
       match($0, /episodes [0-9]+/); e = substr($0, RSTART + 9, RLENGTH - 9)
-      if (t + 0 >= 60 && t0 == "") { t0 = t; s0 = s; e0 = e }
-      t1 = t; s1 = s; e1 = e
+      u = match($0, /upd\/s \([0-9]+\)/) ? substr($0, RSTART + 7, RLENGTH - 8) : ""
+      if (t + 0 >= 60 && t0 == "") { t0 = t; s0 = s; e0 = e; u0 = u }
+      t1 = t; s1 = s; e1 = e; u1 = u
     }
     END {
       if (t0 == "" || t1 - t0 < 10) { print "bench.sh: " name " ran too briefly to measure" > "/dev/stderr"; exit }
       printf "{\"bench\": \"%s\", \"value\": %.0f, \"unit\": \"episodes/h\", \"env_steps_per_s\": %.1f, \"seconds\": %.0f, \"actors\": %s, \"note\": \"whole pipeline on this machine, learner and evaluator included, after the first minute\"}\n", name, (e1 - e0) * 3600 / (t1 - t0), (s1 - s0) / (t1 - t0), t1 - t0, actors
+      if (u0 == "" || u1 == "") exit
+      learner = name; sub(/episodes_per_hour$/, "learner_updates_per_s", learner)
+      printf "{\"bench\": \"%s\", \"value\": %.1f, \"unit\": \"updates/s\", \"updates\": %d, \"seconds\": %.0f, \"actors\": %s, \"note\": \"the learner of a whole pipeline on this machine, with the replay, the actors and the evaluator beside it, after the first minute\"}\n", learner, (u1 - u0) / (t1 - t0), u1 - u0, t1 - t0, actors
     }' >> "$ours"
 }
 
