@@ -13,8 +13,8 @@ namespace rl::nn {
 const Matrix& ReLU::Forward(const Matrix& x) {
   own_output_.resize(x.rows(), x.cols());
   internal::ParallelForColumns(x.cols(), x.size(), [&](int64_t begin, int64_t end) {
-    own_output_.middleCols(begin, end - begin).array() =
-        x.middleCols(begin, end - begin).array().max(0.0f);
+    const int64_t count = end - begin;
+    own_output_.middleCols(begin, count).array() = x.middleCols(begin, count).array().max(0.0f);
   });
   adopted_output_ = nullptr;
   return own_output_;

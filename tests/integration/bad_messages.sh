@@ -35,8 +35,7 @@ metrics="$run/metrics.jsonl"
 # (grep -c fails when it counts 0: a short run may have no learner row yet.)
 rows=$(grep -c '"role": "learner"' "$metrics" 2>/dev/null || true)
 rows=${rows:-0}
-timeout 30 bash -c 'until [ "$(grep -c "\"role\": \"learner\"" "$0")" -ge "$1" ]; do sleep 0.1; done' \
-  "$metrics" $((rows + 2)) || fail "the monitor wrote no learner row for 30 s"
+wait_lines "$metrics" '"role": "learner"' $((rows + 2)) 30
 inserts0=$(last_metric "$run" replay inserts)
 updates0=$(last_metric "$run" learner updates)
 [ -n "$inserts0" ] && [ -n "$updates0" ] || fail "no replay or learner rows in $metrics"

@@ -97,6 +97,15 @@ wait_line() {  # wait_line FILE PATTERN TIMEOUT_SECONDS
     fail "no line matching '$pattern' in $file within $limit s"
 }
 
+# Waits (bounded) until FILE has at least COUNT lines matching PATTERN.
+wait_lines() {  # wait_lines FILE PATTERN COUNT TIMEOUT_SECONDS
+  local file=$1 pattern=$2 count=$3 limit=$4
+  timeout "$limit" bash -c 'until n=$(grep -c -- "$1" "$0" 2>/dev/null); [ "${n:-0}" -ge "$2" ]; do
+      sleep 0.05
+    done' "$file" "$pattern" "$count" ||
+    fail "fewer than $count lines matching '$pattern' in $file within $limit s"
+}
+
 # Waits (bounded) until the learner of the run in RUN_DIR has saved its state (it does with its
 # first checkpoint).
 wait_learner_state() {  # wait_learner_state RUN_DIR

@@ -45,8 +45,7 @@ victim=$(awk '$1 == "replay" {p = $2} END {print p}' "$run/pids")
 hold_learner_and_evaluator
 kill -KILL "$victim"
 echo "killed the replay (pid $victim) $moment"
-timeout 30 bash -c 'until [ "$(grep -c "^replay: ready" "$0")" -ge 2 ]; do sleep 0.05; done' "$log" ||
-  fail "the replay was not ready again within 30 s"
+wait_lines "$log" "^replay: ready" 2 30
 # shellcheck disable=SC2086
 kill -CONT $held
 status=0

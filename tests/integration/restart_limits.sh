@@ -21,8 +21,7 @@ kill_evaluator() {  # kill_evaluator N K
   local victim
   victim=$(awk '$1 == "evaluator" {p = $2} END {print p}' "$run/pids")
   kill -KILL "$victim"
-  timeout 60 bash -c 'until [ "$(grep -c "^evaluator " "$0")" -gt "$1" ]; do sleep 0.05; done' \
-    "$run/pids" "$2" || fail "the evaluator was not started again after kill $2"
+  wait_lines "$run/pids" "^evaluator " $(($2 + 1)) 60  # started again
   [ "$(tail -1 "$run/restarts" | cut -d' ' -f2-)" = "evaluator status 137 restart $1" ] ||
     fail "kill $2: the restart line is $(tail -1 "$run/restarts")"
   echo "$(tail -1 "$run/restarts")"

@@ -23,8 +23,7 @@ echo "killed actor-3 (pid $pid)"
 wait_line "$run/restarts" " actor-3 status 137 restart 1$" 30
 # Started again as a step on node2, and ready.
 slurm_wait_steps
-timeout 30 bash -c 'until [ "$(grep -c "^actor-3: ready" "$0")" -ge 2 ]; do sleep 0.1; done' "$run/logs/actor-3.log" ||
-  fail "actor-3 was not ready again within 30 s"
+wait_lines "$run/logs/actor-3.log" "^actor-3: ready" 2 30
 # shellcheck disable=SC2086
 kill -CONT $held
 best=$(slurm_expect_goal)

@@ -32,8 +32,7 @@ last_update_before=$(sed -n 's/.*"update": \([0-9]*\).*/\1/p' "$run/eval.jsonl" 
 best_before=$(best_mean "$run/eval.jsonl")
 slurm_wait_steps
 # A new evaluation of the resumed run, then scancel.
-timeout 120 bash -c 'until [ "$(grep -c "\"update\"" "$0")" -gt "$1" ]; do sleep 0.2; done' "$run/eval.jsonl" "$evals_before" ||
-  fail "the resumed run did not evaluate within 120 s"
+wait_lines "$run/eval.jsonl" '"update"' $((evals_before + 1)) 120
 cluster_exec ctl scancel "$job"
 state=$(cluster_wait_job "$job" 60) || fail "job $job did not end after scancel"
 grep -v '^\[' "$out" | tail -20

@@ -44,7 +44,6 @@ learner_metric() {
     grep -Eo '[0-9.e+]+$'
 }
 lines() { grep -c -- "$2" "$1" || true; }          # lines FILE PATTERN
-at_least() { [ "$(lines "$1" "$2")" -ge "$3" ]; }  # at_least FILE PATTERN N
 learner_updates_at_least() { [ "$(learner_metric updates)" -ge "$1" ]; }
 # Waits (bounded) until COMMAND succeeds.
 wait_for() {  # wait_for TIMEOUT_SECONDS WHAT COMMAND...
@@ -85,8 +84,7 @@ grep -q "dropped a replayed message" "$run/logs/replay.log" || fail "the replay 
 written="^replay: snapshot [0-9]* written"
 snapshots=$(lines "$run/logs/replay.log" "$written")
 # Two more snapshots: the second began after the recording's end, so it holds every position.
-wait_for 30 "two snapshots with the actors stopped" \
-  at_least "$run/logs/replay.log" "$written" $((snapshots + 2))
+wait_lines "$run/logs/replay.log" "$written" $((snapshots + 2)) 30
 kill -KILL "$(pid_of replay)"
 wait_line "$run/logs/replay.log" "^replay: snapshot .* loaded (" 30
 grep "^replay: snapshot .* loaded (" "$run/logs/replay.log" | tail -1
@@ -104,17 +102,16 @@ kill -STOP "$replay_pid"
 kill -INT "$bulk_logger"
 wait "$bulk_logger" || true
 kill -KILL "$(pid_of learner)"
-wait_for 30 "a restarted learner" at_least "$run/logs/learner.log" "^learner: ready" 2
+wait_lines "$run/logs/learner.log" "^learner: ready" 2 30
 # Its first stats, then what it has trained and refused so far.
 rows=$(lines "$run/metrics.jsonl" "$learner_rows")
-wait_for 10 "stats of the restarted learner" \
-  at_least "$run/metrics.jsonl" "$learner_rows" $((rows + 2))
+wait_lines "$run/metrics.jsonl" "$learner_rows" $((rows + 2)) 10
 before=$(learner_metric updates)
 refused_before=$(learner_metric replayed)
 lcm-logplayer --speed=20 --regexp=RL_SAMPLES --lcm-url="$bulk_url" "$dir/bulk.lcmlog" \
   > "$dir/bulk-player.log" 2>&1 || fail "lcm-logplayer failed: $(tail -3 "$dir/bulk-player.log")"
 rows=$(lines "$run/metrics.jsonl" "$learner_rows")
-wait_for 10 "stats of the learner" at_least "$run/metrics.jsonl" "$learner_rows" $((rows + 2))
+wait_lines "$run/metrics.jsonl" "$learner_rows" $((rows + 2)) 10
 after=$(learner_metric updates)
 refused_after=$(learner_metric replayed)
 kill -CONT "$replay_pid"
