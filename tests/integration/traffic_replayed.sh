@@ -55,17 +55,22 @@ wait_for() {  # wait_for TIMEOUT_SECONDS WHAT COMMAND...
   done
 }
 # Plays the main-port recording back while inject checks that the replay and the evaluator
-# refuse all of it and that nothing changes (the actors are stopped).
+# refuse all of it and that nothing changes (the actors are stopped). Each call logs to a file of
+# its own: the background inject truncates its log only once it starts, so a reused file would
+# still hold the last call's "ready for playback" and the playback would begin before inject
+# took its baseline.
+plays=0
 play_back() {  # play_back WHAT
+  local log="$dir/inject-$((plays += 1)).log"
   "$bin/inject" --replayed-log "$dir/main.lcmlog" --run-id "$(run_setting "$run" run-id)" \
     --key-file "$run/key" --lcm-url "$url" --lcm-bulk-url "$bulk_url" --timeout 60 \
-    > "$dir/inject.log" 2>&1 &
+    > "$log" 2>&1 &
   local inject_pid=$! inject_status=0
-  wait_line "$dir/inject.log" "ready for playback" 60
+  wait_line "$log" "ready for playback" 60
   lcm-logplayer --speed=2 --lcm-url="$url" "$dir/main.lcmlog" > "$dir/player.log" 2>&1 ||
     fail "lcm-logplayer failed: $(tail -3 "$dir/player.log")"
   wait "$inject_pid" || inject_status=$?
-  grep -v "^\[inject\]" "$dir/inject.log"
+  grep -v "^\[inject\]" "$log"
   [ "$inject_status" -eq 0 ] || fail "$1 took recorded traffic, or it changed the run"
 }
 
