@@ -32,9 +32,7 @@ done < "$run/pids"
 # replay's inserts and the learner's updates must grow, actor-0 must hold weights of a later update
 # and the evaluator must have scored a checkpoint of a later update.
 metrics="$run/metrics.jsonl"
-# (grep -c fails when it counts 0: a short run may have no learner row yet.)
-rows=$(grep -c '"role": "learner"' "$metrics" 2>/dev/null || true)
-rows=${rows:-0}
+rows=$(lines "$metrics" '"role": "learner"')  # a short run may have no learner row yet
 wait_lines "$metrics" '"role": "learner"' $((rows + 2)) 30
 inserts0=$(last_metric "$run" replay inserts)
 updates0=$(last_metric "$run" learner updates)

@@ -97,6 +97,13 @@ wait_line() {  # wait_line FILE PATTERN TIMEOUT_SECONDS
     fail "no line matching '$pattern' in $file within $limit s"
 }
 
+# Prints how many lines of FILE match PATTERN (0 for none, or while FILE does not exist yet).
+lines() {  # lines FILE PATTERN
+  local n
+  n=$(grep -c -- "$2" "$1" 2>/dev/null)
+  echo "${n:-0}"
+}
+
 # Waits (bounded) until FILE has at least COUNT lines matching PATTERN.
 wait_lines() {  # wait_lines FILE PATTERN COUNT TIMEOUT_SECONDS
   local file=$1 pattern=$2 count=$3 limit=$4

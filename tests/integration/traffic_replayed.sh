@@ -43,7 +43,6 @@ learner_metric() {
   grep "$learner_rows" "$run/metrics.jsonl" | tail -1 | grep -Eo "\"$1\": [0-9.e+]+" |
     grep -Eo '[0-9.e+]+$'
 }
-lines() { grep -c -- "$2" "$1" || true; }          # lines FILE PATTERN
 learner_updates_at_least() { [ "$(learner_metric updates)" -ge "$1" ]; }
 # Waits (bounded) until COMMAND succeeds.
 wait_for() {  # wait_for TIMEOUT_SECONDS WHAT COMMAND...
