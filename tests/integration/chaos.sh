@@ -74,7 +74,7 @@ start_ms=$(now_ms)
 since() { awk -v ms=$(($(now_ms) - $1)) 'BEGIN { printf "%.1f s", ms / 1000 }'; }
 elapsed() { since "$start_ms"; }
 pid_of() { awk -v r="$1" '$1 == r {p = $2} END {print p}' "$run/pids" 2>/dev/null; }
-starts_of() { grep -c "^$1 " "$run/pids" 2>/dev/null || true; }
+starts_of() { lines "$run/pids" "^$1 "; }
 alive() { awk '$3 != "Z" { found = 1 } END { exit !found }' "/proc/$1/stat" 2>/dev/null; }
 going() { kill -0 "$launch_pid" 2>/dev/null; }
 
