@@ -100,6 +100,7 @@ void Bus::SubscribeRaw(const std::string& channel, Port port, int64_t fingerprin
   if (s == nullptr) throw std::runtime_error("cannot subscribe to " + channel);
   s->setQueueCapacity(config_.queue_capacity);
   subscriptions_.push_back(std::move(sub));
+  subscribed_[static_cast<int>(port)] = true;
 }
 
 void Bus::OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/,
@@ -319,20 +320,28 @@ std::vector<StreamPosition> ParsePositions(std::string_view text) {
 }
 
 int Bus::Handle(int timeout_ms) {
-  pollfd fds[2] = {{main_->getFileno(), POLLIN, 0}, {bulk_->getFileno(), POLLIN, 0}};
+  // Only the ports with a subscription: LCM's udpm binds a port and joins its group when asked
+  // for its descriptor, subscribed or not. (With none, poll() just waits out the timeout.)
+  pollfd fds[2];
+  lcm::LCM* ports[2];
+  nfds_t count = 0;
+  for (const Port port : {Port::kMain, Port::kBulk}) {
+    if (!subscribed_[static_cast<int>(port)]) continue;
+    ports[count] = &lcm(port);
+    fds[count] = {ports[count]->getFileno(), POLLIN, 0};
+    ++count;
+  }
   int dispatched = 0;
   int wait = timeout_ms;
-  // Dispatch until both queues are empty; bounded so that a flood cannot starve the caller.
+  // Dispatch until the queues are empty; bounded so that a flood cannot starve the caller.
   for (int round = 0; round < 100000; ++round) {
-    if (poll(fds, 2, wait) <= 0) break;
+    if (poll(fds, count, wait) <= 0) break;
     wait = 0;
-    if (fds[0].revents & POLLIN) {
-      main_->handle();
-      ++dispatched;
-    }
-    if (fds[1].revents & POLLIN) {
-      bulk_->handle();
-      ++dispatched;
+    for (nfds_t k = 0; k < count; ++k) {
+      if (fds[k].revents & POLLIN) {
+        ports[k]->handle();
+        ++dispatched;
+      }
     }
   }
   return dispatched;

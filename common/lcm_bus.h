@@ -193,8 +193,11 @@ class Bus {
   // ParsePositions(text), then RestorePositions (throws as ParsePositions does).
   void LoadPositions(std::string_view text) { RestorePositions(ParsePositions(text)); }
 
-  // Waits at most timeout_ms (0: no wait) for traffic on either port, then dispatches every
-  // pending message. Returns the number of messages dispatched.
+  // Waits at most timeout_ms (0: no wait) for traffic on the ports this bus subscribes on, then
+  // dispatches every pending message. Returns the number of messages dispatched. A port without
+  // a subscription is never read, so LCM never joins it: a process with no use for the bulk port
+  // does not copy every sample reply and weight broadcast of the run out of the kernel only to
+  // drop it.
   int Handle(int timeout_ms);
 
   const BusCounters& counters() const { return counters_; }
@@ -267,6 +270,7 @@ class Bus {
   std::unique_ptr<lcm::LCM> main_;
   std::unique_ptr<lcm::LCM> bulk_;
   std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
+  bool subscribed_[2] = {false, false};                           // by Port: a subscription on it
   std::map<std::string, int64_t> publish_seq_;                    // by channel
   std::map<std::string, SenderPositions, std::less<>> restored_;  // by channel (LoadPositions)
   std::vector<uint8_t> encode_buffer_;

@@ -1,8 +1,12 @@
 #include "common/lcm_bus.h"
 
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <memory>
+#include <random>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -619,6 +623,57 @@ TEST(MessageTableTest, RefusesAnotherTypeOrPortOnAChannelOfTheTable) {
   EXPECT_EQ(ChannelPort("TEST_CHANNEL", "checkpoint_t", std::nullopt), Port::kMain);
   EXPECT_EQ(ChannelPort("TEST_CHANNEL", "checkpoint_t", Port::kBulk), Port::kBulk);
   EXPECT_TRUE(bus.Publish("TEST_CHANNEL", &c));
+}
+
+// How many UDP sockets of this host are bound to `port` (/proc/net/udp: "slot local_address ...",
+// the address as HEXADDR:HEXPORT).
+int SocketsBoundTo(int port) {
+  std::ifstream in("/proc/net/udp");
+  std::string line;
+  std::getline(in, line);  // the header
+  int count = 0;
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    std::string slot, local;
+    if (!(fields >> slot >> local)) continue;
+    const size_t colon = local.rfind(':');
+    if (colon != std::string::npos && std::stoi(local.substr(colon + 1), nullptr, 16) == port) {
+      ++count;
+    }
+  }
+  return count;
+}
+
+// A bus binds (and joins the multicast group of) only the ports it subscribes on, when it handles
+// traffic: a process with no use for the bulk port (the monitor, the evaluator, the replay, which
+// only publishes there) must not receive the run's sample replies and weights only to drop them.
+TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
+  std::random_device device;
+  const int port = 20000 + 2 * std::uniform_int_distribution<int>(0, 19999)(device);
+  if (SocketsBoundTo(port) != 0 || SocketsBoundTo(port + 1) != 0) GTEST_SKIP() << "port in use";
+  BusConfig c = MemqConfig(5, "monitor");
+  c.url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
+  c.bulk_url = "udpm://239.255.76.67:" + std::to_string(port + 1) + "?ttl=0";
+  std::unique_ptr<Bus> bus;
+  try {
+    bus = std::make_unique<Bus>(c);
+  } catch (const std::runtime_error& e) {
+    GTEST_SKIP() << "no multicast here: " << e.what();
+  }
+  bus->Subscribe<rlmsg::stats_actor_t>(channels::kStatsActor, [](const rlmsg::stats_actor_t&) {});
+  bus->Handle(0);
+  EXPECT_EQ(SocketsBoundTo(port), 1);
+  EXPECT_EQ(SocketsBoundTo(port + 1), 0) << "the bulk port was bound without a subscription";
+
+  // Subscribed there too, it hears what is published there.
+  int weights = 0;
+  bus->Subscribe<rlmsg::weights_chunk_t>(
+      channels::kWeights, [&weights](const rlmsg::weights_chunk_t&) { ++weights; }, Port::kBulk);
+  EXPECT_EQ(SocketsBoundTo(port + 1), 1);
+  rlmsg::weights_chunk_t w = examples::Example<rlmsg::weights_chunk_t>();
+  ASSERT_TRUE(bus->Publish(channels::kWeights, &w));
+  for (int i = 0; i < 100 && weights == 0; ++i) bus->Handle(10);
+  EXPECT_EQ(weights, 1);
 }
 
 }  // namespace
