@@ -20,6 +20,7 @@
 
 #include "common/atomic_file.h"
 #include "common/clock.h"
+#include "common/host_ports.h"
 #include "common/text_format.h"
 #include "launch/launch_options.h"
 #include "launch/placement.h"
@@ -45,24 +46,8 @@ std::string ReadText(const std::string& path) {
   return text.str();
 }
 
-// Whether a UDP socket of this host (IPv4 or IPv6) is bound to `port`.
-bool PortInUse(int port) {
-  for (const char* table : {"/proc/net/udp", "/proc/net/udp6"}) {
-    std::ifstream in(table);
-    std::string line;
-    std::getline(in, line);  // the header
-    while (std::getline(in, line)) {
-      std::istringstream fields(line);
-      std::string slot, local;
-      if (!(fields >> slot >> local)) continue;
-      const size_t colon = local.rfind(':');
-      if (colon != std::string::npos && std::stoi(local.substr(colon + 1), nullptr, 16) == port) {
-        return true;
-      }
-    }
-  }
-  return false;
-}
+// Whether a UDP socket of this host is bound to `port`.
+bool PortInUse(int port) { return rl::SocketsOnPort("udp", port) > 0; }
 
 // A free pair of UDP ports (P, P + 1), P even in [20000, 60000): only the port isolates two runs
 // on one host.

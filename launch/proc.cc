@@ -13,6 +13,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/host_ports.h"
+
 namespace rl::launch {
 
 uint64_t ProcessStartTime(pid_t pid) {
@@ -68,23 +70,7 @@ bool HoldsFileOpen(pid_t pid, const std::string& path) {
   return false;
 }
 
-bool ListensOnTcp(int port) {
-  for (const char* table : {"/proc/net/tcp", "/proc/net/tcp6"}) {
-    std::ifstream in(table);
-    std::string line;
-    std::getline(in, line);  // the header
-    while (std::getline(in, line)) {
-      std::istringstream fields(line);
-      std::string slot, local, remote, state;
-      if (!(fields >> slot >> local >> remote >> state) || state != "0A") continue;  // LISTEN
-      const size_t colon = local.rfind(':');
-      if (colon != std::string::npos && std::stoi(local.substr(colon + 1), nullptr, 16) == port) {
-        return true;
-      }
-    }
-  }
-  return false;
-}
+bool ListensOnTcp(int port) { return SocketsOnPort("tcp", port, "0A") > 0; }  // 0A: LISTEN
 
 std::string ExecutableDir() {
   std::error_code ec;

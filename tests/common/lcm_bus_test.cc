@@ -1,12 +1,10 @@
 #include "common/lcm_bus.h"
 
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <random>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -16,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "common/channels.h"
+#include "common/host_ports.h"
 #include "common/message_auth.h"
 #include "common/message_examples.h"
 
@@ -625,32 +624,14 @@ TEST(MessageTableTest, RefusesAnotherTypeOrPortOnAChannelOfTheTable) {
   EXPECT_TRUE(bus.Publish("TEST_CHANNEL", &c));
 }
 
-// How many UDP sockets of this host are bound to `port` (/proc/net/udp: "slot local_address ...",
-// the address as HEXADDR:HEXPORT).
-int SocketsBoundTo(int port) {
-  std::ifstream in("/proc/net/udp");
-  std::string line;
-  std::getline(in, line);  // the header
-  int count = 0;
-  while (std::getline(in, line)) {
-    std::istringstream fields(line);
-    std::string slot, local;
-    if (!(fields >> slot >> local)) continue;
-    const size_t colon = local.rfind(':');
-    if (colon != std::string::npos && std::stoi(local.substr(colon + 1), nullptr, 16) == port) {
-      ++count;
-    }
-  }
-  return count;
-}
-
 // A bus binds (and joins the multicast group of) only the ports it subscribes on, when it handles
 // traffic: a process with no use for the bulk port (the monitor, the evaluator, the replay, which
 // only publishes there) must not receive the run's sample replies and weights only to drop them.
 TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
   std::random_device device;
   const int port = 20000 + 2 * std::uniform_int_distribution<int>(0, 19999)(device);
-  if (SocketsBoundTo(port) != 0 || SocketsBoundTo(port + 1) != 0) GTEST_SKIP() << "port in use";
+  if (SocketsOnPort("udp", port) != 0 || SocketsOnPort("udp", port + 1) != 0)
+    GTEST_SKIP() << "port in use";
   BusConfig c = MemqConfig(5, "monitor");
   c.url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
   c.bulk_url = "udpm://239.255.76.67:" + std::to_string(port + 1) + "?ttl=0";
@@ -662,14 +643,14 @@ TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
   }
   bus->Subscribe<rlmsg::stats_actor_t>(channels::kStatsActor, [](const rlmsg::stats_actor_t&) {});
   bus->Handle(0);
-  EXPECT_EQ(SocketsBoundTo(port), 1);
-  EXPECT_EQ(SocketsBoundTo(port + 1), 0) << "the bulk port was bound without a subscription";
+  EXPECT_EQ(SocketsOnPort("udp", port), 1);
+  EXPECT_EQ(SocketsOnPort("udp", port + 1), 0) << "the bulk port was bound without a subscription";
 
   // Subscribed there too, it hears what is published there.
   int weights = 0;
   bus->Subscribe<rlmsg::weights_chunk_t>(
       channels::kWeights, [&weights](const rlmsg::weights_chunk_t&) { ++weights; }, Port::kBulk);
-  EXPECT_EQ(SocketsBoundTo(port + 1), 1);
+  EXPECT_EQ(SocketsOnPort("udp", port + 1), 1);
   rlmsg::weights_chunk_t w = examples::Example<rlmsg::weights_chunk_t>();
   ASSERT_TRUE(bus->Publish(channels::kWeights, &w));
   for (int i = 0; i < 100 && weights == 0; ++i) bus->Handle(10);

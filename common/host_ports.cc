@@ -1,0 +1,29 @@
+#include "common/host_ports.h"
+
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace rl {
+
+int SocketsOnPort(std::string_view protocol, int port, std::string_view state) {
+  int count = 0;
+  for (const char* family : {"", "6"}) {
+    std::ifstream in("/proc/net/" + std::string(protocol) + family);
+    std::string line;
+    std::getline(in, line);  // the header
+    // "slot local_address rem_address st ...", each address as HEXADDR:HEXPORT.
+    while (std::getline(in, line)) {
+      std::istringstream fields(line);
+      std::string slot, local, remote, st;
+      if (!(fields >> slot >> local >> remote >> st) || (!state.empty() && st != state)) continue;
+      const size_t colon = local.rfind(':');
+      if (colon != std::string::npos && std::stoi(local.substr(colon + 1), nullptr, 16) == port) {
+        ++count;
+      }
+    }
+  }
+  return count;
+}
+
+}  // namespace rl
