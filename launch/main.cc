@@ -1,10 +1,10 @@
 // launcher: runs a whole run on this host (scripts/launch.sh is its entry point; see
 // LaunchUsage() in launch_options.cc and README.md). Checks its input before anything starts,
 // creates and locks the run folder, builds the run's plan and supervises it.
-#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -45,6 +45,9 @@ std::string ReadText(const std::string& path) {
   text << in.rdbuf();
   return text.str();
 }
+
+// Opens `path` with `mode` and closes it: empty (trunc), or there as it was (app).
+void Touch(const std::string& path, std::ios::openmode mode) { std::ofstream file(path, mode); }
 
 // Whether a UDP socket of this host is bound to `port`.
 bool PortInUse(int port) { return rl::SocketsOnPort("udp", port) > 0; }
@@ -126,10 +129,10 @@ void PrepareRunFolder(const RunPlan& plan, const std::string& preset_text) {
                             "the run's config");
   }
   EnsureKeyFile(plan.key_file);
-  std::ofstream(dir + "/pids", std::ios::trunc);
-  std::ofstream(dir + "/restarts", s.resume ? std::ios::app : std::ios::trunc);
+  Touch(dir + "/pids", std::ios::trunc);
+  Touch(dir + "/restarts", s.resume ? std::ios::app : std::ios::trunc);
   if (!s.resume) {
-    for (const PlannedProcess& p : plan.processes) std::ofstream(p.log, std::ios::trunc);
+    for (const PlannedProcess& p : plan.processes) Touch(p.log, std::ios::trunc);
   }
   WriteLaunchPid(dir);
 }
