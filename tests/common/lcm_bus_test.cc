@@ -642,6 +642,8 @@ TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
     GTEST_SKIP() << "no multicast here: " << e.what();
   }
   bus->Subscribe<rlmsg::stats_actor_t>(channels::kStatsActor, [](const rlmsg::stats_actor_t&) {});
+  // LCM closes a port it cannot hear its own test message on (multicast loopback blocked).
+  if (SocketsOnPort("udp", port) == 0) GTEST_SKIP() << "LCM cannot receive multicast here";
   bus->Handle(0);
   EXPECT_EQ(SocketsOnPort("udp", port), 1);
   EXPECT_EQ(SocketsOnPort("udp", port + 1), 0) << "the bulk port was bound without a subscription";
