@@ -123,6 +123,9 @@ void EvaluatorConfig::Validate() const {
   if (!(screen_margin >= 0.0) || std::isinf(screen_margin)) {
     throw std::invalid_argument("screen-margin must be finite and at least 0");
   }
+  if (backlog < 0) {
+    throw std::invalid_argument("backlog must be at least 0, got " + std::to_string(backlog));
+  }
   if (screen_max_rejects < 1) {
     throw std::invalid_argument("screen-max-rejects must be at least 1, got " +
                                 std::to_string(screen_max_rejects));
@@ -183,9 +186,13 @@ bool EvaluatorService::Poll(int timeout_ms) {
   const double until_stats = next_stats_time_ - MonoSeconds();
   const int stats_ms = until_stats <= 0 ? 0 : static_cast<int>(std::ceil(until_stats * 1000.0));
   bus_->Handle(std::clamp(stats_ms, 0, std::max(timeout_ms, 0)));
-  const bool reached = ScorePending();
+  const bool had_pending = queue_.has_pending();
+  bool reached = ScorePending();
   // A map left due by the time share is made when the time allows, between checkpoints.
-  if (!reached && !queue_.has_pending()) MakeDueTsneMap();
+  const bool mapped = !reached && !queue_.has_pending() && MakeDueTsneMap();
+  // A superseded checkpoint only when this poll did nothing else, so that the next Handle has
+  // brought any newer announcement first.
+  if (!had_pending && !mapped && !reached) reached = ScoreFromBacklog();
   if (MonoSeconds() >= next_stats_time_) PublishStats();
   return reached && config_.stop_at_goal;
 }
@@ -271,9 +278,17 @@ bool EvaluatorService::PassesScreen(const nn::Checkpoint& ckpt,
 
 bool EvaluatorService::ScorePending() {
   const std::optional<rlmsg::checkpoint_t> announced = queue_.Take();
-  if (!announced) return false;
+  return announced && ScoreAnnounced(*announced);
+}
+
+bool EvaluatorService::ScoreFromBacklog() {
+  const std::optional<rlmsg::checkpoint_t> announced = queue_.TakeFromBacklog();
+  return announced && ScoreAnnounced(*announced);
+}
+
+bool EvaluatorService::ScoreAnnounced(const rlmsg::checkpoint_t& announced) {
   nn::Checkpoint ckpt;
-  const std::optional<EvalRecord> record = Score(*announced, &ckpt);
+  const std::optional<EvalRecord> record = Score(announced, &ckpt);
   if (!record) return false;
   const bool reached = record->mean >= report_.goal;
   ++scored_;
@@ -285,16 +300,16 @@ bool EvaluatorService::ScorePending() {
   }
   if (config_.videos && !report_dir_.empty()) {
     try {
-      media_.RecordIfBest(ckpt, announced->path, *record, [this] { Tick(); });
+      media_.RecordIfBest(ckpt, announced.path, *record, [this] { Tick(); });
     } catch (const Interrupted&) {
       // A stop during the video: the result is still announced and reported, without it.
     }
   }
-  tsne_.OfferBest(ckpt, announced->path, *record);
+  tsne_.OfferBest(ckpt, announced.path, *record);
   // At the goal the run may end as soon as the result is out: a quick map goes first.
   if (reached && tsne_.due() && tsne_.quick()) MakeTsneMap();
   WriteReportNow();
-  Announce(*announced, *record, reached);
+  Announce(announced, *record, reached);
   MakeDueTsneMap();
   return reached;
 }
@@ -329,9 +344,10 @@ bool EvaluatorService::MakeTsneMap() {
   return written;
 }
 
-void EvaluatorService::MakeDueTsneMap() {
-  if (!tsne_.due() || StopRequested() || !tsne_.fits_share()) return;
+bool EvaluatorService::MakeDueTsneMap() {
+  if (!tsne_.due() || StopRequested() || !tsne_.fits_share()) return false;
   if (MakeTsneMap()) WriteReportNow();
+  return true;
 }
 
 void EvaluatorService::WriteReportNow() {

@@ -76,6 +76,12 @@ struct EvaluatorConfig {
   int screen_episodes = 0;
   double screen_margin = 0;
   int screen_max_rejects = 3;
+  // Checkpoints superseded by a newer one before their turn (scoring is slower than the
+  // learner, or busy with a second metric, a video or a map) wait, up to this many, and are
+  // scored later, newest first, when nothing newer waits; the learner may delete some meanwhile
+  // (keep-checkpoints), and those, like the ones over the limit, are skipped. 0: every
+  // superseded checkpoint is skipped.
+  int backlog = 16;
 
   /// Throws std::invalid_argument saying what is wrong.
   void Validate() const;
@@ -101,8 +107,9 @@ class EvaluatorService {
   ~EvaluatorService();
 
   /// Waits at most timeout_ms for announcements (less when stats are due), scores the pending
-  /// checkpoint if there is one, and publishes stats when due. Returns true when stop_at_goal is
-  /// set and the checkpoint just scored reached the goal.
+  /// checkpoint if there is one (else, when no t-SNE map is due either, the newest one of the
+  /// backlog), and publishes stats when due. Returns true when stop_at_goal is set and the
+  /// checkpoint just scored reached the goal.
   bool Poll(int timeout_ms);
 
   /// Polls until StopRequested() or, with stop_at_goal, until a checkpoint reaches the goal;
@@ -111,6 +118,9 @@ class EvaluatorService {
 
   /// Scores the pending checkpoint, if any. Returns true when it reached the goal.
   bool ScorePending();
+  /// Scores the newest checkpoint of the backlog that is still there, if any. Returns true when
+  /// it reached the goal.
+  bool ScoreFromBacklog();
 
   /// Rewrites out_dir/report/ (no-op without out_dir). Logs, never throws.
   void WriteReportNow();
@@ -129,9 +139,12 @@ class EvaluatorService {
   /// Whether some record (resumed ones included) reached the goal.
   bool goal_reached() const;
   bool has_pending() const { return queue_.has_pending(); }
+  /// Superseded checkpoints waiting to be scored (EvaluatorConfig::backlog).
+  int backlog() const { return queue_.backlog(); }
   /// Every record, resumed ones first, in scoring order.
   const std::vector<EvalRecord>& records() const { return history_.records(); }
   int64_t checkpoints_scored() const { return scored_; }
+  /// Superseded checkpoints dropped unscored (EvaluatorConfig::backlog).
   int64_t checkpoints_skipped() const { return queue_.skipped(); }
   int64_t checkpoints_refused() const { return refused_; }
   /// Checkpoints that failed the screen (EvaluatorConfig::screen_episodes) and were not scored.
@@ -148,6 +161,9 @@ class EvaluatorService {
   // it (with its second metric when a new best); nullopt when it was refused or a stop was
   // requested.
   std::optional<EvalRecord> Score(const rlmsg::checkpoint_t& announced, nn::Checkpoint* ckpt);
+  // Scores the announced checkpoint and records, reports and announces the result (with its
+  // video and map when a new best). Returns true when it reached the goal.
+  bool ScoreAnnounced(const rlmsg::checkpoint_t& announced);
   // Whether the checkpoint earns its full evaluation: true without a screen (screen_episodes 0,
   // no best yet, or screen_max_rejects failures in a row), else whether the mean of its first
   // screen_episodes episodes reaches the best full mean less screen_margin. A failure is counted
@@ -161,7 +177,8 @@ class EvaluatorService {
   // Makes the due t-SNE map now (busy, with stats). Returns true when it was written.
   bool MakeTsneMap();
   // MakeTsneMap() when a map is due and the time share allows it; rewrites the report after it.
-  void MakeDueTsneMap();
+  // Returns whether it tried.
+  bool MakeDueTsneMap();
   // Between episodes: stats when due; Interrupted when a stop was requested.
   void Tick();
 
@@ -171,7 +188,7 @@ class EvaluatorService {
   std::string report_dir_;  // empty without out_dir
   ReportInfo report_;       // what every report shows (env, run, goal, config, settings)
   EvalHistory history_;
-  CheckpointQueue queue_{&history_};
+  CheckpointQueue queue_{&history_, config_.backlog};
   SecondMetric second_;
   BestMedia media_;
   TsneScheduler tsne_;

@@ -24,8 +24,8 @@ constexpr char kUsage[] =
     "Usage:\n"
     "  evaluator --out DIR [options]\n"
     "      Service mode: scores every checkpoint the learner announces on RL_CHECKPOINT (the\n"
-    "      newest first; older unscored ones are skipped), appends DIR/eval.jsonl, rewrites\n"
-    "      DIR/report/index.html and its learning curves, publishes RL_EVAL and\n"
+    "      newest first; superseded ones later, see --backlog), appends DIR/eval.jsonl,\n"
+    "      rewrites DIR/report/index.html and its learning curves, publishes RL_EVAL and\n"
     "      RL_STATS_EVALUATOR. Prints 'evaluator: ready' once subscribed. Stops on SIGINT or\n"
     "      SIGTERM, or with --stop-at-goal once a checkpoint reaches the goal, and then prints\n"
     "      'evaluator: goal reached' or 'evaluator: goal not reached (best X)'; exit status 0.\n"
@@ -162,6 +162,10 @@ int Main(int argc, char** argv) {
        rl::po::value(&config.screen_max_rejects)->default_value(config.screen_max_rejects),
        "service mode: after this many checkpoints screened out in a row, the next one is "
        "evaluated in full without a screen")  //
+      ("backlog", rl::po::value(&config.backlog)->default_value(config.backlog),
+       "service mode: checkpoints superseded by a newer one before their turn wait, up to this "
+       "many, and are scored later, newest first, when nothing newer waits (those the learner "
+       "has deleted meanwhile are skipped); 0: superseded checkpoints are skipped")  //
       ("sched-policy", rl::po::value(&sched_policy),
        "CPU scheduling policy of the whole evaluator: normal, batch (no wake-up preemption) or "
        "idle (runs only on cycles nothing else wants). Default: the one it was started with")  //

@@ -415,22 +415,73 @@ TEST_F(EvaluatorServiceTest, RefusesANetworkThatDoesNotFitTheEnv) {
   EXPECT_TRUE(results_.empty());
 }
 
-TEST_F(EvaluatorServiceTest, ScoresOnlyTheNewestOfSeveralUnscoredCheckpoints) {
+TEST_F(EvaluatorServiceTest, ScoresTheNewestFirstThenTheSupersededOnesNewestFirst) {
   EvaluatorService service(Config(), &bus_, nullptr);
   const std::string a = WriteCheckpoint(10), b = WriteCheckpoint(20), c = WriteCheckpoint(30);
   Announce(a, 10);
   Announce(c, 30);
   Announce(b, 20);  // arrives late, older than the pending one
-  ASSERT_TRUE(PollUntil(&service, [&] { return !results_.empty(); }));
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 3; }));
+  EXPECT_EQ(results_[0].update, 30);
+  EXPECT_EQ(results_[1].update, 20);
+  EXPECT_EQ(results_[2].update, 10);
+  for (int i = 0; i < 5; ++i) service.Poll(5);
+  EXPECT_EQ(results_.size(), 3U);
+  EXPECT_EQ(service.checkpoints_skipped(), 0);
+  EXPECT_EQ(service.backlog(), 0);
+  EXPECT_FALSE(service.has_pending());
+}
+
+TEST_F(EvaluatorServiceTest, ANewerAnnouncementGoesBeforeTheBacklog) {
+  EvaluatorService service(Config(), &bus_, nullptr);
+  Announce(WriteCheckpoint(10), 10);
+  Announce(WriteCheckpoint(20), 20);
+  service.Poll(10);  // takes both announcements and scores update 20 ...
+  ASSERT_EQ(service.checkpoints_scored(), 1);
+  EXPECT_EQ(service.backlog(), 1);  // ... while update 10 waits
+  Announce(WriteCheckpoint(30), 30);
+  ASSERT_TRUE(PollUntil(&service, [&] { return results_.size() == 3; }));
+  EXPECT_EQ(results_[0].update, 20);
+  EXPECT_EQ(results_[1].update, 30);
+  EXPECT_EQ(results_[2].update, 10);
+}
+
+TEST_F(EvaluatorServiceTest, SkipsSupersededCheckpointsWithoutABacklogOrWhoseFileIsGone) {
+  EvaluatorConfig config = Config();
+  config.backlog = 0;
+  {
+    EvaluatorService service(config, &bus_, nullptr);
+    const std::string a = WriteCheckpoint(10), b = WriteCheckpoint(20), c = WriteCheckpoint(30);
+    Announce(a, 10);
+    Announce(c, 30);
+    Announce(b, 20);
+    ASSERT_TRUE(PollUntil(&service, [&] { return !results_.empty(); }));
+    for (int i = 0; i < 5; ++i) service.Poll(5);
+    ASSERT_EQ(results_.size(), 1U);
+    EXPECT_EQ(results_.front().update, 30);
+    EXPECT_EQ(service.checkpoints_skipped(), 2);
+    ASSERT_TRUE(PollUntil(&service, [&] {
+      return !stats_.empty() && stats_.back().checkpoints_skipped == 2 &&
+             stats_.back().checkpoints_scored == 1;
+    }));
+  }
+  // With a backlog: a superseded checkpoint the learner deleted before its turn is skipped
+  // quietly, not refused.
+  results_.clear();
+  EvaluatorService service(Config(), &bus_, nullptr);
+  const std::string d = WriteCheckpoint(40);
+  Announce(d, 40);
+  Announce(WriteCheckpoint(50), 50);
+  service.Poll(10);  // scores update 50; update 40 waits
+  ASSERT_EQ(service.checkpoints_scored(), 1);
+  ASSERT_EQ(service.backlog(), 1);
+  ASSERT_TRUE(std::filesystem::remove(d));
   for (int i = 0; i < 5; ++i) service.Poll(5);
   ASSERT_EQ(results_.size(), 1U);
-  EXPECT_EQ(results_.front().update, 30);
-  EXPECT_EQ(service.checkpoints_skipped(), 2);
-  EXPECT_FALSE(service.has_pending());
-  ASSERT_TRUE(PollUntil(&service, [&] {
-    return !stats_.empty() && stats_.back().checkpoints_skipped == 2 &&
-           stats_.back().checkpoints_scored == 1;
-  }));
+  EXPECT_EQ(results_.front().update, 50);
+  EXPECT_EQ(service.checkpoints_skipped(), 1);
+  EXPECT_EQ(service.checkpoints_refused(), 0);
+  EXPECT_EQ(service.backlog(), 0);
 }
 
 TEST_F(EvaluatorServiceTest, StopsAtTheGoalWhenAsked) {

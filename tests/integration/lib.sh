@@ -226,6 +226,17 @@ last_scored_update() {  # last_scored_update RUN_DIR
   { sed -n 's/.*"update": \([0-9]*\).*/\1/p' "$1/eval.jsonl" 2>/dev/null; echo -1; } | sort -n | tail -1
 }
 
+# Whether the numeric FIELD of every line of an eval.jsonl after its first N lines is at least
+# the highest of those N: a resumed run carries on from where it stopped. (Within one part the
+# lines are in scoring order, not always in update order: the evaluator scores superseded
+# checkpoints later.)
+carries_on() {  # carries_on EVAL_JSONL N FIELD
+  awk -v n="$2" -F"\"$3\": " '{ split($2, a, ","); v = a[1] + 0 }
+    NR <= n { if (NR == 1 || v > top) top = v; next }
+    v < top { print "'"$3"' " v " after " top " before the resumption"; bad = 1; exit }
+    END { exit bad }' "$1"
+}
+
 # Fails when a process of the run reported a sanitizer finding in its log (ASan, LSan, UBSan or
 # TSan, on a sanitizer build): the process aborted, and its restart would hide it.
 expect_no_sanitizer_reports() {  # expect_no_sanitizer_reports RUN_DIR

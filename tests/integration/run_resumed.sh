@@ -35,10 +35,8 @@ grep -q "^replay: last snapshot written to $dir/run/replay-snapshot.bin (size [1
   fail "the stopped replay wrote no last snapshot"
 grep -q "^replay: snapshot $dir/run/replay-snapshot.bin loaded (size [1-9]" "$dir/run/logs/replay.log" ||
   fail "the resumed replay did not load its snapshot"
-awk -F'"update": ' '{split($2, a, ","); u = a[1] + 0; if (u < prev) { print "update " u " after " prev; exit 1 } prev = u}' \
-  "$dir/run/eval.jsonl" || fail "evaluation updates went back"
-awk -F'"env_steps": ' '{split($2, a, ","); s = a[1] + 0; if (s < prev) { print "env steps " s " after " prev; exit 1 } prev = s}' \
-  "$dir/run/eval.jsonl" || fail "evaluation env steps went back"
+carries_on "$dir/run/eval.jsonl" "$evals_before" update || fail "evaluation updates went back"
+carries_on "$dir/run/eval.jsonl" "$evals_before" env_steps || fail "evaluation env steps went back"
 # The metrics' time carries on too: the resumed monitor's rows follow the first part's.
 grep -q '"t": ' "$dir/run/metrics.jsonl" || fail "no metrics rows"
 awk -F'"t": ' '{split($2, a, ","); t = a[1] + 0; if (t < prev) { print "metrics t " t " after " prev; exit 1 } prev = t}' \

@@ -50,8 +50,7 @@ size=$(sed -n "s|^replay: snapshot $run/replay-snapshot.bin loaded (size \([0-9]
 # The evaluations carry on: the earlier ones kept, the best of them still the floor.
 head -n "$evals_before" "$run/eval.jsonl" | tail -1 | grep -q "\"update\": $last_update_before," ||
   fail "the earlier evaluations were not kept"
-awk -F'"update": ' '{split($2, a, ","); u = a[1] + 0; if (u < prev) { print "update " u " after " prev; exit 1 } prev = u}' \
-  "$run/eval.jsonl" || fail "evaluation updates went back"
+carries_on "$run/eval.jsonl" "$evals_before" update || fail "evaluation updates went back"
 best=$(best_mean "$run/eval.jsonl")
 awk -v a="$best" -v b="$best_before" 'BEGIN { exit !(a >= b) }' || fail "the best score went from $best_before to $best"
 grep -q '<img' "$run/report/index.html" || fail "the report has no learning curve"
