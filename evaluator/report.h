@@ -25,7 +25,7 @@ struct ReportInfo {
   std::string run_config;     // the run's config text, shown verbatim (escaped) in a <pre>
   std::string eval_settings;  // one line on how checkpoints were scored (episodes, epsilon, seeds)
   std::string second_name;    // what the records' second metric is (empty: none)
-  int64_t checkpoints_skipped = 0;  // announced but superseded before scoring
+  int64_t checkpoints_skipped = 0;  // superseded before scoring and dropped unscored
   int64_t checkpoints_refused = 0;  // files that failed to load or did not fit the env
   std::string video_file;           // a video in the report folder to show (empty: none)
   std::string video_caption;        // what the video shows
