@@ -1,5 +1,6 @@
 #include "evaluator/best_media.h"
 
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -14,8 +15,17 @@
 
 namespace rl::evaluator {
 
-BestMedia::BestMedia(BestMediaConfig config) : config_(std::move(config)) {
+BestMedia::BestMedia(BestMediaConfig config)
+    : config_(std::move(config)), best_mean_(config_.best_before) {
   has_frames_ = envs::LookupSpec(config_.env_id).frame_height > 0;
+  if (std::isfinite(config_.best_before) && !config_.report_dir.empty()) {
+    video_caption_ = ReadCaption(Path(kBestVideo));
+    if (has_frames_) frames_caption_ = ReadCaption(Path(kFrameGrid));
+  }
+}
+
+std::string BestMedia::Path(const char* file) const {
+  return (std::filesystem::path(config_.report_dir) / file).string();
 }
 
 void BestMedia::RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path,
@@ -31,9 +41,9 @@ void BestMedia::RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path
   }
   const auto seed = static_cast<unsigned long long>(config_.seed_base);
   try {
-    const VideoResult v = RecordGreedyVideo(
-        &net, config_.env_id, config_.seed_base, config_.video_width, config_.video_height,
-        config_.video_fps, (std::filesystem::path(config_.report_dir) / kBestVideo).string(), tick);
+    const VideoResult v =
+        RecordGreedyVideo(&net, config_.env_id, config_.seed_base, config_.video_width,
+                          config_.video_height, config_.video_fps, Path(kBestVideo), tick);
     best_mean_ = record.mean;
     char caption[256];
     std::snprintf(caption, sizeof(caption),
@@ -42,14 +52,15 @@ void BestMedia::RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path
                   seed, record.checkpoint.c_str(), static_cast<long long>(record.update),
                   rl::Score(record.mean).c_str(), rl::Score(v.episode_return).c_str(), v.frames);
     video_caption_ = caption;
+    WriteCaption(Path(kBestVideo), video_caption_);
   } catch (const std::exception& e) {
     LogError(std::string("no video: ") + e.what());
   }
   if (!has_frames_) return;
   try {
-    const FrameGridResult g = WriteFrameGrid(
-        &net, config_.env_id, config_.seed_base, kFrameGridEpisodes, kFrameGridColumns,
-        (std::filesystem::path(config_.report_dir) / kFrameGrid).string(), tick);
+    const FrameGridResult g =
+        WriteFrameGrid(&net, config_.env_id, config_.seed_base, kFrameGridEpisodes,
+                       kFrameGridColumns, Path(kFrameGrid), tick);
     char caption[384];
     std::snprintf(caption, sizeof(caption),
                   "%d greedy episodes (epsilon 0, seeds %llu to %llu) of %s (update %lld), one row "
@@ -58,6 +69,7 @@ void BestMedia::RecordIfBest(const nn::Checkpoint& ckpt, const std::string& path
                   g.episodes, seed, seed + static_cast<unsigned long long>(g.episodes) - 1,
                   record.checkpoint.c_str(), static_cast<long long>(record.update), g.mean_return);
     frames_caption_ = caption;
+    WriteCaption(Path(kFrameGrid), frames_caption_);
   } catch (const std::exception& e) {
     LogError(std::string("no frame grid: ") + e.what());
   }

@@ -21,12 +21,17 @@ struct BestMediaConfig {
   int video_height = 240;
   double video_fps = 30;
   std::string report_dir;  // where the files go
+  // The best standard-metric mean of the evaluator's earlier life in this run folder (its
+  // resumed history): only a checkpoint above it is a new best, and
+  // until then the report shows the media that life recorded.
+  double best_before = -std::numeric_limits<double>::infinity();
 };
 
 /// Records the media of every new best checkpoint. Not thread-safe.
 class BestMedia {
  public:
-  /// Throws std::invalid_argument for an unknown env id.
+  /// Throws std::invalid_argument for an unknown env id. With a best_before, the captions of the
+  /// media already in report_dir are read (ReadCaption).
   explicit BestMedia(BestMediaConfig config);
 
   /// When `record` is better than the best recorded so far, records the video of the checkpoint
@@ -40,9 +45,11 @@ class BestMedia {
   void AddTo(ReportInfo* info) const;
 
  private:
+  std::string Path(const char* file) const;  // of a file in report_dir
+
   BestMediaConfig config_;
   bool has_frames_ = false;  // a pixel env: a frame grid too
-  double best_mean_ = -std::numeric_limits<double>::infinity();
+  double best_mean_;
   std::string video_caption_;   // empty until a video was recorded
   std::string frames_caption_;  // empty until a frame grid was written
 };

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <limits>
+#include <set>
 #include <stdexcept>
 #include <system_error>
 
@@ -81,6 +83,13 @@ EvalHistory OpenHistory(const std::string& out_dir) {
   return EvalHistory((fs::path(out_dir) / "eval.jsonl").string());
 }
 
+// The best mean of the history an earlier life left (-infinity for none): the bar a new best
+// must pass for its second metric, media and t-SNE map.
+double BestBefore(const EvalHistory& history) {
+  const EvalRecord* best = history.best();
+  return best != nullptr ? best->mean : -std::numeric_limits<double>::infinity();
+}
+
 std::string ReportDir(const std::string& out_dir) {
   return out_dir.empty() ? "" : (fs::path(out_dir) / "report").string();
 }
@@ -145,11 +154,13 @@ EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* 
       report_(RunReportInfo(config_, bus->config().run_id)),
       history_(OpenHistory(config_.out_dir)),
       second_({config_.second_env, config_.second_episodes, config_.epsilon, config_.seed_base,
-               config_.gamma},
+               config_.gamma, BestBefore(history_)},
               log_),
       media_({config_.env_id, config_.seed_base, config_.video_width, config_.video_height,
-              config_.video_fps, report_dir_}),
-      tsne_({config_.env_id, config_.tsne, config_.seed_base, config_.gamma, report_dir_}, log_) {
+              config_.video_fps, report_dir_, BestBefore(history_)}),
+      tsne_({config_.env_id, config_.tsne, config_.seed_base, config_.gamma, report_dir_,
+             BestBefore(history_)},
+            log_) {
   if (!report_dir_.empty()) {
     // An earlier life killed while it wrote a report file or a video left its temporary file.
     RemoveStaleTemporaries(report_dir_);
@@ -165,6 +176,7 @@ EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* 
                                        [alive = alive_](const rlmsg::checkpoint_t& m) {
                                          if (*alive != nullptr) (*alive)->queue_.Offer(m);
                                        });
+  QueueUnscoredCheckpoints();
   WriteReportNow();
   next_stats_time_ = MonoSeconds();
 }
@@ -179,6 +191,39 @@ bool EvaluatorService::goal_reached() const {
 std::string EvaluatorService::CheckpointFolder() const {
   if (config_.out_dir.empty()) return {};
   return (fs::path(config_.out_dir) / "checkpoints").string();
+}
+
+void EvaluatorService::QueueUnscoredCheckpoints() {
+  const std::string folder = CheckpointFolder();
+  std::error_code ec;
+  if (folder.empty() || !fs::is_directory(folder, ec)) return;
+  std::set<std::string> scored;
+  for (const EvalRecord& r : history_.records()) scored.insert(r.checkpoint);
+  int queued = 0;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    // The learner's files end in .bin (a temporary one of a write cut short does not).
+    if (scored.count(name) > 0 || entry.path().extension() != ".bin") continue;
+    rlmsg::checkpoint_t unscored{};
+    try {
+      const nn::Checkpoint ckpt = ReadAnnouncedCheckpoint(entry.path().string(), folder);
+      if (ckpt.meta.run_id != static_cast<uint64_t>(bus_->config().run_id)) continue;
+      unscored.path = entry.path().string();
+      unscored.update = ckpt.meta.update;
+      unscored.env_steps = ckpt.meta.env_steps;
+      unscored.wall_seconds = ckpt.meta.wall_seconds;
+    } catch (const std::exception& e) {
+      LogError(std::string("not queued: ") + e.what());
+      continue;
+    }
+    if (queue_.Offer(unscored) != CheckpointQueue::Outcome::kDuplicate) ++queued;
+  }
+  if (queued > 0) {
+    log_(
+        "evaluator: %d unscored checkpoints found in %s (%lld of them beyond the backlog "
+        "skipped)\n",
+        queued, folder.c_str(), static_cast<long long>(queue_.skipped()));
+  }
 }
 
 bool EvaluatorService::Poll(int timeout_ms) {

@@ -96,10 +96,11 @@ struct EvaluatorConfig {
 class EvaluatorService {
  public:
   /// Subscribes to RL_CHECKPOINT on `bus` (not owned; must outlive the service). With an
-  /// out_dir, creates it, loads the history of an existing out_dir/eval.jsonl and writes the
-  /// report. Progress lines go to `progress` (not owned; nullptr: none). Throws
-  /// std::invalid_argument for a bad config or env and std::runtime_error when out_dir cannot
-  /// be created.
+  /// out_dir, creates it, loads the history of an existing out_dir/eval.jsonl, queues the
+  /// checkpoints of out_dir/checkpoints that it does not hold (an earlier life's last
+  /// announcements and backlog, lost with it) as if announced, and writes the report. Progress
+  /// lines go to `progress` (not owned; nullptr: none). Throws std::invalid_argument for a bad
+  /// config or env and std::runtime_error when out_dir cannot be created.
   EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* progress = stdout);
   EvaluatorService(const EvaluatorService&) = delete;
   EvaluatorService& operator=(const EvaluatorService&) = delete;
@@ -174,6 +175,9 @@ class EvaluatorService {
   // <out_dir>/checkpoints, the only folder announced checkpoints are read from (empty without
   // an out_dir: every announcement is refused).
   std::string CheckpointFolder() const;
+  // Offers every checkpoint file of this run in CheckpointFolder() that the history has not
+  // scored to the queue (the newest pending, the others in the backlog) and logs how many.
+  void QueueUnscoredCheckpoints();
   // Makes the due t-SNE map now (busy, with stats). Returns true when it was written.
   bool MakeTsneMap();
   // MakeTsneMap() when a map is due and the time share allows it; rewrites the report after it.

@@ -1,5 +1,7 @@
 #include "evaluator/report.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -358,6 +360,39 @@ std::string RestartsSection(const std::string& restarts_file) {
 }
 
 }  // namespace
+
+namespace {
+
+std::string CaptionPath(const std::string& media_path) { return media_path + ".caption"; }
+
+// Which version of a media file a caption is of: its size and modification time (ns); "" when
+// it is not a regular file.
+std::string MediaStamp(const std::string& media_path) {
+  struct stat st {};
+  if (::stat(media_path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return {};
+  const long long ns =
+      static_cast<long long>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec;
+  return std::to_string(st.st_size) + " " + std::to_string(ns);
+}
+
+}  // namespace
+
+void WriteCaption(const std::string& media_path, const std::string& caption) {
+  const std::string stamp = MediaStamp(media_path);
+  if (stamp.empty()) throw std::runtime_error("no media file " + media_path + " to caption");
+  WriteFileAtomically(CaptionPath(media_path), stamp + "\n" + caption, "caption");
+}
+
+std::string ReadCaption(const std::string& media_path) {
+  const std::string stamp = MediaStamp(media_path);
+  if (stamp.empty()) return {};
+  std::ifstream in(CaptionPath(media_path), std::ios::binary);
+  std::string first;
+  if (!std::getline(in, first) || first != stamp) return {};
+  std::ostringstream caption;
+  caption << in.rdbuf();
+  return caption.str();
+}
 
 void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
                  const ReportInfo& info) {

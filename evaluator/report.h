@@ -48,6 +48,15 @@ inline constexpr char kCurveWallTime[] = "curve_wall_time.svg";
 inline constexpr char kBestVideo[] = "best.webm";
 inline constexpr char kFrameGrid[] = "frames.png";
 inline constexpr char kTsneMap[] = "tsne.png";
+/// A media file's caption lives beside it (<media_path>.caption), so that an evaluator resumed in
+/// the same run folder still shows the media of its earlier life's best checkpoint.
+/// WriteCaption, called once the media file is written, writes it atomically with the file's
+/// size and modification time; ReadCaption returns it only while those still match, else ""
+/// (no media file, no caption, or a media file rewritten since: a crash between the two
+/// writes leaves a new file under no caption rather than under the old one).
+void WriteCaption(const std::string& media_path, const std::string& caption);
+std::string ReadCaption(const std::string& media_path);
+
 /// Greedy episodes (rows) and cells per row of the frame grid of a pixel env's report.
 inline constexpr int kFrameGridEpisodes = 4;
 inline constexpr int kFrameGridColumns = 8;

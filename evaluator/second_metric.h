@@ -20,13 +20,16 @@ struct SecondMetricConfig {
   double epsilon = 0;
   uint64_t seed_base = 0;  // episode i is reset with seed seed_base + i
   double gamma = 0;
+  // The best standard-metric mean of the evaluator's earlier life in this run folder (its
+  // resumed history): only a checkpoint above it is a new best.
+  double best_before = -std::numeric_limits<double>::infinity();
 };
 
 /// Scores new best checkpoints on the second env. Not thread-safe.
 class SecondMetric {
  public:
   SecondMetric(SecondMetricConfig config, ProgressLog log)
-      : config_(std::move(config)), log_(log) {}
+      : config_(std::move(config)), log_(log), best_mean_(config_.best_before) {}
 
   /// When `record` (scored on the standard metric) is a new best, scores the checkpoint `ckpt`
   /// (read from `path`) on the second env into record's second_* fields and prints a progress line;
@@ -41,7 +44,7 @@ class SecondMetric {
  private:
   SecondMetricConfig config_;
   ProgressLog log_;
-  double best_mean_ = -std::numeric_limits<double>::infinity();  // on the standard metric
+  double best_mean_;  // on the standard metric
 };
 
 }  // namespace rl::evaluator

@@ -1,5 +1,6 @@
 #include "evaluator/tsne_scheduler.h"
 
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <filesystem>
@@ -50,7 +51,18 @@ std::string Caption(const EvalRecord& record, const StateSamples& samples, const
 }  // namespace
 
 TsneScheduler::TsneScheduler(TsneScheduleConfig config, ProgressLog log)
-    : config_(std::move(config)), log_(log), start_time_(MonoSeconds()) {}
+    : config_(std::move(config)),
+      log_(log),
+      start_time_(MonoSeconds()),
+      best_mean_(config_.best_before) {
+  if (std::isfinite(config_.best_before) && !config_.report_dir.empty()) {
+    caption_ = ReadCaption(MapPath());
+  }
+}
+
+std::string TsneScheduler::MapPath() const {
+  return (std::filesystem::path(config_.report_dir) / kTsneMap).string();
+}
 
 void TsneScheduler::OfferBest(const nn::Checkpoint& ckpt, const std::string& path,
                               const EvalRecord& record) {
@@ -94,15 +106,14 @@ bool TsneScheduler::Make(const Tick& tick) {
         });
     const double collected = MonoSeconds();
     const TsneConfig tsne;
-    const TsneMapResult map = WriteTsneMap(
-        samples, tsne, (std::filesystem::path(config_.report_dir) / kTsneMap).string(),
-        [&](const TsneProgress& p) {
-          char line[96];
-          std::snprintf(line, sizeof(line), "t-SNE iteration %d of %d, KL divergence %.3f",
-                        p.iteration, p.iterations, p.kl_divergence);
-          progress(line);
-        });
+    const TsneMapResult map = WriteTsneMap(samples, tsne, MapPath(), [&](const TsneProgress& p) {
+      char line[96];
+      std::snprintf(line, sizeof(line), "t-SNE iteration %d of %d, KL divergence %.3f", p.iteration,
+                    p.iterations, p.kl_divergence);
+      progress(line);
+    });
     caption_ = Caption(record, samples, map, tsne.iterations, config_.seed_base, config_.gamma);
+    WriteCaption(MapPath(), caption_);
     log_(
         "evaluator: t-SNE map of %s (update %lld): %d states of %d greedy episodes (%d "
         "distinct), %d features, KL divergence %.2f (%.1f s: %.1f s playing, %.1f s "

@@ -32,6 +32,10 @@ struct TsneScheduleConfig {
   uint64_t seed_base = 0;  // greedy episode e is reset with seed seed_base + e
   double gamma = 0;        // discount of the returns that colour a TD3 actor's states
   std::string report_dir;  // where the map goes; empty: no maps
+  // The best standard-metric mean of the evaluator's earlier life in this run folder (its
+  // resumed history): only a checkpoint above it is a new best, and
+  // until then the report shows the map that life made.
+  double best_before = -std::numeric_limits<double>::infinity();
 };
 
 /// Keeps the map of the newest best checkpoint due until the time share allows it. Times are
@@ -65,13 +69,14 @@ class TsneScheduler {
 
  private:
   double ExpectedSeconds() const;
+  std::string MapPath() const;  // report/tsne.png
 
   TsneScheduleConfig config_;
   ProgressLog log_;
   double start_time_;                  // when the scheduler was made
   std::optional<nn::Sequential> net_;  // the network of the due map
   EvalRecord record_;                  // and its checkpoint's record
-  double best_mean_ = -std::numeric_limits<double>::infinity();
+  double best_mean_;
   double seconds_ = 0;       // spent on maps, aborted ones included
   double last_seconds_ = 0;  // the last map written took this long (0: none yet)
   std::string caption_;      // empty until a map was written

@@ -466,8 +466,10 @@ TEST_F(EvaluatorServiceTest, SkipsSupersededCheckpointsWithoutABacklogOrWhoseFil
     }));
   }
   // With a backlog: a superseded checkpoint the learner deleted before its turn is skipped
-  // quietly, not refused.
+  // quietly, not refused. (A new service would queue the files the first one skipped: gone.)
   results_.clear();
+  ASSERT_TRUE(std::filesystem::remove(checkpoints_ + "/ckpt_10.bin"));
+  ASSERT_TRUE(std::filesystem::remove(checkpoints_ + "/ckpt_20.bin"));
   EvaluatorService service(Config(), &bus_, nullptr);
   const std::string d = WriteCheckpoint(40);
   Announce(d, 40);
@@ -482,6 +484,35 @@ TEST_F(EvaluatorServiceTest, SkipsSupersededCheckpointsWithoutABacklogOrWhoseFil
   EXPECT_EQ(service.checkpoints_skipped(), 1);
   EXPECT_EQ(service.checkpoints_refused(), 0);
   EXPECT_EQ(service.backlog(), 0);
+}
+
+TEST_F(EvaluatorServiceTest, QueuesTheCheckpointsAnEarlierLifeLeftUnscored) {
+  {
+    EvaluatorService first(Config(), &bus_, nullptr);
+    ASSERT_TRUE(AnnounceUntilResults(&first, WriteCheckpoint(10), 10, 1));
+  }
+  // Written after the first life ended (or announced to it and lost with its queue), beside
+  // files that are not this run's checkpoints.
+  WriteCheckpoint(20);
+  WriteCheckpoint(30);
+  nn::Checkpoint foreign = AlwaysLeftCheckpoint(40);
+  foreign.meta.run_id = 78;
+  Save(foreign);
+  { std::ofstream(checkpoints_ + "/ckpt_50.bin") << "not a checkpoint"; }
+  { std::ofstream(checkpoints_ + "/ckpt_60.bin.tmp.123") << "a write cut short"; }
+  Bus bus2(MemqConfig());
+  std::FILE* log = std::tmpfile();
+  ASSERT_NE(log, nullptr);
+  EvaluatorService second(Config(), &bus2, log);
+  EXPECT_TRUE(second.has_pending());
+  EXPECT_EQ(second.backlog(), 1);
+  ASSERT_TRUE(PollUntil(&second, [&] { return second.checkpoints_scored() == 2; }));
+  ASSERT_EQ(second.records().size(), 3U);
+  EXPECT_EQ(second.records()[1].update, 30);  // the newest first
+  ExpectMetadataOfUpdate(second.records()[1], 30);
+  EXPECT_EQ(second.records()[2].update, 20);
+  EXPECT_EQ(second.checkpoints_refused(), 0);
+  EXPECT_TRUE(Contains(ReadAndClose(log), "evaluator: 2 unscored checkpoints found in "));
 }
 
 TEST_F(EvaluatorServiceTest, StopsAtTheGoalWhenAsked) {
@@ -527,6 +558,78 @@ TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsTheHistoryAndIgnoresRepeats) 
   EXPECT_EQ(second.checkpoints_scored(), 0);
   const std::string html = ReportHtml(second);
   EXPECT_EQ(CountOccurrences(html, "<td>ckpt_40.bin</td>"), 1);
+}
+
+TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsItsBestsMediaAndScoresNoWorseOneAsABest) {
+  EvaluatorConfig c = WithVideos(Config(), 96, 64);
+  c.second_env = "CartPole-v1";
+  c.second_episodes = 3;
+  {
+    EvaluatorService first(c, &bus_, nullptr);
+    ASSERT_TRUE(AnnounceUntilResults(&first, Save(BalancingCheckpoint(100)), 100, 1));
+  }
+  Bus bus2(MemqConfig());
+  EvaluatorService second(c, &bus2, nullptr);
+  // Before it scores anything, its report shows the video of the first life's best.
+  EXPECT_TRUE(Contains(ReportHtml(second), "<video src=\"best.webm\""));
+  EXPECT_TRUE(Contains(ReportHtml(second), "ckpt_100.bin (update 100"));
+  // A worse checkpoint is no new best: no second metric, and the video stays that of update 100.
+  rlmsg::checkpoint_t m{};
+  m.path = WriteCheckpoint(200);
+  m.update = 200;
+  ASSERT_TRUE(bus2.Publish(channels::kCheckpoint, &m));
+  ASSERT_TRUE(PollUntil(&second, [&] { return second.checkpoints_scored() == 1; }));
+  const std::vector<std::string> lines = JsonLines(second);
+  ASSERT_EQ(lines.size(), 2U);
+  EXPECT_NE(lines[0].find("second_mean"), std::string::npos);
+  EXPECT_EQ(lines[1].find("second_mean"), std::string::npos);
+  const std::string html = ReportHtml(second);
+  EXPECT_TRUE(Contains(html, "ckpt_100.bin (update 100"));
+  EXPECT_EQ(html.find("ckpt_200.bin (update 200"), std::string::npos);
+}
+
+TEST_F(EvaluatorServiceTest, ARestartedServiceShowsItsBestsFrameGridAndTsneMap) {
+  EvaluatorConfig c = WithVideos(CatchConfig(), 64, 64);
+  c.tsne = 100;
+  c.goal = -10;  // reached: the map is made before the result
+  {
+    EvaluatorService first(c, &bus_, nullptr);
+    ASSERT_TRUE(AnnounceUntilResults(&first, Save(CatchCheckpoint(50)), 50, 1));
+    ASSERT_TRUE(HasReportFile(first, "tsne.png", 1000));
+  }
+  Bus bus2(MemqConfig());
+  EvaluatorService second(c, &bus2, nullptr);
+  std::string html = ReportHtml(second);
+  EXPECT_TRUE(Contains(html, "<img src=\"frames.png\""));
+  EXPECT_TRUE(Contains(html, "<img src=\"tsne.png\""));
+  EXPECT_TRUE(Contains(html, "ckpt_50.bin (update 50"));
+  // The same policy scores the same: no new best, no new map.
+  rlmsg::checkpoint_t m{};
+  m.path = Save(CatchCheckpoint(60));
+  m.update = 60;
+  ASSERT_TRUE(bus2.Publish(channels::kCheckpoint, &m));
+  ASSERT_TRUE(PollUntil(&second, [&] { return second.checkpoints_scored() == 1; }));
+  EXPECT_FALSE(second.tsne_map_due());
+  EXPECT_EQ(second.tsne_seconds(), 0.0);
+  html = ReportHtml(second);
+  EXPECT_TRUE(Contains(html, "<img src=\"tsne.png\""));
+  EXPECT_EQ(html.find("ckpt_60.bin (update 60"), std::string::npos);
+}
+
+TEST(CaptionTest, IsThatOfTheMediaFileAsItWasWhenCaptioned) {
+  TempDir dir;
+  const std::string media = dir / "best.webm";
+  EXPECT_THROW(WriteCaption(media, "a caption"), std::runtime_error);  // no media file
+  EXPECT_EQ(ReadCaption(media), "");
+  { std::ofstream(media) << "video"; }
+  EXPECT_EQ(ReadCaption(media), "");  // no caption
+  WriteCaption(media, "a caption\nof two lines");
+  EXPECT_EQ(ReadCaption(media), "a caption\nof two lines");
+  // The media file rewritten (an evaluator killed before it wrote the new caption): not shown.
+  { std::ofstream(media) << "another video"; }
+  EXPECT_EQ(ReadCaption(media), "");
+  std::filesystem::remove(media);
+  EXPECT_EQ(ReadCaption(media), "");
 }
 
 TEST_F(EvaluatorServiceTest, ProgressLinesGoToTheGivenStream) {

@@ -229,10 +229,16 @@ last_scored_update() {  # last_scored_update RUN_DIR
 # Whether the numeric FIELD of every line of an eval.jsonl after its first N lines is at least
 # the highest of those N: a resumed run carries on from where it stopped. (Within one part the
 # lines are in scoring order, not always in update order: the evaluator scores superseded
-# checkpoints later.)
-carries_on() {  # carries_on EVAL_JSONL N FIELD
-  awk -v n="$2" -F"\"$3\": " '{ split($2, a, ","); v = a[1] + 0 }
-    NR <= n { if (NR == 1 || v > top) top = v; next }
+# checkpoints later.) ON_DISK, a file of the checkpoint names in the run's folder at the
+# resumption: those of them not scored in the first N lines are the earlier part's, which the
+# resumed evaluator scores after the resumption, and their lines are not checked.
+carries_on() {  # carries_on EVAL_JSONL N FIELD [ON_DISK]
+  awk -v n="$2" -v on_disk="${4:-}" -F"\"$3\": " '
+    BEGIN { if (on_disk != "") while ((getline name < on_disk) > 0) earlier[name] = 1 }
+    { split($2, a, ","); v = a[1] + 0
+      name = ""; if (match($0, /"checkpoint": "[^"]*"/)) name = substr($0, RSTART + 15, RLENGTH - 16) }
+    NR <= n { delete earlier[name]; if (NR == 1 || v > top) top = v; next }
+    name in earlier { next }
     v < top { print "'"$3"' " v " after " top " before the resumption"; bad = 1; exit }
     END { exit bad }' "$1"
 }

@@ -19,6 +19,7 @@ wait_launch "$dir/first.log"
 [ "$status" -eq 130 ] || fail "the stopped launch exited with $status, not 130"
 run_id=$(run_setting "$dir/run" run-id)
 evals_before=$(wc -l < "$dir/run/eval.jsonl")
+ls "$dir/run/checkpoints" > "$dir/on_disk"
 last_update_before=$(sed -n 's/.*"update": \([0-9]*\).*/\1/p' "$dir/run/eval.jsonl" | tail -1)
 # Second part: resumed, with the preset's goal.
 resume_to_goal "$dir/run" "$dir/second.log"
@@ -35,8 +36,8 @@ grep -q "^replay: last snapshot written to $dir/run/replay-snapshot.bin (size [1
   fail "the stopped replay wrote no last snapshot"
 grep -q "^replay: snapshot $dir/run/replay-snapshot.bin loaded (size [1-9]" "$dir/run/logs/replay.log" ||
   fail "the resumed replay did not load its snapshot"
-carries_on "$dir/run/eval.jsonl" "$evals_before" update || fail "evaluation updates went back"
-carries_on "$dir/run/eval.jsonl" "$evals_before" env_steps || fail "evaluation env steps went back"
+carries_on "$dir/run/eval.jsonl" "$evals_before" update "$dir/on_disk" || fail "evaluation updates went back"
+carries_on "$dir/run/eval.jsonl" "$evals_before" env_steps "$dir/on_disk" || fail "evaluation env steps went back"
 # The metrics' time carries on too: the resumed monitor's rows follow the first part's.
 grep -q '"t": ' "$dir/run/metrics.jsonl" || fail "no metrics rows"
 awk -F'"t": ' '{split($2, a, ","); t = a[1] + 0; if (t < prev) { print "metrics t " t " after " prev; exit 1 } prev = t}' \

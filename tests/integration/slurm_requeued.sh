@@ -28,6 +28,7 @@ fi
 wait_line "$out" "^slurm.sbatch: job $job (restart 1)" 90
 wait_line "$out" "^launch: run .* on Slurm job $job: .*, resumed$" 30
 evals_before=$(grep -c '"update"' "$run/eval.jsonl")
+ls "$run/checkpoints" > "$dir/on_disk"
 last_update_before=$(sed -n 's/.*"update": \([0-9]*\).*/\1/p' "$run/eval.jsonl" | head -n "$evals_before" | tail -1)
 best_before=$(best_mean "$run/eval.jsonl")
 slurm_wait_steps
@@ -50,7 +51,7 @@ size=$(sed -n "s|^replay: snapshot $run/replay-snapshot.bin loaded (size \([0-9]
 # The evaluations carry on: the earlier ones kept, the best of them still the floor.
 head -n "$evals_before" "$run/eval.jsonl" | tail -1 | grep -q "\"update\": $last_update_before," ||
   fail "the earlier evaluations were not kept"
-carries_on "$run/eval.jsonl" "$evals_before" update || fail "evaluation updates went back"
+carries_on "$run/eval.jsonl" "$evals_before" update "$dir/on_disk" || fail "evaluation updates went back"
 best=$(best_mean "$run/eval.jsonl")
 awk -v a="$best" -v b="$best_before" 'BEGIN { exit !(a >= b) }' || fail "the best score went from $best_before to $best"
 grep -q '<img' "$run/report/index.html" || fail "the report has no learning curve"
