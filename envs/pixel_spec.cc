@@ -52,6 +52,7 @@ EnvIdParts ParseEnvId(const std::string& id) {
       {"render-height", &c.render_height},
       {"noop-start", &c.noop_start},
       {"time-limit", &c.time_limit},
+      {"off-track-grace", &parts.off_track_grace},
   };
   std::stringstream list(id.substr(open, close - open));
   std::string item;
@@ -75,14 +76,18 @@ EnvIdParts ParseEnvId(const std::string& id) {
       throw std::invalid_argument(
           "env '" + id + "': unknown pixels key '" + key +
           "' (known: width, height, stack, skip, max-pool, crop-top, crop-bottom, crop-left, "
-          "crop-right, render-width, render-height, noop-start, off-track, time-limit, "
-          "lap-ends)");
+          "crop-right, render-width, render-height, noop-start, off-track, off-track-grace, "
+          "time-limit, lap-ends)");
     }
   }
   try {
     c.Validate();
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument("env '" + id + "': " + e.what());
+  }
+  if (parts.off_track_grace < 0 || (parts.off_track_grace > 0 && !parts.off_track)) {
+    throw std::invalid_argument("env '" + id +
+                                "': off-track-grace is a count of frames >= 0, with off-track=1");
   }
   if ((parts.off_track || !parts.lap_ends) && !parts.base.starts_with("CarRacing")) {
     throw std::invalid_argument("env '" + id +

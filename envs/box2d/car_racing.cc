@@ -178,6 +178,10 @@ void CarRacingConfig::Validate() const {
     throw std::invalid_argument("CarRacingConfig: off_track_after must be >= 0, got " +
                                 std::to_string(off_track_after));
   }
+  if (off_track_grace < 0) {
+    throw std::invalid_argument("CarRacingConfig: off_track_grace must be >= 0, got " +
+                                std::to_string(off_track_grace));
+  }
 }
 
 double CarRacingCar::speed() const { return std::hypot(velocity.x, velocity.y); }
@@ -297,6 +301,7 @@ void CarRacing::NewEpisode() {
   prev_reward_ = 0;
   t_ = 0;
   lap_finished_ = false;
+  off_track_frames_ = 0;
   // The reference's reset ends with step(None): physics without an action or reward rules.
   Advance();
 }
@@ -392,9 +397,12 @@ StepResult CarRacing::OnStep(std::span<const float> action) {
   }
   Advance();
   StepResult result = Finish();
-  if (config_.off_track && elapsed_steps() > config_.off_track_after && OffTrack()) {
-    result.reward = -10.0;
-    result.terminated = true;
+  if (config_.off_track && elapsed_steps() > config_.off_track_after) {
+    off_track_frames_ = OffTrack() ? off_track_frames_ + 1 : 0;
+    if (off_track_frames_ > config_.off_track_grace) {
+      result.reward = -10.0;
+      result.terminated = true;
+    }
   }
   return result;
 }
@@ -570,7 +578,8 @@ std::unique_ptr<Env> MakeCarRacing(const EnvIdParts& id, bool continuous) {
   return std::make_unique<CarRacing>(CarRacingConfig{.continuous = continuous,
                                                      .lap_ends = id.lap_ends,
                                                      .off_track = id.off_track,
-                                                     .off_track_after = id.image.noop_start});
+                                                     .off_track_after = id.image.noop_start,
+                                                     .off_track_grace = id.off_track_grace});
 }
 
 }  // namespace

@@ -41,12 +41,16 @@ struct CarRacingConfig {
   // 45 no-op frames of zoom-in (MakeEnv sets off_track_after to the id's noop-start).
   bool off_track = false;
   int off_track_after = 0;
+  // Frames in a row the car may be off the track before the rule ends the episode (0: the
+  // article's rule, at the first). Within them the step's reward is the usual one, so a policy
+  // can learn to steer back onto the track, which the article's rule never shows it.
+  int off_track_grace = 0;
   // Point samples per pixel side of the 96 x 96 observation (4: 16 samples per pixel, see
   // car_racing_render.h). Larger renders use fewer, never more than one per surface pixel.
   int supersample = 4;
 
   /// Throws std::invalid_argument unless lap_complete_percent is in [0, 1], supersample in
-  /// [1, 8] and off_track_after >= 0.
+  /// [1, 8], and off_track_after and off_track_grace >= 0.
   void Validate() const;
 };
 
@@ -183,6 +187,7 @@ class CarRacing : public SeededEnv {
   double prev_reward_ = 0;
   double t_ = 0;
   bool lap_finished_ = false;
+  int off_track_frames_ = 0;     // frames in a row the off-track rule's test held
   std::vector<int> road_index_;  // Where tile i is in scene_.road.
   mutable CarRacingScene scene_;
   mutable bool scene_stale_ = true;

@@ -80,6 +80,10 @@ TEST(PixelSpecTest, RefusesBadSpecsWithTheReason) {
             std::string::npos);
   EXPECT_NE(message("CarRacing-v3+pixels(lap-ends=2)").find("lap-ends is 0 or 1"),
             std::string::npos);
+  EXPECT_NE(message("CarRacing-v3+pixels(off-track-grace=20)").find("with off-track=1"),
+            std::string::npos);
+  EXPECT_NE(message("CarRacing-v3+pixels(off-track=1,off-track-grace=-1)").find("frames >= 0"),
+            std::string::npos);
 }
 
 // time-limit replaces the env's own limit, in inner steps: Catch's 9 steps cut at 3 (with an

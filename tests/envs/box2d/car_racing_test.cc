@@ -227,22 +227,27 @@ bool ShowsGrassBesideTheCar(const CarRacing& env) {
 }
 
 // The off-track rule, against a twin without it on the same seed and actions: each step pays the
-// twin's reward until the first step past off_track_after whose picture shows grass on both sides
-// of the car, which pays -10 and ends the episode.
-void CheckOffTrackRule(int after) {
-  CarRacing env(CarRacingConfig{.off_track = true, .off_track_after = after});
+// twin's reward until the step past off_track_after whose picture shows grass on both sides of
+// the car for the (grace + 1)-th frame in a row, which pays -10 and ends the episode.
+void CheckOffTrackRule(int after, int grace = 0) {
+  CarRacing env(
+      CarRacingConfig{.off_track = true, .off_track_after = after, .off_track_grace = grace});
   CarRacing twin;
   env.Reset(4);
   twin.Reset(4);
   const std::array<float, 3> swerve = {1.0f, 0.5f, 0.0f};  // Full right: off the road soon.
   bool ended = false;
   bool skipped_grass = false;
+  int in_a_row = 0;
+  int most_in_a_row = 0;
   for (int t = 1; t <= 400 && !ended; ++t) {
     const StepResult r = env.Step(swerve);
     const StepResult plain = twin.Step(swerve);
     const bool grass = ShowsGrassBesideTheCar(twin);
     if (grass && t <= after) skipped_grass = true;
-    if (grass && t > after) {
+    in_a_row = grass && t > after ? in_a_row + 1 : 0;
+    most_in_a_row = std::max(most_in_a_row, in_a_row);
+    if (in_a_row > grace) {
       EXPECT_EQ(r.reward, -10.0) << "step " << t;
       EXPECT_TRUE(r.terminated) << "step " << t;
       ended = true;
@@ -252,6 +257,7 @@ void CheckOffTrackRule(int after) {
     }
   }
   EXPECT_TRUE(ended) << "the car never left the road";
+  EXPECT_EQ(most_in_a_row, grace + 1);
   if (after > 0) {
     EXPECT_TRUE(skipped_grass) << "nothing for off_track_after to skip";
   }
@@ -262,6 +268,12 @@ TEST(CarRacingTest, OffTrackRuleEndsTheEpisodeOnTheFirstFrameOnGrass) { CheckOff
 TEST(CarRacingTest, OffTrackRuleSkipsTheFirstFramesOfAnEpisode) {
   // During the zoom-in the picture shows grass beside the car: the article's 45 no-op frames.
   CheckOffTrackRule(45);
+}
+
+TEST(CarRacingTest, OffTrackRuleWithAGraceEndsTheEpisodeAfterThatManyFramesOnGrassInARow) {
+  CheckOffTrackRule(45, 30);
+  CarRacingConfig bad{.off_track = true, .off_track_grace = -1};
+  EXPECT_THROW(bad.Validate(), std::invalid_argument);
 }
 
 // The pixels keys off-track and lap-ends reach CarRacing's own options; the rule skips the
@@ -287,7 +299,9 @@ TEST(CarRacingTest, EnvIdKeysSetTheRulesOfTheEnvUnderThePipeline) {
   EXPECT_TRUE(car->config().off_track);
   EXPECT_EQ(car->config().off_track_after, 45);
   EXPECT_FALSE(car->config().lap_ends);
+  EXPECT_EQ(car->config().off_track_grace, 0);
   EXPECT_FALSE(ParseEnvId("CarRacing-v3+pixels(skip=5)").off_track);
+  EXPECT_EQ(ParseEnvId("CarRacing-v3+pixels(off-track=1,off-track-grace=50)").off_track_grace, 50);
 }
 
 TEST(CarRacingTest, ScriptedPilotCompletesLapsWithAHighScore) {
