@@ -219,10 +219,12 @@ void EvaluatorService::QueueUnscoredCheckpoints() {
     if (queue_.Offer(unscored) != CheckpointQueue::Outcome::kDuplicate) ++queued;
   }
   if (queued > 0) {
-    log_(
-        "evaluator: %d unscored checkpoints found in %s (%lld of them beyond the backlog "
-        "skipped)\n",
-        queued, folder.c_str(), static_cast<long long>(queue_.skipped()));
+    std::string over;
+    if (queue_.skipped() > 0) {
+      over = ", " + std::to_string(queue_.skipped()) + " of them beyond the backlog skipped";
+    }
+    log_("evaluator: %d unscored checkpoints found in %s%s\n", queued, folder.c_str(),
+         over.c_str());
   }
 }
 

@@ -359,10 +359,6 @@ std::string RestartsSection(const std::string& restarts_file) {
          rows + "</tbody>\n</table></div>\n</section>\n";
 }
 
-}  // namespace
-
-namespace {
-
 std::string CaptionPath(const std::string& media_path) { return media_path + ".caption"; }
 
 // Which version of a media file a caption is of: its size and modification time (ns); "" when

@@ -494,6 +494,7 @@ TEST_F(EvaluatorServiceTest, QueuesTheCheckpointsAnEarlierLifeLeftUnscored) {
   // Written after the first life ended (or announced to it and lost with its queue), beside
   // files that are not this run's checkpoints.
   WriteCheckpoint(20);
+  WriteCheckpoint(25);
   WriteCheckpoint(30);
   nn::Checkpoint foreign = AlwaysLeftCheckpoint(40);
   foreign.meta.run_id = 78;
@@ -503,16 +504,21 @@ TEST_F(EvaluatorServiceTest, QueuesTheCheckpointsAnEarlierLifeLeftUnscored) {
   Bus bus2(MemqConfig());
   std::FILE* log = std::tmpfile();
   ASSERT_NE(log, nullptr);
-  EvaluatorService second(Config(), &bus2, log);
+  EvaluatorConfig c = Config();
+  c.backlog = 1;
+  EvaluatorService second(c, &bus2, log);
   EXPECT_TRUE(second.has_pending());
   EXPECT_EQ(second.backlog(), 1);
+  EXPECT_EQ(second.checkpoints_skipped(), 1);  // the oldest, 20, beyond the backlog
   ASSERT_TRUE(PollUntil(&second, [&] { return second.checkpoints_scored() == 2; }));
   ASSERT_EQ(second.records().size(), 3U);
   EXPECT_EQ(second.records()[1].update, 30);  // the newest first
   ExpectMetadataOfUpdate(second.records()[1], 30);
-  EXPECT_EQ(second.records()[2].update, 20);
+  EXPECT_EQ(second.records()[2].update, 25);
   EXPECT_EQ(second.checkpoints_refused(), 0);
-  EXPECT_TRUE(Contains(ReadAndClose(log), "evaluator: 2 unscored checkpoints found in "));
+  EXPECT_TRUE(Contains(ReadAndClose(log), "evaluator: 3 unscored checkpoints found in " +
+                                              checkpoints_ +
+                                              ", 1 of them beyond the backlog skipped\n"));
 }
 
 TEST_F(EvaluatorServiceTest, StopsAtTheGoalWhenAsked) {
