@@ -53,6 +53,10 @@ class Algorithm {
   virtual int64_t updates() const = 0;
   /// A short description for the learner's ready line.
   virtual std::string Describe() const = 0;
+  /// Sets every optimizer's step size to `scale` (>= 0) times its configured one, from the next
+  /// Update on (the learner's learning-rate decay). Not part of the state: the learner sets it
+  /// again before each update.
+  virtual void SetLearningRateScale(float scale) = 0;
 
   /// Adds to `state` everything needed to continue exactly where this algorithm is: networks and
   /// their targets (with their architecture strings), optimizer states, counters and random

@@ -129,6 +129,10 @@ std::string Dqn::Describe() const {
   return std::string(config_.double_dqn ? "Double DQN" : "DQN") + ", " + online_.Architecture();
 }
 
+void Dqn::SetLearningRateScale(float scale) {
+  optimizer_->set_learning_rate(config_.learning_rate * scale);
+}
+
 UpdateResult Dqn::Update(const Batch& b) {
   if (b.obs == nullptr || b.next_obs == nullptr || b.obs->rows() != obs_size_ ||
       b.next_obs->rows() != obs_size_ || b.obs->cols() != b.count ||

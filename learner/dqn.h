@@ -73,6 +73,7 @@ class Dqn final : public Algorithm {
   nn::Sequential& policy() override { return online_; }
   int64_t updates() const override { return updates_; }
   std::string Describe() const override;
+  void SetLearningRateScale(float scale) override;
   /// Sections "dqn.online", "dqn.target", "dqn.optimizer", "dqn.updates".
   void SaveState(StateFile* state) const override;
   void LoadState(const StateFile& state) override;

@@ -77,9 +77,22 @@ void LearnerConfig::Validate() const {
   if (checkpoint_every < 1) throw std::invalid_argument("checkpoint-every must be >= 1");
   if (keep_checkpoints < 0) throw std::invalid_argument("keep-checkpoints must be >= 0");
   if (policy_average < 0) throw std::invalid_argument("policy-average must be >= 0");
+  if (learning_rate_decay_updates < 0) {
+    throw std::invalid_argument("learning-rate-decay-updates must be >= 0");
+  }
+  if (!(learning_rate_end >= 0 && learning_rate_end <= 1)) {
+    throw std::invalid_argument("learning-rate-end must be in [0, 1]");
+  }
   if (!(stats_hz > 0)) throw std::invalid_argument("stats-hz must be > 0");
   if (threads < 1 || threads > 64) throw std::invalid_argument("threads must be in [1, 64]");
   nn::ParsePrecision(precision);
+}
+
+float LearningRateScale(int64_t updates, int64_t decay_updates, double end) {
+  if (decay_updates <= 0) return 1.0f;
+  const double done =
+      static_cast<double>(std::min(updates, decay_updates)) / static_cast<double>(decay_updates);
+  return static_cast<float>(1.0 - (1.0 - end) * done);
 }
 
 Learner::Learner(LearnerConfig config, Bus* bus)
@@ -167,6 +180,10 @@ void Learner::TrainOn(const rlmsg::sample_batch_t& m) {
   const char* why = decoder_.Decode(m, &batch);
   UpdateResult r;
   if (why == nullptr) {
+    if (config_.learning_rate_decay_updates > 0) {
+      algorithm_->SetLearningRateScale(LearningRateScale(
+          algorithm_->updates(), config_.learning_rate_decay_updates, config_.learning_rate_end));
+    }
     try {
       r = algorithm_->Update(batch);
     } catch (const std::invalid_argument& e) {
@@ -248,6 +265,13 @@ std::string Learner::Checkpoint() {
   ckpt.meta.wall_seconds = MonoSeconds() - start_time_;
   ckpt.meta.run_id = static_cast<uint64_t>(bus_->config().run_id);
   ckpt.meta.note = "env = " + config_.env_id + "\nprecision = " + config_.precision;
+  if (config_.learning_rate_decay_updates > 0) {
+    char scale[32];
+    std::snprintf(scale, sizeof scale, "%.4g",
+                  LearningRateScale(algorithm_->updates(), config_.learning_rate_decay_updates,
+                                    config_.learning_rate_end));
+    ckpt.meta.note += std::string("\nlearning rates = ") + scale + " of their start";
+  }
   if (!average_ || average_->values().empty()) {
     algorithm_->policy().GetFlat(&ckpt.params);
   } else {

@@ -49,6 +49,11 @@ struct LearnerConfig {
   // parameters over about this many updates instead of its current ones; the actors still get
   // the current ones. 0: no average.
   int policy_average = 0;
+  // The algorithm's learning rates fall linearly from their configured values at update 0 to
+  // learning_rate_end times those at this update, and stay there (0: constant). Follows the
+  // update count, so a resumed learner continues the schedule.
+  int64_t learning_rate_decay_updates = 0;
+  double learning_rate_end = 0.1;
   int threads = 1;  // compute threads of the network library (nn::SetNumThreads)
   // The networks' matrix products, "fp32" or "bf16" (nn/precision.h); kept in the learner state.
   std::string precision = "fp32";
@@ -70,6 +75,10 @@ struct LearnerConfig {
     return std::get<Config>(algorithms);
   }
 };
+
+/// The learning rates' scale for the update after `updates` updates under that decay: 1 at 0,
+/// `end` from `decay_updates` on, linear between; 1 throughout when decay_updates is 0.
+float LearningRateScale(int64_t updates, int64_t decay_updates, double end);
 
 class Learner {
  public:

@@ -90,6 +90,12 @@ int Main(int argc, char** argv) {
        "checkpoints, and so the evaluator's scores, hold an exponential moving average of the "
        "policy's parameters over about this many updates (the actors still explore with the "
        "current ones); 0: the current parameters")  //
+      ("learning-rate-decay-updates",
+       rl::po::value(&c.learning_rate_decay_updates)->default_value(c.learning_rate_decay_updates),
+       "the learning rates fall linearly over this many updates to learning-rate-end times "
+       "their start, then stay there; a resumed learner continues the schedule (0: constant)")  //
+      ("learning-rate-end", rl::po::value(&c.learning_rate_end)->default_value(c.learning_rate_end),
+       "the fraction of the learning rates left at the end of that decay, in [0, 1]")  //
       ("precision", rl::po::value(&c.precision)->default_value(c.precision),
        "the networks' matrix products: fp32, or bf16 (inputs rounded to bfloat16, sums in fp32; "
        "weights, optimizer, activations and losses stay fp32). bf16 is fast on CPUs with "
@@ -166,8 +172,15 @@ int Main(int argc, char** argv) {
       c.policy_average > 0
           ? ", checkpoints average the policy over " + std::to_string(c.policy_average) + " updates"
           : "";
-  std::printf("learner: ready (%s)%s, %s%s%s\n", learner.algorithm().Describe().c_str(),
-              shifts.c_str(), kernels.c_str(), average.c_str(), resumed.c_str());
+  std::string decay;
+  if (c.learning_rate_decay_updates > 0) {
+    char text[160];
+    std::snprintf(text, sizeof text, ", learning rates falling to %g of their start by update %lld",
+                  c.learning_rate_end, static_cast<long long>(c.learning_rate_decay_updates));
+    decay = text;
+  }
+  std::printf("learner: ready (%s)%s, %s%s%s%s\n", learner.algorithm().Describe().c_str(),
+              shifts.c_str(), kernels.c_str(), average.c_str(), decay.c_str(), resumed.c_str());
   std::fflush(stdout);
   learner.Run();
   std::printf("learner: stopped after %lld updates\n", static_cast<long long>(learner.updates()));

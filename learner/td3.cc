@@ -215,6 +215,11 @@ void Td3::TargetActions(const nn::Matrix& next_obs) {
   }
 }
 
+void Td3::SetLearningRateScale(float scale) {
+  actor_optimizer_->set_learning_rate(config_.actor_learning_rate * scale);
+  critic_optimizer_->set_learning_rate(config_.critic_learning_rate * scale);
+}
+
 UpdateResult Td3::Update(const Batch& b) {
   const int n = b.count;
   if (n < 1) throw std::invalid_argument("empty batch");

@@ -87,6 +87,7 @@ class Td3 final : public Algorithm {
   nn::Sequential& policy() override;
   int64_t updates() const override { return updates_; }
   std::string Describe() const override;
+  void SetLearningRateScale(float scale) override;
   /// Sections "td3.*": the actor, both critics and their targets (and the shared encoder), both
   /// optimizers, the update counters and the target-noise generator.
   void SaveState(StateFile* state) const override;

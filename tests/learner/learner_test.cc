@@ -1,6 +1,7 @@
 #include "learner/learner.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -301,6 +302,24 @@ TEST(LearnerConfigTest, RefusesBadSettings) {
   c = LearnerConfig{};
   c.policy_average = -1;
   EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = LearnerConfig{};
+  c.learning_rate_decay_updates = -1;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  for (double end : {-0.1, 1.5, std::nan("")}) {
+    c = LearnerConfig{};
+    c.learning_rate_end = end;
+    EXPECT_THROW(c.Validate(), std::invalid_argument) << end;
+  }
+}
+
+TEST(LearnerConfigTest, LearningRatesFallLinearlyThenHold) {
+  EXPECT_EQ(LearningRateScale(0, 0, 0.1), 1.0f);  // No decay.
+  EXPECT_EQ(LearningRateScale(500, 0, 0.1), 1.0f);
+  EXPECT_EQ(LearningRateScale(0, 10, 0.1), 1.0f);
+  EXPECT_FLOAT_EQ(LearningRateScale(5, 10, 0.1), 0.55f);
+  EXPECT_FLOAT_EQ(LearningRateScale(10, 10, 0.1), 0.1f);
+  EXPECT_FLOAT_EQ(LearningRateScale(1000, 10, 0.1), 0.1f);
+  EXPECT_FLOAT_EQ(LearningRateScale(3, 4, 0.0), 0.25f);
 }
 
 TEST_F(LearnerTest, RefusesRandomShiftsForAnEnvWithoutPixels) {
@@ -529,6 +548,57 @@ TEST_F(LearnerTest, CheckpointsHoldThePolicysAverageAndAResumeContinuesIt) {
   const nn::Checkpoint resumed = nn::LoadCheckpoint(announced_.back());
   EXPECT_EQ(resumed.meta.update, 35);
   EXPECT_EQ(resumed.params, expected.values());
+}
+
+// With a learning-rate decay to 0 over 10 updates, the 10th update is the last that moves the
+// policy (the weights broadcast after every update show it), the checkpoints say where the
+// schedule stands, and a resumed learner stays on it (its updates count from the state).
+TEST_F(LearnerTest, LearningRatesDecayWithTheUpdatesAndAcrossAResume) {
+  std::map<int64_t, std::vector<float>> broadcast;  // by version; the CartPole net is one chunk
+  bus_->Subscribe<rlmsg::weights_chunk_t>(
+      channels::kWeights,
+      [&broadcast](const rlmsg::weights_chunk_t& m) {
+        ASSERT_EQ(m.num_chunks, 1);
+        broadcast[m.version] = m.data;
+      },
+      Port::kBulk);
+  LearnerConfig c = ShortRun(16, 20, 5);
+  c.weights_every = 1;
+  c.learning_rate_decay_updates = 10;
+  c.learning_rate_end = 0;
+  Learner first(c, bus_.get());
+  first.Run();
+  bus_->Handle(0);
+  for (int64_t v = 1; v <= 10; ++v) {
+    ASSERT_TRUE(broadcast.count(v - 1) && broadcast.count(v)) << v;
+    EXPECT_NE(broadcast[v], broadcast[v - 1]) << "update " << v << " should move the policy";
+  }
+  for (int64_t v = 11; v <= 20; ++v) {
+    ASSERT_TRUE(broadcast.count(v)) << v;
+    EXPECT_EQ(broadcast[v], broadcast[10]) << "update " << v << " should not";
+  }
+  const nn::Checkpoint at5 = nn::LoadCheckpoint(announced_[0]);
+  ASSERT_EQ(at5.meta.update, 5);
+  EXPECT_NE(at5.meta.note.find("learning rates = 0.5 of their start"), std::string::npos)
+      << at5.meta.note;
+
+  c.resume = true;
+  c.max_updates = 25;
+  Learner second(c, bus_.get());
+  ASSERT_TRUE(second.resumed());
+  second.Run();
+  bus_->Handle(0);
+  ASSERT_TRUE(broadcast.count(25));
+  EXPECT_EQ(broadcast[25], broadcast[10]);
+  // Without the decay, the same resumed learner moves on.
+  c.learning_rate_decay_updates = 0;
+  c.max_updates = 30;
+  Learner third(c, bus_.get());
+  ASSERT_TRUE(third.resumed());
+  third.Run();
+  bus_->Handle(0);
+  ASSERT_TRUE(broadcast.count(30));
+  EXPECT_NE(broadcast[30], broadcast[10]);
 }
 
 }  // namespace

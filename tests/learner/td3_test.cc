@@ -145,6 +145,39 @@ TEST(Td3Test, DelaysActorAndTargetUpdatesAndAveragesTheTargets) {
   }
 }
 
+// SetLearningRateScale: Adam's steps are proportional to the step size, so from the same start
+// and batch a critic scaled by 0.5 moves half as far; scaled by 0 nothing moves.
+TEST(Td3Test, LearningRateScaleScalesTheSteps) {
+  const envs::EnvSpec spec = SmallSpec();
+  Td3Config c = SmallConfig();
+  c.policy_delay = 1;
+  Td3 full(spec, c);
+  Td3 half(spec, c);
+  Td3 none(spec, c);
+  half.SetLearningRateScale(0.5f);
+  none.SetLearningRateScale(0.0f);
+  std::mt19937 rng(5);
+  const OwnedBatch batch = RandomBatch(spec, 16, &rng);
+  const std::vector<float> start_critic = Flat(full.critic(1));
+  const std::vector<float> start_actor = Flat(full.actor());
+  for (Td3* td3 : {&full, &half, &none}) td3->Update(batch.view(2));
+  EXPECT_EQ(Flat(none.critic(1)), start_critic);
+  EXPECT_EQ(Flat(none.actor()), start_actor);
+  const std::vector<float> after_full = Flat(full.critic(1));
+  const std::vector<float> after_half = Flat(half.critic(1));
+  ASSERT_NE(after_full, start_critic);
+  for (size_t k = 0; k < start_critic.size(); ++k) {
+    const float step = after_full[k] - start_critic[k];
+    ASSERT_NEAR(after_half[k] - start_critic[k], 0.5f * step, 1e-7f + 1e-3f * std::abs(step)) << k;
+  }
+  EXPECT_NE(Flat(half.actor()), start_actor);
+  // Back to 1: the configured step sizes again.
+  half.SetLearningRateScale(1.0f);
+  none.SetLearningRateScale(1.0f);
+  none.Update(batch.view(2));
+  EXPECT_NE(Flat(none.critic(1)), start_critic);
+}
+
 // The actor's gradient: d(-mean_i Q1(s_i, mu(s_i)))/d(theta), through the critic's action input,
 // against central finite differences of that loss in the actor's parameters.
 TEST(Td3Test, TheActorsGradientThroughTheCriticMatchesFiniteDifferences) {
