@@ -33,6 +33,18 @@ namespace fs = std::filesystem;
 // request is answered until the learner has sent request 0 again, so the retry must happen.
 class LearnerTest : public TempDirTest {
  protected:
+  // The weights the learner broadcasts from now on, by version (the CartPole net is one chunk).
+  std::map<int64_t, std::vector<float>>& RecordWeights() {
+    bus_->Subscribe<rlmsg::weights_chunk_t>(
+        channels::kWeights,
+        [this](const rlmsg::weights_chunk_t& m) {
+          ASSERT_EQ(m.num_chunks, 1);
+          weights_[m.version] = m.data;
+        },
+        Port::kBulk);
+    return weights_;
+  }
+
   // A short run against this fixture's replay: `max_updates` updates on batches of `batch_size`,
   // a checkpoint every `checkpoint_every` updates into the scratch folder, lost replies retried
   // after 50 ms.
@@ -169,6 +181,7 @@ class LearnerTest : public TempDirTest {
   int requests_seen_ = 0;
   std::vector<std::string> announced_;
   std::set<int64_t> versions_;
+  std::map<int64_t, std::vector<float>> weights_;  // RecordWeights()
 };
 
 TEST_F(LearnerTest, TrainsBroadcastsWeightsAndWritesLoadableCheckpoints) {
@@ -506,14 +519,7 @@ TEST_F(LearnerTest, AResumedLearnerRefusesRecordedRepliesOlderThanItsState) {
 // weights broadcast with every update here, the current ones), and say so; a resumed learner
 // continues the average from its state.
 TEST_F(LearnerTest, CheckpointsHoldThePolicysAverageAndAResumeContinuesIt) {
-  std::map<int64_t, std::vector<float>> broadcast;  // by version; the CartPole net is one chunk
-  bus_->Subscribe<rlmsg::weights_chunk_t>(
-      channels::kWeights,
-      [&broadcast](const rlmsg::weights_chunk_t& m) {
-        ASSERT_EQ(m.num_chunks, 1);
-        broadcast[m.version] = m.data;
-      },
-      Port::kBulk);
+  std::map<int64_t, std::vector<float>>& broadcast = RecordWeights();
   LearnerConfig c = ShortRun(16, 30, 10);
   c.weights_every = 1;
   c.policy_average = 5;
@@ -554,14 +560,7 @@ TEST_F(LearnerTest, CheckpointsHoldThePolicysAverageAndAResumeContinuesIt) {
 // policy (the weights broadcast after every update show it), the checkpoints say where the
 // schedule stands, and a resumed learner stays on it (its updates count from the state).
 TEST_F(LearnerTest, LearningRatesDecayWithTheUpdatesAndAcrossAResume) {
-  std::map<int64_t, std::vector<float>> broadcast;  // by version; the CartPole net is one chunk
-  bus_->Subscribe<rlmsg::weights_chunk_t>(
-      channels::kWeights,
-      [&broadcast](const rlmsg::weights_chunk_t& m) {
-        ASSERT_EQ(m.num_chunks, 1);
-        broadcast[m.version] = m.data;
-      },
-      Port::kBulk);
+  std::map<int64_t, std::vector<float>>& broadcast = RecordWeights();
   LearnerConfig c = ShortRun(16, 20, 5);
   c.weights_every = 1;
   c.learning_rate_decay_updates = 10;
