@@ -204,10 +204,11 @@ RunPlan BuildRunPlan(const RunSettings& settings, const RunIdentity& identity) {
 
   // The monitor prints the progress line and decides when the run is over.
   PlannedProcess monitor = OurProcess(plan, "monitor", "monitor");
-  monitor.argv.insert(monitor.argv.end(),
-                      {"--goal", settings.goal, "--time-budget", Number(settings.time_budget),
-                       "--metrics", dir + "/metrics.jsonl", "--restarts", dir + "/restarts",
-                       "--stale-seconds", Number(plan.monitor_silence)});
+  monitor.argv.insert(
+      monitor.argv.end(),
+      {"--goal", settings.goal, "--time-budget", Number(settings.time_budget), "--metrics",
+       dir + "/metrics.jsonl", "--restarts", dir + "/restarts", "--history", dir + "/eval.jsonl",
+       "--stale-seconds", Number(plan.monitor_silence)});
   monitor.ready = {Readiness::kAtStart, ""};
   monitor.restart = false;
   monitor.ends_run = true;

@@ -4,7 +4,8 @@
 // exits when the run is over: 0 when an evaluation reached the goal, 1 when the time budget ran
 // out, 3 when the replay, the learner or the evaluator went silent, 130 on SIGINT/SIGTERM. With
 // --metrics FILE it also appends the stats of every process to FILE as a time series
-// (tools/metrics_log.h).
+// (tools/metrics_log.h); with --history FILE (the run's eval.jsonl) a resumed run's progress line
+// starts from the evaluations of its earlier parts.
 #include <unistd.h>
 
 #include <algorithm>
@@ -15,12 +16,14 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "common/channels.h"
 #include "common/clock.h"
 #include "common/options.h"
 #include "common/shutdown.h"
 #include "common/text_format.h"
+#include "evaluator/eval_history.h"
 #include "rlmsg/eval_result_t.hpp"
 #include "rlmsg/stats_actor_t.hpp"
 #include "rlmsg/stats_evaluator_t.hpp"
@@ -73,6 +76,21 @@ int64_t CountRestarts(const std::string& path) {
   return n;
 }
 
+// Starts the view's evaluations from the run's history: the last one scored and the best.
+void LoadHistory(const std::string& path, View* v) {
+  int skipped = 0;
+  const std::vector<rl::evaluator::EvalRecord> records =
+      rl::evaluator::LoadJsonLines(path, &skipped);
+  if (skipped > 0) {
+    std::fprintf(stderr, "monitor: %d unreadable lines in %s\n", skipped, path.c_str());
+  }
+  if (records.empty()) return;
+  v->have_eval = true;
+  v->last_eval.mean = records.back().mean;
+  v->last_eval.std = records.back().std;
+  for (const rl::evaluator::EvalRecord& r : records) v->best_eval = std::max(v->best_eval, r.mean);
+}
+
 std::string ProgressLine(const View& v, double elapsed, double now, int64_t restarts = 0) {
   int64_t steps = 0, episodes = 0, lost = 0, dropped = 0;
   double ret = 0;
@@ -115,6 +133,7 @@ int Main(int argc, char** argv) {
   double print_seconds = 1;
   std::string metrics_path;
   std::string restarts_path;
+  std::string history_path;
   rl::po::options_description desc("Options");
   rl::AddCommonOptions(&desc, &common);
   desc.add_options()                                                                            //
@@ -132,7 +151,10 @@ int Main(int argc, char** argv) {
        "hour, then every 10 s)")  //
       ("restarts", rl::po::value(&restarts_path),
        "the launch script's file of restarted processes (a line each): their count joins the "
-       "progress line");
+       "progress line")  //
+      ("history", rl::po::value(&history_path),
+       "the run's evaluation history (eval.jsonl): the progress line's last and best evaluation "
+       "start from it, so that a resumed run shows the best of all its parts");
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "monitor",
                         "Usage: monitor [options]\n"
@@ -146,6 +168,7 @@ int Main(int argc, char** argv) {
   if (!metrics_path.empty()) metrics = std::make_unique<rl::tools::MetricsLog>(metrics_path);
   rl::Bus bus(common.MakeBusConfig("monitor"));
   View v;
+  if (!history_path.empty()) LoadHistory(history_path, &v);
   bus.Subscribe<rlmsg::stats_actor_t>(rl::channels::kStatsActor,
                                       [&v](const rlmsg::stats_actor_t& s) {
                                         v.actors[s.header.sender] = s;

@@ -2,7 +2,7 @@
 # A run stopped with a signal (as Ctrl-C stops it) and continued with `launch.sh --resume`: the
 # same folder, run id and config; the learner resumes from its saved state and the replay from
 # its snapshot; update counts, env steps and the evaluation history carry on; and the resumed run
-# reaches the CartPole goal.
+# reaches the CartPole goal; its progress line starts from the best of the first part.
 source "$(dirname "$0")/lib.sh"
 source "$(dirname "$0")/launch_lib.sh"
 isolate "$@"
@@ -21,8 +21,16 @@ run_id=$(run_setting "$dir/run" run-id)
 evals_before=$(wc -l < "$dir/run/eval.jsonl")
 ls "$dir/run/checkpoints" > "$dir/on_disk"
 last_update_before=$(sed -n 's/.*"update": \([0-9]*\).*/\1/p' "$dir/run/eval.jsonl" | tail -1)
+best_before=$(best_mean "$dir/run/eval.jsonl")
 # Second part: resumed, with the preset's goal.
 resume_to_goal "$dir/run" "$dir/second.log"
+# Its progress line starts from the first part's evaluations: the first line shows their best,
+# before the resumed evaluator has scored anything.
+first_line=$(grep -m 1 '^\[ *[0-9.]*s\] steps ' "$dir/second.log")
+shown=$(sed -n 's/.* (best \([-0-9.]*\)).*/\1/p' <<< "$first_line")
+[ -n "$shown" ] || fail "the resumed run's first progress line shows no best: $first_line"
+awk -v s="$shown" -v b="$best_before" 'BEGIN{exit !(s <= b + 0.001 && b - s < 0.11)}' ||
+  fail "the resumed run's first progress line shows best $shown, not the first part's $best_before"
 grep -q "run $run_id of 'cartpole'" "$dir/second.log" || fail "the resumed run has another id"
 grep -q '^# resumed ' "$dir/run/config.ini" || fail "config.ini does not record the resumption"
 resumed=$(sed -n 's/.*resumed at update \([0-9]*\).*/\1/p' "$dir/run/logs/learner.log" | tail -1)

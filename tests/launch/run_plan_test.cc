@@ -60,6 +60,8 @@ TEST(RunPlanTest, ProcessesStartInOrderWithTheirLogsAndReadiness) {
   EXPECT_TRUE(monitor.shown);
   EXPECT_FALSE(monitor.restart);
   EXPECT_EQ(monitor.log, "/runs/r/logs/monitor.log");
+  // It starts from the run's evaluations, so that a resumed run shows the best of all its parts.
+  EXPECT_EQ(ValueOf(monitor.argv, "--history"), "/runs/r/eval.jsonl");
 }
 
 TEST(RunPlanTest, EveryProcessGetsTheRunsIdentity) {
