@@ -15,7 +15,7 @@
 //                             episode repeated to fill the stack), published back to back from
 //                             the main thread; transitions/s and MB/s stored, and what was lost.
 //   pixel_replay_sample       the learner's path: 4 requests of 32 stacks in flight (the
-//                             learner's default), replies of ~1.8 MB on the bulk port.
+//                             learner's default), replies of ~1.8 MB on the samples port.
 //   pixel_replay_8_actors     8 actor threads, each with its own bus, each publishing a batch
 //                             every 32 / 250 s (250 env steps/s per actor: an assumed nominal
 //                             rate for an Atari-like env with a Nature CNN policy on one core,
@@ -114,6 +114,8 @@ rl::BusConfig Config(int port, const std::string& sender, const std::string& key
   c.key = key;
   c.url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0&recv_buf_size=4194304";
   c.bulk_url = "udpm://239.255.76.67:" + std::to_string(port + 1) + "?ttl=0&recv_buf_size=4194304";
+  c.samples_url =
+      "udpm://239.255.76.67:" + std::to_string(port + 2) + "?ttl=0&recv_buf_size=4194304";
   c.run_id = 77;
   c.sender = sender;
   return c;
@@ -130,7 +132,7 @@ bool WaitForReplay(rl::Bus* bus) {
   return *replay_up;
 }
 
-// Flat CartPole transitions: replay_inserts_lcm and replay_samples_lcm, on `port` and port + 1.
+// Flat CartPole transitions: replay_inserts_lcm and replay_samples_lcm, on `port` to port + 2.
 int RunFlat(int repeats, double seconds, int port) {
   // The replay service, on its own thread and sockets.
   std::atomic<bool> stop{false};
@@ -158,7 +160,7 @@ int RunFlat(int repeats, double seconds, int port) {
         received += m.count;
         --in_flight;
       },
-      rl::Port::kBulk);
+      rl::Port::kSamples);
   if (!WaitForReplay(&bus)) {
     std::fprintf(stderr, "bench_replay: the replay service did not come up\n");
     stop = true;
@@ -509,7 +511,7 @@ int PixelInsertCpu(int repeats, double seconds, int port, double rate) {
   PixelInsertSide sides[2];
   sides[0].port = port;
   sides[1].key = std::string(rl::kKeyBytes, 'k');
-  sides[1].port = port + 2;
+  sides[1].port = port + 3;  // each bus takes 3 ports (main, bulk, samples)
   auto stop = [&] {
     for (PixelInsertSide& side : sides) {
       if (side.probe == nullptr) continue;
@@ -627,7 +629,7 @@ void PixelSample(rl::Bus* bus, int repeats, double seconds) {
         state->received += m.count;
         ++state->batches;
       },
-      rl::Port::kBulk);
+      rl::Port::kSamples);
   int64_t next_id = 0, timeouts = 0;
   const int64_t gaps_before = bus->counters().lost;
   std::vector<double> rates, batch_rates;
@@ -663,7 +665,7 @@ void PixelSample(rl::Bus* bus, int repeats, double seconds) {
   char extra[512];
   std::snprintf(extra, sizeof(extra),
                 "\"batch\": %d, \"frame\": \"%dx%d\", \"stack\": %d, \"in_flight\": %d, "
-                "\"transport\": \"udpm\", \"port\": \"bulk\", \"batches_per_s_median\": %.1f, "
+                "\"transport\": \"udpm\", \"port\": \"samples\", \"batches_per_s_median\": %.1f, "
                 "\"batches_per_s_min\": %.1f, \"batches_per_s_max\": %.1f, \"reply_mb\": %.2f, "
                 "\"mb_per_s_median\": %.0f, \"replies_timed_out\": %lld, "
                 "\"replies_lost_seq_gaps\": %lld",
@@ -770,7 +772,7 @@ void PixelActors(rl::Bus* bus, const ServiceProbe& probe, int port, int multipli
   rl::bench::Emit(name, "transitions/s", rl::bench::Summarize(delivered), windows, extra);
 }
 
-// Pixel benchmarks through LCM, on `port` and port + 1; with a key, or insert_only, only the
+// Pixel benchmarks through LCM, on `port` to port + 2; with a key, or insert_only, only the
 // insert row.
 int RunPixelLcm(int repeats, double seconds, int port, const std::string& key = "",
                 bool insert_only = false) {
@@ -1159,15 +1161,15 @@ int main(int argc, char** argv) {
     const double seconds = args.Number(1, 1.0);
     const int port = args.Int(2, 17667);
     // Forks its replay processes, so it runs first, while this process has no other thread.
-    if (const int rc = PixelInsertCpu(repeats, 2 * seconds, port + 6, kInsertCpuRate); rc != 0) {
+    if (const int rc = PixelInsertCpu(repeats, 2 * seconds, port + 9, kInsertCpuRate); rc != 0) {
       return rc;
     }
     MacRows(repeats);
     BusReceiveRows(repeats);
-    if (const int rc = RunPixelLcm(repeats, seconds, port + 2, "", /*insert_only=*/true); rc != 0) {
+    if (const int rc = RunPixelLcm(repeats, seconds, port + 3, "", /*insert_only=*/true); rc != 0) {
       return rc;
     }
-    return RunPixelLcm(repeats, seconds, port + 4, std::string(rl::kKeyBytes, 'k'));
+    return RunPixelLcm(repeats, seconds, port + 6, std::string(rl::kKeyBytes, 'k'));
   }
   if (mode == "--snapshots") {
     FlatSnapshots(repeats);
@@ -1178,14 +1180,14 @@ int main(int argc, char** argv) {
   const int port = args.Int(2, 17667);
 
   // Forks its replay processes, so it runs first, while this process has no other thread.
-  if (const int rc = PixelInsertCpu(repeats, 2 * seconds, port + 6, kInsertCpuRate); rc != 0) {
+  if (const int rc = PixelInsertCpu(repeats, 2 * seconds, port + 9, kInsertCpuRate); rc != 0) {
     return rc;
   }
   if (const int rc = RunFlat(repeats, seconds, port); rc != 0) return rc;
-  if (const int rc = RunPixelLcm(repeats, seconds, port + 2); rc != 0) return rc;
+  if (const int rc = RunPixelLcm(repeats, seconds, port + 3); rc != 0) return rc;
   MacRows(repeats);
   BusReceiveRows(repeats);
-  if (const int rc = RunPixelLcm(repeats, seconds, port + 4, std::string(rl::kKeyBytes, 'k'));
+  if (const int rc = RunPixelLcm(repeats, seconds, port + 6, std::string(rl::kKeyBytes, 'k'));
       rc != 0) {
     return rc;
   }

@@ -53,6 +53,18 @@ bool PrintableName(std::string_view s, size_t max) {
 
 }  // namespace
 
+const char* PortName(Port port) {
+  switch (port) {
+    case Port::kMain:
+      return "main";
+    case Port::kBulk:
+      return "bulk";
+    case Port::kSamples:
+      return "samples";
+  }
+  return "?";
+}
+
 Port ChannelPort(std::string_view channel, std::string_view type, std::optional<Port> port) {
   const MessageInfo* info = FindChannel(channel);
   if (info == nullptr) return port.value_or(Port::kMain);
@@ -61,8 +73,7 @@ Port ChannelPort(std::string_view channel, std::string_view type, std::optional<
                                 ", not " + std::string(type) + " (common/channels.h)");
   }
   if (port && *port != info->port) {
-    throw std::invalid_argument(std::string(channel) + " goes on the " +
-                                (info->port == Port::kBulk ? "bulk" : "main") +
+    throw std::invalid_argument(std::string(channel) + " goes on the " + PortName(info->port) +
                                 " port (common/channels.h)");
   }
   return info->port;
@@ -77,8 +88,12 @@ Bus::Bus(BusConfig config) : config_(std::move(config)), incarnation_(NewIncarna
     throw std::invalid_argument("the message age window and the clock skew must be > 0");
   }
   if (!config_.key.empty()) auth_ = std::make_unique<MessageAuthenticator>(config_.key);
-  main_ = OpenLcm(config_.url);
-  bulk_ = OpenLcm(config_.bulk_url);
+  instances_.push_back(OpenLcm(config_.url));
+  ports_[static_cast<int>(Port::kMain)] = instances_.back().get();
+  instances_.push_back(OpenLcm(config_.bulk_url));
+  ports_[static_cast<int>(Port::kBulk)] = instances_.back().get();
+  if (config_.samples_url != config_.bulk_url) instances_.push_back(OpenLcm(config_.samples_url));
+  ports_[static_cast<int>(Port::kSamples)] = instances_.back().get();
 }
 
 Bus::~Bus() = default;
@@ -322,12 +337,13 @@ std::vector<StreamPosition> ParsePositions(std::string_view text) {
 int Bus::Handle(int timeout_ms) {
   // Only the ports with a subscription: LCM's udpm binds a port and joins its group when asked
   // for its descriptor, subscribed or not. (With none, poll() just waits out the timeout.)
-  pollfd fds[2];
-  lcm::LCM* ports[2];
+  // A port that shares another's instance is polled once.
+  pollfd fds[kNumPorts];
+  lcm::LCM* ports[kNumPorts];
   nfds_t count = 0;
-  for (const Port port : {Port::kMain, Port::kBulk}) {
-    if (!subscribed_[static_cast<int>(port)]) continue;
-    ports[count] = &lcm(port);
+  for (int k = 0; k < kNumPorts; ++k) {
+    if (!subscribed_[k] || std::find(ports, ports + count, ports_[k]) != ports + count) continue;
+    ports[count] = ports_[k];
     fds[count] = {ports[count]->getFileno(), POLLIN, 0};
     ++count;
   }

@@ -1,11 +1,12 @@
 // Bus: the one way our processes talk LCM.
 //
-// It owns two LCM instances, one for the main port (small, high-rate messages) and one for the
-// bulk port (weights, sample replies), so that bulk traffic never starves the rest. Publish()
-// fills the header (run id, sender, incarnation, per-channel sequence number, time) and, when the
-// run has a key, the MAC (common/message_auth.h). Subscribe() installs a typed handler behind the
-// checks, and a message reaches the handler only when it passes every one, in this order, each
-// drop counted by its reason:
+// It owns an LCM instance for each port of the run (common/channels.h): the main port (small,
+// high-rate messages), the bulk port (weights) and the samples port (the replay's sample replies
+// to the learner), so that bulk traffic never starves the rest and the actors never receive the
+// sample replies. Publish() fills the header (run id, sender, incarnation, per-channel sequence
+// number, time) and, when the run has a key, the MAC (common/message_auth.h). Subscribe() installs
+// a typed handler behind the checks, and a message reaches the handler only when it passes every
+// one, in this order, each drop counted by its reason:
 //   malformed        its header cannot be read from the raw bytes (too short, a sender name that
 //                    is empty, over 64 bytes or not printable), it is another type (fingerprint),
 //                    or later it does not decode (torn or forged lengths: Prescan, lcm-gen)
@@ -67,6 +68,8 @@ namespace rl {
 inline constexpr char kDefaultLcmUrl[] = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=4194304";
 inline constexpr char kDefaultLcmBulkUrl[] =
     "udpm://239.255.76.67:7668?ttl=0&recv_buf_size=4194304";
+inline constexpr char kDefaultLcmSamplesUrl[] =
+    "udpm://239.255.76.67:7669?ttl=0&recv_buf_size=4194304";
 
 // The freshness window's defaults (BusConfig, --max-message-age and --max-clock-skew). A message's
 // age is its sender's clock at publication against this host's at the packet's arrival, before
@@ -80,20 +83,23 @@ inline constexpr int64_t kDefaultMaxClockSkewMicros = 10'000'000;
 struct BusConfig {
   std::string url = kDefaultLcmUrl;           // main port
   std::string bulk_url = kDefaultLcmBulkUrl;  // bulk port
-  int64_t run_id = 0;                         // messages of other runs are dropped
-  std::string sender;                         // header.sender of what we publish
-  std::string key;  // the run's secret key (kKeyBytes), or empty: no MACs written or checked
+  // Samples port; the bulk port's URL shares the bulk port's LCM instance (a TCP hub's run, where
+  // the hub forwards a channel only to its subscribers).
+  std::string samples_url = kDefaultLcmSamplesUrl;
+  int64_t run_id = 0;  // messages of other runs are dropped
+  std::string sender;  // header.sender of what we publish
+  std::string key;     // the run's secret key (kKeyBytes), or empty: no MACs written or checked
   int queue_capacity = 10000;  // per-subscription LCM queue (LCM's default: 30)
   // Freshness window (see the top of this file), microseconds, both > 0.
   int64_t max_message_age = kDefaultMaxMessageAgeMicros;
   int64_t max_clock_skew = kDefaultMaxClockSkewMicros;
 };
 
-/// An in-process bus (LCM's memq:// provider on both ports): only this process receives what it
+/// An in-process bus (LCM's memq:// provider on every port): only this process receives what it
 /// publishes. For unit tests and benchmarks.
 inline BusConfig InProcessBusConfig(int64_t run_id, std::string sender) {
   BusConfig c;
-  c.url = c.bulk_url = "memq://";
+  c.url = c.bulk_url = c.samples_url = "memq://";
   c.run_id = run_id;
   c.sender = std::move(sender);
   return c;
@@ -134,6 +140,9 @@ std::string FormatPositions(const std::vector<StreamPosition>& positions);
 /// negative (incarnation, seq), or more than kMaxStoredPositions lines.
 std::vector<StreamPosition> ParsePositions(std::string_view text);
 inline constexpr size_t kMaxStoredPositions = 65536;
+
+/// "main", "bulk" or "samples".
+const char* PortName(Port port);
 
 /// The port a message of `type` (lcm-gen's name) goes on when published or subscribed on
 /// `channel`: the channel's port in RL_MESSAGES (common/channels.h), or `port` (the main one if
@@ -195,9 +204,9 @@ class Bus {
 
   // Waits at most timeout_ms (0: no wait) for traffic on the ports this bus subscribes on, then
   // dispatches every pending message. Returns the number of messages dispatched. A port without
-  // a subscription is never read, so LCM never joins it: a process with no use for the bulk port
-  // does not copy every sample reply and weight broadcast of the run out of the kernel only to
-  // drop it.
+  // a subscription is never read, so LCM never joins it: a process with no use for the bulk or
+  // the samples port does not copy every weight broadcast or sample reply of the run out of the
+  // kernel only to drop it.
   int Handle(int timeout_ms);
 
   const BusCounters& counters() const { return counters_; }
@@ -244,7 +253,7 @@ class Bus {
     SenderPositions heard;
   };
 
-  lcm::LCM& lcm(Port port) { return port == Port::kMain ? *main_ : *bulk_; }
+  lcm::LCM& lcm(Port port) { return *ports_[static_cast<int>(port)]; }
   void SubscribeRaw(const std::string& channel, Port port, int64_t fingerprint,
                     std::function<const char*(const uint8_t*, size_t)> decode,
                     std::function<void()> handle);
@@ -266,11 +275,11 @@ class Bus {
 
   BusConfig config_;
   int64_t incarnation_;
-  std::unique_ptr<MessageAuthenticator> auth_;  // null without a key
-  std::unique_ptr<lcm::LCM> main_;
-  std::unique_ptr<lcm::LCM> bulk_;
+  std::unique_ptr<MessageAuthenticator> auth_;        // null without a key
+  std::vector<std::unique_ptr<lcm::LCM>> instances_;  // one per distinct URL
+  lcm::LCM* ports_[kNumPorts] = {};                   // by Port: its instance
   std::vector<std::unique_ptr<RawSubscription>> subscriptions_;
-  bool subscribed_[2] = {false, false};                           // by Port: a subscription on it
+  bool subscribed_[kNumPorts] = {};                               // by Port: a subscription on it
   std::map<std::string, int64_t> publish_seq_;                    // by channel
   std::map<std::string, SenderPositions, std::less<>> restored_;  // by channel (LoadPositions)
   std::vector<uint8_t> encode_buffer_;

@@ -24,6 +24,7 @@ BusConfig CommonOptions::MakeBusConfig(const std::string& sender) const {
   BusConfig c;
   c.url = lcm_url;
   c.bulk_url = lcm_bulk_url;
+  c.samples_url = lcm_samples_url;
   c.run_id = run_id;
   c.sender = sender;
   // A day bounds the window far above any use and keeps the microseconds far from overflow.
@@ -55,7 +56,11 @@ void AddCommonOptions(po::options_description* desc, CommonOptions* common) {
       ("lcm-url", po::value(&common->lcm_url)->default_value(common->lcm_url),
        "LCM URL of the main port (small, high-rate messages)")  //
       ("lcm-bulk-url", po::value(&common->lcm_bulk_url)->default_value(common->lcm_bulk_url),
-       "LCM URL of the bulk port (weights, sample replies)")  //
+       "LCM URL of the bulk port (weights)")  //
+      ("lcm-samples-url",
+       po::value(&common->lcm_samples_url)->default_value(common->lcm_samples_url),
+       "LCM URL of the samples port (the replay's sample replies to the learner); the bulk "
+       "port's URL shares the bulk port")  //
       ("max-message-age",
        po::value(&common->max_message_age)->default_value(common->max_message_age),
        "seconds a message may be old (its header time against its arrival here) before it is "

@@ -24,13 +24,14 @@ namespace po = boost::program_options;
 inline constexpr const char* kConfigSections[] = {"actor", "replay", "learner", "evaluator"};
 
 // Options every process has: --config, --run-id, --key-file, --lcm-url, --lcm-bulk-url,
-// --max-message-age, --max-clock-skew, and --help and --list-options.
+// --lcm-samples-url, --max-message-age, --max-clock-skew, and --help and --list-options.
 struct CommonOptions {
   std::string config_file;
   int64_t run_id = 0;
   std::string key_file;  // the run's secret key (common/message_auth.h); empty: no MACs
   std::string lcm_url = kDefaultLcmUrl;
   std::string lcm_bulk_url = kDefaultLcmBulkUrl;
+  std::string lcm_samples_url = kDefaultLcmSamplesUrl;
   // The freshness window, seconds (common/lcm_bus.h: why these defaults).
   double max_message_age = kDefaultMaxMessageAgeMicros * 1e-6;
   double max_clock_skew = kDefaultMaxClockSkewMicros * 1e-6;

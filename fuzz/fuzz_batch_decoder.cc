@@ -59,11 +59,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         } catch (const std::invalid_argument&) {
         }
       },
-      rl::Port::kBulk);
+      rl::Port::kSamples);
   int64_t seq = 0;
   for (const std::string_view record : rl::fuzz::Records(data + 1, size - 1)) {
     rl::fuzz::Deliver<rlmsg::sample_batch_t>(&bus, rl::channels::kSamples, record, "replay", &seq,
-                                             rl::Port::kBulk);
+                                             rl::Port::kSamples);
   }
   return 0;
 }

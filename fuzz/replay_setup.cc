@@ -40,7 +40,7 @@ rlmsg::transition_batch_t SetupBatch(int config, int first, int count, int32_t a
 Replica::Replica(int config) : config_(config), bus_(InProcessBusConfig(kRunId, "replay")) {
   bus_.Subscribe<rlmsg::sample_batch_t>(
       channels::kSamples, [this](const rlmsg::sample_batch_t& m) { replies_.push_back(m); },
-      Port::kBulk);
+      Port::kSamples);
   service_ = std::make_unique<replay::ReplayService>(&bus_, Options(config));
 }
 

@@ -95,7 +95,8 @@ void ParseRunOptions(const std::vector<std::string>& args, size_t i, LaunchOptio
     } else if (name == "--actors-per-node") {
       o->actors_per_node = ParseWhole(name, value, 0, 4096, "a whole number from 0 to 4096");
     } else if (name == "--port") {
-      o->port = ParseWhole(name, value, 1024, 65534, "a UDP port from 1024 to 65534 (P and P+1)");
+      o->port =
+          ParseWhole(name, value, 1024, 65533, "a UDP port from 1024 to 65533 (P, P+1 and P+2)");
     } else if (name == "--run-id") {
       refuse_on_resume("id");
       o->run_id = ParseWhole<int64_t>(name, value, 1, INT64_MAX, "a positive whole number");
@@ -209,7 +210,7 @@ their last snapshot and state, and a watchdog kills those still running 10 s lat
   --seed N               run seed (default 1)
   --ttl 0|1              LCM multicast TTL: 0 keeps traffic on this host, 1 reaches the LAN
                          (--slurm: 1)
-  --port P               LCM port of the run (P and P+1; default: a free random pair)
+  --port P               LCM port of the run (P, P+1 and P+2; default: three free random ones)
   --run-id ID            run id (default: random)
   --actor-args "..."     extra options for every actor, split at spaces (also --replay-args,
                          --learner-args, --evaluator-args)

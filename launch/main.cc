@@ -52,16 +52,21 @@ void Touch(const std::string& path, std::ios::openmode mode) { std::ofstream fil
 // Whether a UDP socket of this host is bound to `port`.
 bool PortInUse(int port) { return rl::SocketsOnPort("udp", port) > 0; }
 
-// A free pair of UDP ports (P, P + 1), P even in [20000, 60000): only the port isolates two runs
-// on one host.
+// Whether one of a run's UDP ports (P, P + 1, P + 2: main, bulk, samples) is bound on this host.
+bool RunPortsInUse(int port) {
+  return PortInUse(port) || PortInUse(port + 1) || PortInUse(port + 2);
+}
+
+// Three free UDP ports (P, P + 1, P + 2), P in [20000, 60000) and a multiple of 3 from 20000, so
+// that two picks never overlap: only the port isolates two runs on one host.
 int PickFreePort() {
   std::random_device device;
-  std::uniform_int_distribution<int> pick(0, 19999);
+  std::uniform_int_distribution<int> pick(0, 13332);
   for (int attempt = 0; attempt < 100; ++attempt) {
-    const int port = 20000 + 2 * pick(device);
-    if (!PortInUse(port) && !PortInUse(port + 1)) return port;
+    const int port = 20000 + 3 * pick(device);
+    if (!RunPortsInUse(port)) return port;
   }
-  throw LaunchError("no free pair of UDP ports found in 100 tries (pass --port)");
+  throw LaunchError("no three free UDP ports found in 100 tries (pass --port)");
 }
 
 bool OnPath(const std::string& program) {
@@ -306,7 +311,7 @@ int Launch(LaunchOptions o) {
     id.run_id = in.resumed->run_id;
     // The resumed run keeps its port, so that its config.ini and scripts/spy.sh stay right.
     id.port = o.port.value_or(in.resumed->Port());
-    if (!o.port && !slurm && (id.port == 0 || PortInUse(id.port) || PortInUse(id.port + 1))) {
+    if (!o.port && !slurm && (id.port == 0 || RunPortsInUse(id.port))) {
       throw LaunchError("the run's LCM port " + std::to_string(id.port) +
                         " is in use: is the run still going? (or pass --port)");
     }

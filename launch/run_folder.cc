@@ -44,6 +44,7 @@ std::string FormatRunHeader(const RunHeader& h) {
   s += "# run-id = " + std::to_string(h.run_id) + "\n";
   s += "# lcm-url = " + h.lcm_url + "\n";
   s += "# lcm-bulk-url = " + h.lcm_bulk_url + "\n";
+  s += "# lcm-samples-url = " + h.lcm_samples_url + "\n";
   s += "# actors = " + std::to_string(h.actors) + " (of " + std::to_string(h.num_actors) +
        "), seed = " + std::to_string(h.seed) + ", goal = " + h.goal +
        ", time budget = " + Number(h.time_budget) + " s\n";
@@ -78,6 +79,9 @@ RunHeader ParseRunHeader(const std::string& config_text, const std::string& path
       h.lcm_url = *url;
     } else if (const auto bulk = after(line, "# lcm-bulk-url = "); bulk && h.lcm_bulk_url.empty()) {
       h.lcm_bulk_url = *bulk;
+    } else if (const auto samples = after(line, "# lcm-samples-url = ");
+               samples && h.lcm_samples_url.empty()) {
+      h.lcm_samples_url = *samples;
     } else if (after(line, "# actors = ") && !have_actors) {
       // "# actors = 4 (of 4), seed = 1, goal = 475, time budget = 600 s"
       unsigned long long seed = 0;

@@ -15,6 +15,7 @@ namespace rl::launch {
 ///   # run-id = 123
 ///   # lcm-url = udpm://239.255.76.67:P?ttl=0&recv_buf_size=4194304
 ///   # lcm-bulk-url = udpm://239.255.76.67:P+1?...
+///   # lcm-samples-url = udpm://239.255.76.67:P+2?...   (not in runs of earlier versions)
 ///   # actors = 4 (of 4), seed = 1, goal = 475, time budget = 600 s
 ///   # extra: actor [...] replay [...] learner [...] evaluator [...]     (only with extra args)
 struct RunHeader {
@@ -23,6 +24,7 @@ struct RunHeader {
   int64_t run_id = 0;
   std::string lcm_url;
   std::string lcm_bulk_url;
+  std::string lcm_samples_url;
   int actors = 0;
   int num_actors = 0;
   uint64_t seed = 0;

@@ -25,9 +25,9 @@ PlannedProcess OurProcess(const RunPlan& plan, const std::string& role, const st
   p.kind = kind;
   p.argv = {plan.settings.bin_dir + "/" + kind};
   if (kind != "monitor") p.argv.insert(p.argv.end(), {"--config", plan.config_file});
-  p.argv.insert(p.argv.end(),
-                {"--run-id", std::to_string(plan.identity.run_id), "--key-file", plan.key_file,
-                 "--lcm-url", plan.lcm_url, "--lcm-bulk-url", plan.lcm_bulk_url});
+  p.argv.insert(p.argv.end(), {"--run-id", std::to_string(plan.identity.run_id), "--key-file",
+                               plan.key_file, "--lcm-url", plan.lcm_url, "--lcm-bulk-url",
+                               plan.lcm_bulk_url, "--lcm-samples-url", plan.lcm_samples_url});
   p.log = plan.identity.run_dir + "/logs/" + role + ".log";
   p.ready = {Readiness::kLogLine, role + ": ready"};
   return p;
@@ -112,6 +112,7 @@ RunHeader RunPlan::Header(const std::string& started) const {
   h.run_id = identity.run_id;
   h.lcm_url = lcm_url;
   h.lcm_bulk_url = lcm_bulk_url;
+  h.lcm_samples_url = lcm_samples_url;
   h.actors = settings.actors;
   h.num_actors = settings.num_actors;
   h.seed = settings.seed;
@@ -136,6 +137,7 @@ RunPlan BuildRunPlan(const RunSettings& settings, const RunIdentity& identity) {
       tcp ? TcpHubUrl(settings.hub_host, identity.port) : LcmUrl(identity.port, settings.ttl);
   plan.lcm_bulk_url = tcp ? TcpHubUrl(settings.hub_host, identity.port + 1)
                           : LcmUrl(identity.port + 1, settings.ttl);
+  plan.lcm_samples_url = tcp ? plan.lcm_bulk_url : LcmUrl(identity.port + 2, settings.ttl);
   const std::string& dir = identity.run_dir;
   plan.config_file = dir + "/config.ini";
   plan.key_file = dir + "/key";

@@ -79,7 +79,7 @@ RunSettings ResolveSettings(const LaunchOptions& options, const Preset& preset,
 struct RunIdentity {
   std::string run_dir;  // absolute
   int64_t run_id = 0;
-  int port = 0;  // main LCM port; the bulk port is port + 1
+  int port = 0;  // main LCM port; the bulk port is port + 1, the samples port port + 2
 };
 
 /// A run: settings, identity, and its processes in the order they start.
@@ -88,6 +88,9 @@ struct RunPlan {
   RunIdentity identity;
   std::string lcm_url;
   std::string lcm_bulk_url;
+  // The samples port's (udpm: port + 2); through TCP hubs the bulk port's, whose hub forwards a
+  // channel to its subscribers only.
+  std::string lcm_samples_url;
   std::string config_file;  // RUN/config.ini: the header and the preset, every process's --config
   std::string key_file;     // RUN/key
   double monitor_silence = 0;  // the monitor's --stale-seconds (MonitorSilenceLimit)

@@ -115,7 +115,7 @@ Learner::Learner(LearnerConfig config, Bus* bus)
     resumed_ = true;
   }
   bus_->Subscribe<rlmsg::sample_batch_t>(
-      channels::kSamples, [this](rlmsg::sample_batch_t& m) { OnSamples(m); }, Port::kBulk);
+      channels::kSamples, [this](rlmsg::sample_batch_t& m) { OnSamples(m); }, Port::kSamples);
 }
 
 bool Learner::Accept(const std::string& requester, int64_t request_id, int64_t total_inserts) {

@@ -297,7 +297,7 @@ void ReplayService::Answer(const PendingRequest& request) {
   r.replay_size = table_->size();
   r.total_inserts = table_->total_inserts();
   limiter_.Sample(count);
-  bus_.Publish(channels::kSamples, &r, Port::kBulk);
+  bus_.Publish(channels::kSamples, &r, Port::kSamples);
   ++counters_.requests_answered;
 }
 

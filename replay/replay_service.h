@@ -9,7 +9,7 @@
 //   RL_SAMPLE_REQUEST  sample_request_t    queued; several may be in flight
 //   RL_PRIORITIES      priority_update_t   new priorities (prioritized replay)
 // Out:
-//   RL_SAMPLES         sample_batch_t      (bulk port) one reply per request, in request order,
+//   RL_SAMPLES         sample_batch_t      (samples port) one reply per request, in request order,
 //                                          as soon as the limiter allows a sample of its size
 //                                          (flat observations or rebuilt pixel stacks)
 //   RL_FLOW            flow_control_t      at flow_hz, and at once whenever insert_allowed changes

@@ -2,19 +2,21 @@
 # Starts lcm-spy on Java 17 with our message types, so that every channel of a run is decoded.
 # (Debian's lcm-spy wrapper passes -Xincgc, which Java 17 refuses.)
 #
-# Usage: scripts/spy.sh [--run RUN_DIR | --lcm-url URL] [--bulk] [--build-dir DIR]
+# Usage: scripts/spy.sh [--run RUN_DIR | --lcm-url URL] [--bulk | --samples] [--build-dir DIR]
 #   --run RUN_DIR   watch the run in RUN_DIR (reads its LCM URLs from RUN_DIR/config.ini)
 #   --lcm-url URL   watch this URL (default: the processes' default main URL)
-#   --bulk          watch the run's bulk port (weights, sample replies) instead of the main one
+#   --bulk          watch the run's bulk port (weights) instead of the main one
+#   --samples       watch the run's samples port (the replay's sample replies to the learner)
 # lcm-spy's Java side ignores recv_buf_size; our chunks stay below 60 KB so that it sees them.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-run="" url="udpm://239.255.76.67:7667?ttl=0" bulk=0 build_dir="$root/build"
+run="" url="udpm://239.255.76.67:7667?ttl=0" key=lcm-url build_dir="$root/build"
 while [ $# -gt 0 ]; do
   case "$1" in
     --run) run="$2"; shift ;;
     --lcm-url) url="$2"; shift ;;
-    --bulk) bulk=1 ;;
+    --bulk) key=lcm-bulk-url ;;
+    --samples) key=lcm-samples-url ;;
     --build-dir) build_dir="$2"; shift ;;
     -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "$0"; exit 0 ;;
     *) echo "spy.sh: unknown option '$1'" >&2; exit 2 ;;
@@ -22,8 +24,6 @@ while [ $# -gt 0 ]; do
   shift
 done
 if [ -n "$run" ]; then
-  key=lcm-url
-  [ "$bulk" -eq 1 ] && key=lcm-bulk-url
   url=$(sed -n "s/^# $key = //p" "$run/config.ini")
   [ -n "$url" ] || { echo "spy.sh: no '# $key' line in $run/config.ini" >&2; exit 2; }
 fi

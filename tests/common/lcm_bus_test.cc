@@ -619,22 +619,43 @@ TEST(MessageTableTest, RefusesAnotherTypeOrPortOnAChannelOfTheTable) {
   EXPECT_THROW(bus.Publish(channels::kWeights, &w, Port::kMain), std::invalid_argument);
   EXPECT_EQ(ChannelPort(channels::kWeights, "weights_chunk_t", std::nullopt), Port::kBulk);
   EXPECT_EQ(ChannelPort(channels::kWeights, "", std::nullopt), Port::kBulk);
+  EXPECT_EQ(ChannelPort(channels::kSamples, "sample_batch_t", std::nullopt), Port::kSamples);
+  try {
+    ChannelPort(channels::kSamples, "sample_batch_t", Port::kBulk);
+    ADD_FAILURE() << "a sample reply was let onto the bulk port";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "RL_SAMPLES goes on the samples port (common/channels.h)");
+  }
   EXPECT_EQ(ChannelPort("TEST_CHANNEL", "checkpoint_t", std::nullopt), Port::kMain);
   EXPECT_EQ(ChannelPort("TEST_CHANNEL", "checkpoint_t", Port::kBulk), Port::kBulk);
   EXPECT_TRUE(bus.Publish("TEST_CHANNEL", &c));
 }
 
+// Three free UDP ports from a random one (0 when the first tries are taken).
+int FreePorts() {
+  std::random_device device;
+  for (int attempt = 0; attempt < 10; ++attempt) {
+    const int port = 20000 + 3 * std::uniform_int_distribution<int>(0, 13332)(device);
+    if (SocketsOnPort("udp", port) + SocketsOnPort("udp", port + 1) +
+            SocketsOnPort("udp", port + 2) ==
+        0) {
+      return port;
+    }
+  }
+  return 0;
+}
+
 // A bus binds (and joins the multicast group of) only the ports it subscribes on, when it handles
 // traffic: a process with no use for the bulk port (the monitor, the evaluator, the replay, which
-// only publishes there) must not receive the run's sample replies and weights only to drop them.
+// only publishes there) must not receive the run's weights only to drop them, and one with no
+// use for the samples port (the actors, which listen for weights) the sample replies.
 TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
-  std::random_device device;
-  const int port = 20000 + 2 * std::uniform_int_distribution<int>(0, 19999)(device);
-  if (SocketsOnPort("udp", port) != 0 || SocketsOnPort("udp", port + 1) != 0)
-    GTEST_SKIP() << "port in use";
+  const int port = FreePorts();
+  if (port == 0) GTEST_SKIP() << "ports in use";
   BusConfig c = MemqConfig(5, "monitor");
   c.url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
   c.bulk_url = "udpm://239.255.76.67:" + std::to_string(port + 1) + "?ttl=0";
+  c.samples_url = "udpm://239.255.76.67:" + std::to_string(port + 2) + "?ttl=0";
   std::unique_ptr<Bus> bus;
   try {
     bus = std::make_unique<Bus>(c);
@@ -656,6 +677,53 @@ TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
   rlmsg::weights_chunk_t w = examples::Example<rlmsg::weights_chunk_t>();
   ASSERT_TRUE(bus->Publish(channels::kWeights, &w));
   for (int i = 0; i < 100 && weights == 0; ++i) bus->Handle(10);
+  EXPECT_EQ(weights, 1);
+  EXPECT_EQ(SocketsOnPort("udp", port + 2), 0)
+      << "the samples port was bound without a subscription";
+
+  // And the same for the samples port: subscribed, it is bound and hears the replies, which no
+  // longer reach the bulk port's subscribers.
+  int replies = 0;
+  bus->Subscribe<rlmsg::sample_batch_t>(channels::kSamples,
+                                        [&replies](const rlmsg::sample_batch_t&) { ++replies; });
+  bus->Handle(0);
+  EXPECT_EQ(SocketsOnPort("udp", port + 2), 1);
+  rlmsg::sample_batch_t s = examples::Example<rlmsg::sample_batch_t>();
+  ASSERT_TRUE(bus->Publish(channels::kSamples, &s));
+  for (int i = 0; i < 100 && replies == 0; ++i) bus->Handle(10);
+  EXPECT_EQ(replies, 1);
+  EXPECT_EQ(weights, 1);
+}
+
+// A samples URL equal to the bulk one (a run through TCP hubs) shares the bulk port's LCM
+// instance: one socket, and the replies are heard there.
+TEST(BusPortsTest, TheSamplesPortCanShareTheBulkPort) {
+  const int port = FreePorts();
+  if (port == 0) GTEST_SKIP() << "ports in use";
+  BusConfig c = MemqConfig(5, "learner");
+  c.url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
+  c.bulk_url = c.samples_url = "udpm://239.255.76.67:" + std::to_string(port + 1) + "?ttl=0";
+  std::unique_ptr<Bus> bus;
+  try {
+    bus = std::make_unique<Bus>(c);
+  } catch (const std::runtime_error& e) {
+    GTEST_SKIP() << "no multicast here: " << e.what();
+  }
+  int replies = 0, weights = 0;
+  bus->Subscribe<rlmsg::sample_batch_t>(channels::kSamples,
+                                        [&replies](const rlmsg::sample_batch_t&) { ++replies; });
+  bus->Subscribe<rlmsg::weights_chunk_t>(channels::kWeights,
+                                         [&weights](const rlmsg::weights_chunk_t&) { ++weights; });
+  bus->Handle(0);
+  if (SocketsOnPort("udp", port + 1) == 0) GTEST_SKIP() << "LCM cannot receive multicast here";
+  EXPECT_EQ(SocketsOnPort("udp", port + 1), 1) << "two sockets on the shared port";
+  EXPECT_EQ(SocketsOnPort("udp", port + 2), 0);
+  rlmsg::sample_batch_t s = examples::Example<rlmsg::sample_batch_t>();
+  rlmsg::weights_chunk_t w = examples::Example<rlmsg::weights_chunk_t>();
+  ASSERT_TRUE(bus->Publish(channels::kSamples, &s));
+  ASSERT_TRUE(bus->Publish(channels::kWeights, &w));
+  for (int i = 0; i < 100 && (replies == 0 || weights == 0); ++i) bus->Handle(10);
+  EXPECT_EQ(replies, 1);
   EXPECT_EQ(weights, 1);
 }
 

@@ -90,7 +90,8 @@ TEST(OptionsTest, ListOptionsPrintsTheNamesAPresetMaySet) {
   std::cout.rdbuf(saved);
   EXPECT_FALSE(go_on);
   EXPECT_EQ(out.str(),
-            "run-id\nkey-file\nlcm-url\nlcm-bulk-url\nmax-message-age\nmax-clock-skew\nepisodes\n");
+            "run-id\nkey-file\nlcm-url\nlcm-bulk-url\nlcm-samples-url\nmax-message-age\nmax-clock-"
+            "skew\nepisodes\n");
 }
 
 // The freshness window: seconds on the command line, microseconds in the bus's configuration;

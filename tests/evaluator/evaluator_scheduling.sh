@@ -27,7 +27,7 @@ fi
 check() {
   printf '[evaluator]\n%b' "$4" > "$dir/run.ini"
   "${@:5}" "$evaluator" --config "$dir/run.ini" --out "$dir/run-$1" --run-id 7 --lcm-url memq:// \
-    --lcm-bulk-url memq:// > "$dir/log-$1" 2>&1 &
+    --lcm-bulk-url memq:// --lcm-samples-url memq:// > "$dir/log-$1" 2>&1 &
   pid=$!
   for _ in $(seq 300); do
     grep -q '^evaluator: ready' "$dir/log-$1" && break

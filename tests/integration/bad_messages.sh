@@ -21,7 +21,8 @@ wait_line "$dir/launch.log" "running; logs in" 60
 run="$dir/run"
 env_id=$(sed -n 's/^env = //p' "$run/config.ini" | head -1)
 "$bin/inject" --env "$env_id" --run-id "$(run_setting "$run" run-id)" --key-file "$run/key" --lcm-url "$(run_setting "$run" lcm-url)" \
-  --lcm-bulk-url "$(run_setting "$run" lcm-bulk-url)" --count 20 --timeout 30 \
+  --lcm-bulk-url "$(run_setting "$run" lcm-bulk-url)" \
+  --lcm-samples-url "$(run_setting "$run" lcm-samples-url)" --count 20 --timeout 30 \
   --roles replay,learner,actor,evaluator || fail "the processes did not count every bad message"
 # Every process is still alive.
 while read -r role pid; do

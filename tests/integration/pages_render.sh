@@ -60,7 +60,9 @@ last=$(tail -n 1 "$dir/seed1/eval.jsonl" | grep -Eo '"mean": *[-0-9.e+]+' | grep
 port=7790
 url="udpm://239.255.76.67:$port?ttl=0&recv_buf_size=4194304"
 bulk_url="udpm://239.255.76.67:$((port + 1))?ttl=0&recv_buf_size=4194304"
-"$bin/monitor" --run-id "$run_id" --lcm-url "$url" --lcm-bulk-url "$bulk_url" --goal "$last" \
+samples_url="udpm://239.255.76.67:$((port + 2))?ttl=0&recv_buf_size=4194304"
+"$bin/monitor" --run-id "$run_id" --lcm-url "$url" --lcm-bulk-url "$bulk_url" \
+  --lcm-samples-url "$samples_url" --goal "$last" \
   --time-budget 60 --stale-seconds 60 > "$dir/replayed.log" 2>&1 &
 monitor_pid=$!
 wait_line "$dir/replayed.log" "monitor: ready" 10

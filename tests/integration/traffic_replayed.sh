@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Recorded traffic played back into the live run it came from changes nothing, also after the
 # receiver was killed and restarted: a CartPole run records its main port (launch.sh --record)
-# and, here, its bulk port too; lcm-logplayer plays the recordings back onto the run's ports.
+# and, here, its samples port too; lcm-logplayer plays the recordings back onto the run's ports.
 #   1. Into the live run, with its actors stopped: the replay and the evaluator drop every
 #      recorded message of their channels as replayed (exactly as many as the file holds), the
 #      replay inserts nothing, and no lost count moves (tools/inject.cc --replayed-log).
@@ -18,12 +18,13 @@ source "$(dirname "$0")/lib.sh"
 isolate "$@"
 scratch
 command -v lcm-logplayer >/dev/null || fail "lcm-logplayer is missing (liblcm-bin)"
-# The bulk port is recorded from before the run starts, so that the recording holds the replies
-# to the learner's first requests (ids 0, 1, ...).
-port=$((20000 + 2 * (RANDOM % 20000)))
+# The samples port is recorded from before the run starts, so that the recording holds the
+# replies to the learner's first requests (ids 0, 1, ...).
+port=$((20000 + 3 * (RANDOM % 13000)))
 bulk_url="udpm://239.255.76.67:$((port + 1))?ttl=0&recv_buf_size=4194304"
-lcm-logger --quiet --lcm-url="$bulk_url" "$dir/bulk.lcmlog" > "$dir/bulk-logger.log" 2>&1 &
-bulk_logger=$!
+samples_url="udpm://239.255.76.67:$((port + 2))?ttl=0&recv_buf_size=4194304"
+lcm-logger --quiet --lcm-url="$samples_url" "$dir/samples.lcmlog" > "$dir/samples-logger.log" 2>&1 &
+samples_logger=$!
 set -m
 launch cartpole --out "$dir/run" --actors 2 --seed 4 --goal 1000000 --time-budget 300 --record \
   --port "$port" --replay-args "--snapshot-every 1" > "$dir/launch.log" 2>&1 &
@@ -33,6 +34,8 @@ wait_line "$dir/launch.log" "running; logs in" 60
 run="$dir/run"
 url=$(run_setting "$run" lcm-url)
 [ "$(run_setting "$run" lcm-bulk-url)" = "$bulk_url" ] || fail "the run's bulk port is not $bulk_url"
+[ "$(run_setting "$run" lcm-samples-url)" = "$samples_url" ] ||
+  fail "the run's samples port is not $samples_url"
 # Traffic of every kind, a checkpoint and its evaluation included.
 wait_line "$run/eval.jsonl" '"checkpoint"' 90
 
@@ -62,7 +65,7 @@ plays=0
 play_back() {  # play_back WHAT
   local log="$dir/inject-$((plays += 1)).log"
   "$bin/inject" --replayed-log "$dir/main.lcmlog" --run-id "$(run_setting "$run" run-id)" \
-    --key-file "$run/key" --lcm-url "$url" --lcm-bulk-url "$bulk_url" --timeout 60 \
+    --key-file "$run/key" --lcm-url "$url" --lcm-bulk-url "$bulk_url" --lcm-samples-url "$samples_url" --timeout 60 \
     > "$log" 2>&1 &
   local inject_pid=$! inject_status=0
   wait_line "$log" "ready for playback" 60
@@ -103,8 +106,8 @@ updates=$(learner_metric updates)
 wait_for 60 "1000 more updates" learner_updates_at_least $((updates + 1000))
 replay_pid=$(pid_of replay)
 kill -STOP "$replay_pid"
-kill -INT "$bulk_logger"
-wait "$bulk_logger" || true
+kill -INT "$samples_logger"
+wait "$samples_logger" || true
 kill -KILL "$(pid_of learner)"
 wait_lines "$run/logs/learner.log" "^learner: ready" 2 30
 # Its first stats, then what it has trained and refused so far.
@@ -112,8 +115,9 @@ rows=$(lines "$run/metrics.jsonl" "$learner_rows")
 wait_lines "$run/metrics.jsonl" "$learner_rows" $((rows + 2)) 10
 before=$(learner_metric updates)
 refused_before=$(learner_metric replayed)
-lcm-logplayer --speed=20 --regexp=RL_SAMPLES --lcm-url="$bulk_url" "$dir/bulk.lcmlog" \
-  > "$dir/bulk-player.log" 2>&1 || fail "lcm-logplayer failed: $(tail -3 "$dir/bulk-player.log")"
+lcm-logplayer --speed=20 --regexp=RL_SAMPLES --lcm-url="$samples_url" "$dir/samples.lcmlog" \
+  > "$dir/samples-player.log" 2>&1 ||
+  fail "lcm-logplayer failed: $(tail -3 "$dir/samples-player.log")"
 rows=$(lines "$run/metrics.jsonl" "$learner_rows")
 wait_lines "$run/metrics.jsonl" "$learner_rows" $((rows + 2)) 10
 after=$(learner_metric updates)

@@ -97,7 +97,7 @@ TEST(LaunchOptionsTest, RefusesNumbersThatAreNoneOrOutOfRange) {
       {"--seed", "a whole number", {"1.5"}},
       {"--goal", "a number (an evaluation mean)", {"high"}},
       {"--ttl", "0 or 1", {"2"}},
-      {"--port", "a UDP port from 1024 to 65534 (P and P+1)", {"65535"}},
+      {"--port", "a UDP port from 1024 to 65533 (P, P+1 and P+2)", {"65534"}},
       {"--record-mb", "a whole number of at least 8", {"4"}},
       {"--max-backoff", "a positive number of seconds", {"-1"}},
   };

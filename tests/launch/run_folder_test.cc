@@ -123,6 +123,7 @@ TEST_F(RunFolderTest, TheHeaderReadsBackAsWritten) {
   h.run_id = 123456789;
   h.lcm_url = "udpm://239.255.76.67:23456?ttl=0&recv_buf_size=4194304";
   h.lcm_bulk_url = "udpm://239.255.76.67:23457?ttl=0&recv_buf_size=4194304";
+  h.lcm_samples_url = "udpm://239.255.76.67:23458?ttl=0&recv_buf_size=4194304";
   h.actors = 2;
   h.num_actors = 6;
   h.seed = 4;
@@ -135,6 +136,7 @@ TEST_F(RunFolderTest, TheHeaderReadsBackAsWritten) {
             "# run-id = 123456789\n"
             "# lcm-url = udpm://239.255.76.67:23456?ttl=0&recv_buf_size=4194304\n"
             "# lcm-bulk-url = udpm://239.255.76.67:23457?ttl=0&recv_buf_size=4194304\n"
+            "# lcm-samples-url = udpm://239.255.76.67:23458?ttl=0&recv_buf_size=4194304\n"
             "# actors = 2 (of 6), seed = 4, goal = -250, time budget = 90.5 s\n"
             "# extra: actor [--stats-hz 2] replay [] learner [] evaluator []\n");
   const RunHeader back = ParseRunHeader(
@@ -142,12 +144,23 @@ TEST_F(RunFolderTest, TheHeaderReadsBackAsWritten) {
   EXPECT_EQ(back.preset, h.preset);
   EXPECT_EQ(back.run_id, h.run_id);
   EXPECT_EQ(back.Port(), 23456);
+  EXPECT_EQ(back.lcm_bulk_url, h.lcm_bulk_url);
+  EXPECT_EQ(back.lcm_samples_url, h.lcm_samples_url);
   EXPECT_EQ(back.actors, 2);
   EXPECT_EQ(back.num_actors, 6);
   EXPECT_EQ(back.seed, 4u);
   EXPECT_EQ(back.goal, "-250");
   EXPECT_EQ(back.extra, h.extra);
   EXPECT_THROW(ParseRunHeader("env = CartPole-v1\n", "config.ini"), LaunchError);
+  // A run of an earlier version has no samples port in its header: it resumes all the same (the
+  // plan gives it port + 2).
+  std::string earlier = text;
+  earlier.erase(earlier.find("# lcm-samples-url"),
+                earlier.find("# actors") - earlier.find("# lcm-samples-url"));
+  const RunHeader old = ParseRunHeader(earlier, "config.ini");
+  EXPECT_EQ(old.Port(), 23456);
+  EXPECT_EQ(old.lcm_samples_url, "");
+  EXPECT_EQ(old.actors, 2);
 }
 
 TEST_F(RunFolderTest, TheKeyIsPrivateAndKept) {

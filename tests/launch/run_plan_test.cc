@@ -68,11 +68,13 @@ TEST(RunPlanTest, EveryProcessGetsTheRunsIdentity) {
   const RunPlan plan = Plan({"cartpole"});
   EXPECT_EQ(plan.lcm_url, "udpm://239.255.76.67:23456?ttl=0&recv_buf_size=4194304");
   EXPECT_EQ(plan.lcm_bulk_url, "udpm://239.255.76.67:23457?ttl=0&recv_buf_size=4194304");
+  EXPECT_EQ(plan.lcm_samples_url, "udpm://239.255.76.67:23458?ttl=0&recv_buf_size=4194304");
   for (const PlannedProcess& p : plan.processes) {
     EXPECT_EQ(ValueOf(p.argv, "--run-id"), "77") << p.role;
     EXPECT_EQ(ValueOf(p.argv, "--key-file"), "/runs/r/key") << p.role;
     EXPECT_EQ(ValueOf(p.argv, "--lcm-url"), plan.lcm_url) << p.role;
     EXPECT_EQ(ValueOf(p.argv, "--lcm-bulk-url"), plan.lcm_bulk_url) << p.role;
+    EXPECT_EQ(ValueOf(p.argv, "--lcm-samples-url"), plan.lcm_samples_url) << p.role;
     // The monitor reads no preset; every other process the run's copy of it.
     EXPECT_EQ(ValueOf(p.argv, "--config"), p.role == "monitor" ? "" : "/runs/r/config.ini");
   }

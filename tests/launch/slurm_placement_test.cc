@@ -60,6 +60,9 @@ TEST(SlurmPlacementTest, StepsGoToTheirNodesAndTheRestStaysBesideTheLauncher) {
   const RunPlan plan = BuildRunPlan(s, {"/runs/r", 7, 23456});
   EXPECT_EQ(plan.lcm_url, "tcpq://198.18.1.11:23456");
   EXPECT_EQ(plan.lcm_bulk_url, "tcpq://198.18.1.11:23457");
+  // Through the hubs the sample replies share the bulk hub, which forwards them to the learner
+  // alone.
+  EXPECT_EQ(plan.lcm_samples_url, plan.lcm_bulk_url);
   std::vector<std::string> nodes;
   for (const PlannedProcess& p : plan.processes) {
     const std::vector<std::string> c = placement.Command(p);

@@ -135,7 +135,7 @@ class LearnerTest : public TempDirTest {
     }
     b.replay_size = 1000;
     b.total_inserts = 1234;
-    bus_->Publish(channels::kSamples, &b, Port::kBulk);
+    bus_->Publish(channels::kSamples, &b, Port::kSamples);
   }
 
   // A batch of Catch-shaped pixel transitions (stack 2 of 10 x 5 frames); transition i is
@@ -165,7 +165,7 @@ class LearnerTest : public TempDirTest {
     }
     b.replay_size = 1000;
     b.total_inserts = 4321;
-    bus_->Publish(channels::kSamples, &b, Port::kBulk);
+    bus_->Publish(channels::kSamples, &b, Port::kSamples);
   }
 
   bool pixels_ = false;
@@ -497,7 +497,7 @@ TEST_F(LearnerTest, AResumedLearnerRefusesRecordedRepliesOlderThanItsState) {
         m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
         recorded.push_back(std::move(bytes));
       },
-      Port::kBulk);
+      Port::kSamples);
   LearnerConfig c = ShortRun(16, 30, 10);
   Learner first(c, bus_.get());  // alive to the end: the bus keeps its handler
   first.Run();                   // its last checkpoint (and state) when it stops

@@ -51,7 +51,7 @@ class ReplayServiceTest : public ::testing::Test {
   ReplayServiceTest() : bus_(MemqConfig()) {
     bus_.Subscribe<rlmsg::sample_batch_t>(
         channels::kSamples, [this](const rlmsg::sample_batch_t& m) { replies_.push_back(m); },
-        Port::kBulk);
+        Port::kSamples);
     bus_.Subscribe<rlmsg::flow_control_t>(
         channels::kFlow, [this](const rlmsg::flow_control_t& m) { flows_.push_back(m); });
     bus_.Subscribe<rlmsg::stats_replay_t>(

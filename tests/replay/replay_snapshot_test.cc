@@ -65,7 +65,7 @@ class Replica {
       : bus_(InProcessBusConfig(run_id, "replay")), run_id_(run_id) {
     bus_.Subscribe<rlmsg::sample_batch_t>(
         channels::kSamples, [this](const rlmsg::sample_batch_t& m) { replies_.push_back(m); },
-        Port::kBulk);
+        Port::kSamples);
     service_ = std::make_unique<ReplayService>(&bus_, options);
   }
 
