@@ -161,7 +161,7 @@ LaunchOptions ParseLaunchArgs(const std::vector<std::string>& args) {
     o.mode = Mode::kResume;
     o.run_dir = args[at + 1];
     i = at + 2;
-  } else if (first.rfind("-", 0) == 0) {
+  } else if (first.rfind('-', 0) == 0) {
     throw LaunchError(
         "the first argument must be a preset, --resume RUN_DIR or --stop RUN_DIR, not '" + first +
         "' (see --help)");

@@ -112,7 +112,7 @@ std::string LocalTimeNow(const char* format) {
 }
 
 std::string IsoNow() {
-  const std::string s = LocalTimeNow("%Y-%m-%dT%H:%M:%S%z");
+  std::string s = LocalTimeNow("%Y-%m-%dT%H:%M:%S%z");
   if (s.size() < 5) return s;
   return s.substr(0, s.size() - 2) + ":" + s.substr(s.size() - 2);  // +0100 -> +01:00
 }
@@ -125,7 +125,7 @@ std::string CreateRunFolder(const std::string& path, bool suffix_when_taken) {
   fs::create_directories(fs::path(base).parent_path(), ec);
   if (ec) throw LaunchError("cannot create the run folder " + base + ": " + ec.message());
   for (int k = 1; k <= 1000; ++k) {
-    const std::string candidate = k == 1 ? base : base + "-" + std::to_string(k);
+    std::string candidate = k == 1 ? base : base + "-" + std::to_string(k);
     if (mkdir(candidate.c_str(), 0777) == 0) return candidate;
     if (errno != EEXIST) {
       throw LaunchError("cannot create the run folder " + candidate + ": " + ErrnoText());
