@@ -191,7 +191,9 @@ stops at once with its log (a snapshot or state it refuses, a bad option). The l
 starts with --resume and the replay with --snapshot RUN/replay-snapshot.bin, so that a restarted
 one continues. Restarts are lines of RUN/restarts, of the process's log and of the progress line.
 Should the launcher itself die (killed, a crash), its processes get SIGTERM, so that they write
-their last snapshot and state, and a watchdog kills those still running 10 s later.
+their last snapshot and state, and a watchdog kills those still running 10 s later. A stop
+(Ctrl-C, --stop, the end of the run) gives every process 10 s, and waits longer for the replay's
+last snapshot and the learner's state while their files grow (at most 10 min).
 
   PRESET                 a preset in configs/ (cartpole, ...)
   --resume RUN_DIR       continue a stopped or crashed run in its folder: its copy of the

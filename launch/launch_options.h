@@ -28,6 +28,12 @@ struct RestartLimits {
   double reset_after = 300;    // a process that ran this long before it exited starts a new count
   double startup_seconds = 3;  // an error exit this soon after a start is a startup failure
   double ready_timeout = 30;   // a process not ready this long after its start is a failure
+  // Stopping: a process still running this long after SIGTERM is killed, unless it is writing
+  // (PlannedProcess::writes_at_stop): then once its temporary file has not grown for
+  // stop_stall_seconds, or stop_write_limit after the SIGTERM.
+  double stop_seconds = 10;
+  double stop_stall_seconds = 20;
+  double stop_write_limit = 600;
 };
 
 enum class Mode { kRun, kResume, kStop, kHelp };

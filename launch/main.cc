@@ -101,8 +101,10 @@ int StopRun(const std::string& given) {
   Say(STDOUT_FILENO,
       "launch: stopping the run in " + dir + " (launcher, pid " + std::to_string(*pid) + ")\n");
   kill(*pid, SIGTERM);
-  // Its processes get 10 s to stop before they are killed, and its recorder a few more.
-  const double deadline = rl::MonoSeconds() + 60;
+  // Its processes get 10 s to stop before they are killed, those still writing their last files
+  // up to stop_write_limit, and its recorder a few seconds more.
+  const double limit = RestartLimits{}.stop_write_limit + 60;
+  const double deadline = rl::MonoSeconds() + limit;
   while (rl::MonoSeconds() < deadline) {
     if (!SameProcessAlive(*pid, start)) {
       Say(STDOUT_FILENO, "launch: stopped\n");
@@ -110,8 +112,8 @@ int StopRun(const std::string& given) {
     }
     usleep(100 * 1000);
   }
-  throw LaunchError("the run in " + dir + " has not stopped after 60 s (pid " +
-                    std::to_string(*pid) + ")");
+  throw LaunchError("the run in " + dir + " has not stopped after " +
+                    rl::FormatDouble("%.0f", limit) + " s (pid " + std::to_string(*pid) + ")");
 }
 
 // The run's folders and files before its processes start: config.ini (the header and the preset;
@@ -332,7 +334,7 @@ int Launch(LaunchOptions o) {
                                             : "ttl " + std::to_string(plan.settings.ttl)) +
           ") on " + placement.Describe() + (plan.settings.resume ? ", resumed" : "") + "\n");
   const int signal_fd = BlockRunSignals();
-  Watchdog watchdog(Supervisor::kStopSeconds);
+  Watchdog watchdog(plan.settings.limits);
   Supervisor supervisor(plan, placement, signal_fd, &watchdog);
   supervisor.OnAllReady([&plan] {
     const std::string& dir = plan.identity.run_dir;

@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "common/host_ports.h"
+#include "common/text_format.h"
 
 namespace rl::launch {
 
@@ -135,6 +136,45 @@ std::string RunAndCapture(const std::vector<std::string>& argv) {
                              (last.empty() ? "" : ": " + last));
   }
   return text[0];
+}
+
+void StopWrites::Look() {
+  namespace fs = std::filesystem;
+  files_ = 0;
+  bytes_ = 0;
+  largest_.clear();
+  largest_bytes_ = -1;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir_, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find(".tmp.") == std::string::npos) continue;
+    std::error_code size_ec;
+    const auto size = static_cast<int64_t>(entry.file_size(size_ec));
+    if (size_ec) continue;
+    ++files_;
+    bytes_ += size;
+    if (size > largest_bytes_) {
+      largest_bytes_ = size;
+      largest_ = name;
+    }
+  }
+}
+
+bool StopWrites::Changing(double now, double stall) {
+  if (now - looked_ >= 0.25) {
+    looked_ = now;
+    const int files = files_;
+    const int64_t bytes = bytes_;
+    Look();
+    if (files != files_ || bytes != bytes_) changed_ = now;
+  }
+  return changed_ >= 0 && now - changed_ < stall;
+}
+
+std::string StopWrites::Describe() const {
+  if (files_ == 0) return "";
+  return " (" + largest_ + ": " + FormatDouble("%.0f", static_cast<double>(largest_bytes_) / 1e6) +
+         " MB so far)";
 }
 
 }  // namespace rl::launch

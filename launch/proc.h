@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rl::launch {
@@ -32,6 +33,30 @@ bool HoldsFileOpen(pid_t pid, const std::string& path);
 
 /// Whether a TCP socket of this network namespace listens on `port` (/proc/net/tcp and tcp6).
 bool ListensOnTcp(int port);
+
+/// Watches a folder where a stopping process writes files atomically (NAME.tmp.<pid>, renamed
+/// when complete: the replay's last snapshot, the learner's state), so that a stop can wait for a
+/// write that is under way and still kill a process that hangs.
+class StopWrites {
+ public:
+  explicit StopWrites(std::string dir) : dir_(std::move(dir)) { Look(); }
+  /// Looks at the folder again (at most every 0.25 s) and returns whether its temporary files
+  /// changed (one appeared, grew or went) within `stall` seconds of `now` (MonoSeconds()).
+  bool Changing(double now, double stall);
+  /// " (NAME: N MB so far)" for the largest temporary file, "" when there is none.
+  std::string Describe() const;
+
+ private:
+  void Look();
+
+  std::string dir_;
+  int files_ = 0;
+  int64_t bytes_ = 0;
+  std::string largest_;
+  int64_t largest_bytes_ = 0;
+  double looked_ = -1;   // when it last looked
+  double changed_ = -1;  // when it last saw a change (< 0: never)
+};
 
 /// The directory of the running executable (/proc/self/exe).
 std::string ExecutableDir();

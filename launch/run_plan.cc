@@ -180,11 +180,13 @@ RunPlan BuildRunPlan(const RunSettings& settings, const RunIdentity& identity) {
   PlannedProcess replay = OurProcess(plan, "replay", "replay");
   replay.argv.insert(replay.argv.end(),
                      {"--seed", seed, "--snapshot", dir + "/replay-snapshot.bin"});
+  replay.writes_at_stop = dir;
   AddExtra(settings, &replay);
   plan.processes.push_back(replay);
 
   PlannedProcess learner = OurProcess(plan, "learner", "learner");
   learner.argv.insert(learner.argv.end(), {"--out", dir, "--seed", seed, "--resume"});
+  learner.writes_at_stop = dir + "/checkpoints";
   AddExtra(settings, &learner);
   plan.processes.push_back(learner);
 

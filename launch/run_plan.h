@@ -45,6 +45,10 @@ struct PlannedProcess {
   bool shown = false;     // its output is also the launcher's (the monitor's progress line)
   bool stops_last = false;  // stopped after every other process (the recorder, to record them
                             // all; then the TCP hubs, which carry what it records)
+  // A folder where it writes files atomically (NAME.tmp.<pid>, then renamed) as it stops: the
+  // replay its last snapshot, the learner its checkpoint and state. While such a file there
+  // grows, its stop is waited for beyond the usual seconds (RestartLimits::stop_stall_seconds).
+  std::string writes_at_stop;
 };
 
 /// What a run's plan is built from, resolved from the command line, the preset and, when

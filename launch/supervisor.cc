@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 
 #include "common/clock.h"
@@ -147,6 +148,10 @@ struct Supervisor::Proc {
   bool down = false;       // not to be started again
   bool termed = false;     // stopping: SIGTERM sent
   bool killed = false;     // stopping: SIGKILL sent
+  // Stopping, for a process that writes as it stops: its folder's temporary files, and when the
+  // launcher last said that it waits for them.
+  std::optional<StopWrites> writes;
+  double told_at = -1e9;
 };
 
 int ExitStatusOf(RunEnd end) {
@@ -197,7 +202,7 @@ Supervisor::~Supervisor() {
   for (Proc& p : procs_) {
     if (p.pid > 0) kill(p.pid, placement_.StopSignal(*p.plan));
   }
-  const double deadline = MonoSeconds() + kStopSeconds;
+  const double deadline = MonoSeconds() + plan_.settings.limits.stop_seconds;
   while (AnyRunning(true) || AnyRunning(false)) {
     int status = 0;
     const pid_t pid = waitpid(-1, &status, WNOHANG);
@@ -256,7 +261,7 @@ void Supervisor::Start(Proc* p) {
   p->ready = planned.ready.kind == Readiness::kAtStart;
   p->restart_at = -1;
   AppendToFile(plan_.identity.run_dir + "/pids", planned.role + " " + std::to_string(pid) + "\n");
-  if (watchdog_ != nullptr) watchdog_->Watch(pid, planned.role);
+  if (watchdog_ != nullptr) watchdog_->Watch(pid, planned.role, planned.writes_at_stop);
 }
 
 void Supervisor::Fail(Proc* p, const std::string& why) {
@@ -400,9 +405,25 @@ void Supervisor::BeginStop(RunEnd end) {
     if (p.pid > 0 && !p.plan->stops_last) {
       kill(p.pid, placement_.StopSignal(*p.plan));
       p.termed = true;
+      if (!p.plan->writes_at_stop.empty()) p.writes.emplace(p.plan->writes_at_stop);
     }
   }
-  stop_deadline_ = MonoSeconds() + kStopSeconds;
+  stop_began_ = MonoSeconds();
+  stop_deadline_ = stop_began_ + plan_.settings.limits.stop_seconds;
+}
+
+bool Supervisor::StillWriting(Proc* p, double now) {
+  const RestartLimits& limits = plan_.settings.limits;
+  if (!p->writes || now >= stop_began_ + limits.stop_write_limit ||
+      !p->writes->Changing(now, limits.stop_stall_seconds)) {
+    return false;
+  }
+  if (now >= stop_deadline_ && now - p->told_at >= 10) {
+    p->told_at = now;
+    Tell(p, "launch: " + p->plan->role + " is still writing" + p->writes->Describe() +
+                "; waiting for it");
+  }
+  return true;
 }
 
 bool Supervisor::AnyRunning(bool last) const {
@@ -415,13 +436,12 @@ bool Supervisor::AnyRunning(bool last) const {
 void Supervisor::AdvanceStop(double now) {
   if (phase_ == Phase::kStopping) {
     if (AnyRunning(false)) {
-      if (now < stop_deadline_) return;
       for (Proc& p : procs_) {
-        if (p.pid > 0 && !p.plan->stops_last && !p.killed) {
-          Tell(&p, "launch: " + p.plan->role + " did not stop; killing it");
-          kill(p.pid, SIGKILL);
-          p.killed = true;
-        }
+        if (p.pid <= 0 || p.plan->stops_last || p.killed) continue;
+        if (StillWriting(&p, now) || now < stop_deadline_) continue;
+        Tell(&p, "launch: " + p.plan->role + " did not stop; killing it");
+        kill(p.pid, SIGKILL);
+        p.killed = true;
       }
       return;
     }

@@ -53,7 +53,8 @@ class Supervisor {
   /// `plan`, `placement` and `watchdog` must outlive the supervisor; `signal_fd` is
   /// BlockRunSignals()'s.
   Supervisor(const RunPlan& plan, const Placement& placement, int signal_fd, Watchdog* watchdog);
-  /// Stops every process still running (SIGTERM, 10 s, SIGKILL) and reaps it: an exception in the
+  /// Stops every process still running (SIGTERM; SIGKILL after RestartLimits::stop_seconds) and
+  /// reaps it: an exception in the
   /// launcher leaves nothing behind.
   ~Supervisor();
   Supervisor(const Supervisor&) = delete;
@@ -62,13 +63,11 @@ class Supervisor {
   /// Called once, when every process that starts before the monitor is ready.
   void OnAllReady(std::function<void()> callback) { on_all_ready_ = std::move(callback); }
 
-  /// Starts the run, supervises it until it is over, stops every process (SIGTERM to all; 10 s
-  /// later SIGKILL; the recorder last, once what the others sent is written) and returns how
-  /// the run ended.
+  /// Starts the run, supervises it until it is over, stops every process (SIGTERM to all;
+  /// RestartLimits::stop_seconds later SIGKILL, except to a process still writing its last
+  /// files, PlannedProcess::writes_at_stop; the recorder last, once what the others sent is
+  /// written) and returns how the run ended.
   RunEnd Run();
-
-  /// Seconds a process has to stop after SIGTERM before it is killed.
-  static constexpr double kStopSeconds = 10;
 
  private:
   struct Proc;
@@ -81,6 +80,10 @@ class Supervisor {
   void StartNextInOrder();
   void BeginStop(RunEnd end);
   void AdvanceStop(double now);
+  // Stopping, past the usual seconds: whether `p` is still writing its last files (a temporary
+  // file of writes_at_stop changed within stop_stall_seconds, and stop_write_limit not reached).
+  // Past stop_seconds, says so every 10 s.
+  bool StillWriting(Proc* p, double now);
   void ForwardShownOutput();
   void HandleSignals();
   double NextWakeup(double now) const;
@@ -98,6 +101,7 @@ class Supervisor {
   size_t next_ = 0;  // the next process to start in order
   Phase phase_ = Phase::kRunning;
   RunEnd end_ = RunEnd::kNotReached;
+  double stop_began_ = 0;
   double stop_deadline_ = 0;
   double last_check_ = 0;
   int64_t recorded_bytes_ = -1;

@@ -10,6 +10,7 @@
 #include <csignal>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -25,13 +26,15 @@ struct Watched {
   pid_t pid = 0;
   uint64_t start = 0;
   std::string role;
+  std::string writes_at_stop;
 };
 
 void Say(const std::string& line) { (void)!write(STDERR_FILENO, line.data(), line.size()); }
 
-// The watchdog process: reads "PID START ROLE" lines until the launcher's end of the pipe closes,
-// then gives the processes `grace` seconds to stop and SIGKILLs those still running.
-[[noreturn]] void WatchdogMain(int fd, double grace) {
+// The watchdog process: reads "PID START ROLE [FOLDER]" lines until the launcher's end of the pipe
+// closes, then gives the processes limits.stop_seconds to stop (more to one still writing its last
+// files in FOLDER) and SIGKILLs those still running.
+[[noreturn]] void WatchdogMain(int fd, const RestartLimits& limits) {
   prctl(PR_SET_NAME, "launch-watchdog");
   for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE}) signal(sig, SIG_IGN);
   sigset_t none;
@@ -59,32 +62,45 @@ void Say(const std::string& line) { (void)!write(STDERR_FILENO, line.data(), lin
       std::istringstream line(pending.substr(0, eol));
       pending.erase(0, eol + 1);
       Watched w;
-      if (line >> w.pid >> w.start >> w.role) watched.push_back(w);
+      if (!(line >> w.pid >> w.start >> w.role)) continue;
+      line.get();  // the space before the folder
+      std::getline(line, w.writes_at_stop);
+      watched.push_back(w);
     }
   }
   // The launcher is gone (or done): wait for the processes, then kill the ones left.
-  const double deadline = MonoSeconds() + grace;
+  const double start = MonoSeconds();
+  std::vector<std::optional<StopWrites>> writes(watched.size());
+  for (size_t i = 0; i < watched.size(); ++i) {
+    if (!watched[i].writes_at_stop.empty()) writes[i].emplace(watched[i].writes_at_stop);
+  }
   for (;;) {
-    std::vector<const Watched*> alive;
-    for (const Watched& w : watched) {
-      if (SameProcessAlive(w.pid, w.start)) alive.push_back(&w);
-    }
-    if (alive.empty()) _exit(0);
-    if (MonoSeconds() >= deadline) {
-      for (const Watched* w : alive) {
-        kill(w->pid, SIGKILL);
-        Say("launch: the launcher is gone; killed " + w->role + " (pid " + std::to_string(w->pid) +
-            "), still running " + FormatDouble("%g", grace) + " s after\n");
+    const double now = MonoSeconds();
+    bool alive = false;
+    for (size_t i = 0; i < watched.size(); ++i) {
+      Watched& w = watched[i];
+      if (w.pid == 0) continue;
+      if (!SameProcessAlive(w.pid, w.start)) {
+        w.pid = 0;
+        continue;
       }
-      _exit(0);
+      alive = true;
+      const bool writing = writes[i] && now < start + limits.stop_write_limit &&
+                           writes[i]->Changing(now, limits.stop_stall_seconds);
+      if (writing || now < start + limits.stop_seconds) continue;
+      kill(w.pid, SIGKILL);
+      Say("launch: the launcher is gone; killed " + w.role + " (pid " + std::to_string(w.pid) +
+          "), still running " + FormatDouble("%.0f", now - start) + " s after\n");
+      w.pid = 0;
     }
+    if (!alive) _exit(0);
     poll(nullptr, 0, 100);
   }
 }
 
 }  // namespace
 
-Watchdog::Watchdog(double grace_seconds) {
+Watchdog::Watchdog(const RestartLimits& limits) {
   int fds[2];
   if (pipe2(fds, O_CLOEXEC) != 0) {
     throw std::runtime_error("cannot make the watchdog's pipe: " + std::string(strerror(errno)));
@@ -92,7 +108,7 @@ Watchdog::Watchdog(double grace_seconds) {
   const pid_t child = fork();
   if (child == 0) {
     close(fds[1]);
-    if (fork() == 0) WatchdogMain(fds[0], grace_seconds);
+    if (fork() == 0) WatchdogMain(fds[0], limits);
     _exit(0);
   }
   close(fds[0]);
@@ -109,9 +125,9 @@ Watchdog::~Watchdog() {
   if (fd_ >= 0) close(fd_);
 }
 
-void Watchdog::Watch(pid_t pid, const std::string& role) {
-  const std::string line =
-      std::to_string(pid) + " " + std::to_string(ProcessStartTime(pid)) + " " + role + "\n";
+void Watchdog::Watch(pid_t pid, const std::string& role, const std::string& writes_at_stop) {
+  const std::string line = std::to_string(pid) + " " + std::to_string(ProcessStartTime(pid)) + " " +
+                           role + " " + writes_at_stop + "\n";
   (void)!write(fd_, line.data(), line.size());
 }
 

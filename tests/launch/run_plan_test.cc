@@ -113,7 +113,11 @@ TEST(RunPlanTest, LearnerResumesAndReplayKeepsItsSnapshotAlways) {
   EXPECT_TRUE(Has(learner.argv, "--resume"));
   EXPECT_EQ(ValueOf(learner.argv, "--out"), "/runs/r");
   EXPECT_EQ(ValueOf(Find(plan, "replay").argv, "--snapshot"), "/runs/r/replay-snapshot.bin");
+  // Where they write as they stop, which a stop waits for while it grows.
+  EXPECT_EQ(Find(plan, "replay").writes_at_stop, "/runs/r");
+  EXPECT_EQ(learner.writes_at_stop, "/runs/r/checkpoints");
   const PlannedProcess& evaluator = Find(plan, "evaluator");
+  EXPECT_EQ(evaluator.writes_at_stop, "");
   EXPECT_EQ(ValueOf(evaluator.argv, "--out"), "/runs/r");
   EXPECT_EQ(ValueOf(evaluator.argv, "--run-config"), "/runs/r/config.ini");
 }

@@ -58,6 +58,23 @@ class SupervisorTest : public ::testing::Test {
     p.shown = true;
   }
 
+  // A process that, on SIGTERM, writes its last file in DIR/ROLE (writes_at_stop) atomically, a
+  // line every 0.1 s for `seconds`, then renames it to last.bin and exits; or, `hangs`, starts the
+  // file and then hangs.
+  void AddStopWriter(const std::string& role, double seconds, bool hangs) {
+    const std::string folder = dir_ + "/" + role;
+    fs::create_directories(folder);
+    const std::string tmp = folder + "/last.bin.tmp.$$";
+    const std::string on_term = hangs ? "echo x > " + tmp + "; while :; do sleep 0.1; done"
+                                      : "for i in $(seq " +
+                                            std::to_string(static_cast<int>(seconds * 10)) +
+                                            "); do echo x >> " + tmp + "; sleep 0.1; done; mv " +
+                                            tmp + " " + folder + "/last.bin; exit 0";
+    AddShell(role,
+             "trap '" + on_term + "' TERM; echo " + role + ": ready; while :; do sleep 0.1; done");
+    plan_.processes.back().writes_at_stop = folder;
+  }
+
   // Runs the supervisor in this process with its output in files; returns how the run ended.
   RunEnd RunHere(double* seconds) {
     const int saved_out = dup(STDOUT_FILENO), saved_err = dup(STDERR_FILENO);
@@ -89,7 +106,9 @@ class SupervisorTest : public ::testing::Test {
       dup2(null, STDOUT_FILENO);
       dup2(null, STDERR_FILENO);
       const int signal_fd = BlockRunSignals();
-      Watchdog watchdog(grace);
+      RestartLimits limits = plan_.settings.limits;
+      limits.stop_seconds = grace;
+      Watchdog watchdog(limits);
       Supervisor supervisor(plan_, placement_, signal_fd, &watchdog);
       _exit(ExitStatusOf(supervisor.Run()));
     }
@@ -188,6 +207,39 @@ TEST_F(SupervisorTest, WhenTheLauncherIsKilledItsProcessesStopAndTheStuckOnesAre
   waitpid(launcher, nullptr, 0);
   EXPECT_TRUE(AllEnd(pids, 5)) << "a process outlived its launcher";
   EXPECT_TRUE(fs::exists(dir_ + "/polite.stopped")) << "no SIGTERM for a clean stop";
+}
+
+TEST_F(SupervisorTest, AStopWaitsForALastFileBeingWrittenAndKillsAWriterThatHangs) {
+  plan_.settings.limits.stop_seconds = 1;
+  plan_.settings.limits.stop_stall_seconds = 2;
+  AddStopWriter("writer", /*seconds=*/4, /*hangs=*/false);
+  AddStopWriter("hung", 0, /*hangs=*/true);
+  AddEnder("echo 'monitor: goal reached'; sleep 0.5; exit 0");
+  double seconds = 0;
+  EXPECT_EQ(RunHere(&seconds), RunEnd::kGoalReached);
+  EXPECT_TRUE(fs::exists(dir_ + "/writer/last.bin")) << "killed while it was writing";
+  const std::string err = ReadFile(dir_ + "/err");
+  EXPECT_NE(err.find("launch: writer is still writing (last.bin.tmp."), std::string::npos) << err;
+  EXPECT_EQ(err.find("launch: writer did not stop"), std::string::npos) << err;
+  // Its file stopped changing when it started it: killed once the stall had lasted.
+  EXPECT_NE(err.find("launch: hung did not stop; killing it"), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(dir_ + "/hung/last.bin"));
+  EXPECT_GE(seconds, 4);
+}
+
+TEST_F(SupervisorTest, WhenTheLauncherIsKilledTheWatchdogWaitsForALastFileBeingWritten) {
+  plan_.settings.limits.stop_stall_seconds = 2;
+  AddStopWriter("writer", /*seconds=*/4, /*hangs=*/false);
+  AddStopWriter("hung", 0, /*hangs=*/true);
+  AddEnder("exec sleep 60");
+  const pid_t launcher = LaunchInChild(/*grace=*/1);
+  const std::map<std::string, pid_t> pids = Pids();
+  ASSERT_EQ(pids.size(), 3u);
+  kill(launcher, SIGKILL);
+  waitpid(launcher, nullptr, 0);
+  EXPECT_TRUE(AllEnd(pids, 30)) << "a process outlived its launcher";
+  EXPECT_TRUE(fs::exists(dir_ + "/writer/last.bin")) << "killed while it was writing";
+  EXPECT_FALSE(fs::exists(dir_ + "/hung/last.bin"));
 }
 
 TEST_F(SupervisorTest, AHangUpStopsTheRunInOrder) {
