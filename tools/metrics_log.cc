@@ -10,8 +10,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <stdexcept>
 #include <string_view>
+#include <utility>
 
 #include "common/messages.h"
 #include "evaluator/json_line.h"
@@ -131,6 +133,25 @@ double LastT(const std::string& path) {
 }
 
 }  // namespace
+
+int64_t ActorEpisodes(const std::string& path) {
+  std::ifstream in(path);
+  std::map<std::string, std::pair<int64_t, int64_t>> by_role;  // {earlier lives, this life}
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto object = ParseJsonLine(line);
+    if (!object) continue;
+    const auto role = JsonStringAt(*object, "role");
+    const auto episodes = JsonIntegerAt(*object, "episodes");
+    if (!role || role->rfind("actor-", 0) != 0 || !episodes) continue;
+    auto& [earlier, current] = by_role[*role];
+    if (*episodes < current) earlier += current;
+    current = *episodes;
+  }
+  int64_t total = 0;
+  for (const auto& [role, counts] : by_role) total += counts.first + counts.second;
+  return total;
+}
 
 MetricsLog::MetricsLog(const std::string& path, double dense_seconds, double dense_period,
                        double sparse_period)

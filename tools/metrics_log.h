@@ -11,6 +11,7 @@
 // hour after that, per role).
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "rlmsg/stats_actor_t.hpp"
@@ -28,6 +29,12 @@ std::string MetricsLine(double t, const rlmsg::stats_actor_t& s, double age = 0)
 std::string MetricsLine(double t, const rlmsg::stats_replay_t& s, double age = 0);
 std::string MetricsLine(double t, const rlmsg::stats_learner_t& s, double age = 0);
 std::string MetricsLine(double t, const rlmsg::stats_evaluator_t& s, double age = 0);
+
+/// The episodes that the actors of the metrics file at `path` ran, all their lives together: for
+/// each actor role, the count of its last line plus the count before each drop (a restarted actor
+/// counts from 0 again). 0 for a missing file; lines that are not JSON are passed over. A resumed
+/// run's monitor starts its episode count from it.
+int64_t ActorEpisodes(const std::string& path);
 
 class MetricsLog {
  public:

@@ -4,8 +4,9 @@
 // exits when the run is over: 0 when an evaluation reached the goal, 1 when the time budget ran
 // out, 3 when the replay, the learner or the evaluator went silent, 130 on SIGINT/SIGTERM. With
 // --metrics FILE it also appends the stats of every process to FILE as a time series
-// (tools/metrics_log.h); with --history FILE (the run's eval.jsonl) a resumed run's progress line
-// starts from the evaluations of its earlier parts.
+// (tools/metrics_log.h), and a resumed run's episode count starts from the file's; with --history
+// FILE (the run's eval.jsonl) a resumed run's progress line starts from the evaluations of its
+// earlier parts.
 #include <unistd.h>
 
 #include <algorithm>
@@ -43,6 +44,9 @@ struct View {
   // replay (actor/actor.h), which may lack the batch it had on the way when it died, so the
   // total never goes back.
   std::map<std::string, int64_t> actor_steps;
+  // Episodes of the actors' earlier lives: those of a resumed run's earlier parts (from its
+  // metrics file) and those of an actor restarted since, whose count starts again at 0.
+  int64_t earlier_episodes = 0;
   rlmsg::stats_replay_t replay{};
   rlmsg::stats_learner_t learner{};
   rlmsg::stats_evaluator_t evaluator{};
@@ -92,7 +96,7 @@ void LoadHistory(const std::string& path, View* v) {
 }
 
 std::string ProgressLine(const View& v, double elapsed, double now, int64_t restarts = 0) {
-  int64_t steps = 0, episodes = 0, lost = 0, dropped = 0;
+  int64_t steps = 0, episodes = v.earlier_episodes, lost = 0, dropped = 0;
   double ret = 0;
   int live = 0, paused = 0;
   for (const auto& [name, a] : v.actors) {
@@ -148,7 +152,7 @@ int Main(int argc, char** argv) {
        "seconds between progress lines")  //
       ("metrics", rl::po::value(&metrics_path),
        "append every process's stats to this file as JSON lines (a row a second for the first "
-       "hour, then every 10 s)")  //
+       "hour, then every 10 s); the progress line's episodes count on from its rows")  //
       ("restarts", rl::po::value(&restarts_path),
        "the launch script's file of restarted processes (a line each): their count joins the "
        "progress line")  //
@@ -165,17 +169,24 @@ int Main(int argc, char** argv) {
   }
   rl::InstallStopHandlers();
   std::unique_ptr<rl::tools::MetricsLog> metrics;
-  if (!metrics_path.empty()) metrics = std::make_unique<rl::tools::MetricsLog>(metrics_path);
-  rl::Bus bus(common.MakeBusConfig("monitor"));
   View v;
+  if (!metrics_path.empty()) {
+    v.earlier_episodes = rl::tools::ActorEpisodes(metrics_path);
+    metrics = std::make_unique<rl::tools::MetricsLog>(metrics_path);
+  }
+  rl::Bus bus(common.MakeBusConfig("monitor"));
   if (!history_path.empty()) LoadHistory(history_path, &v);
-  bus.Subscribe<rlmsg::stats_actor_t>(rl::channels::kStatsActor,
-                                      [&v](const rlmsg::stats_actor_t& s) {
-                                        v.actors[s.header.sender] = s;
-                                        v.actor_seen[s.header.sender] = rl::MonoSeconds();
-                                        int64_t& steps = v.actor_steps[s.header.sender];
-                                        steps = std::max(steps, s.env_steps);
-                                      });
+  bus.Subscribe<rlmsg::stats_actor_t>(
+      rl::channels::kStatsActor, [&v](const rlmsg::stats_actor_t& s) {
+        const auto known = v.actors.find(s.header.sender);
+        if (known != v.actors.end() && s.episodes < known->second.episodes) {
+          v.earlier_episodes += known->second.episodes;
+        }
+        v.actors[s.header.sender] = s;
+        v.actor_seen[s.header.sender] = rl::MonoSeconds();
+        int64_t& steps = v.actor_steps[s.header.sender];
+        steps = std::max(steps, s.env_steps);
+      });
   bus.Subscribe<rlmsg::stats_replay_t>(rl::channels::kStatsReplay,
                                        [&v](const rlmsg::stats_replay_t& s) {
                                          v.replay = s;

@@ -116,6 +116,23 @@ TEST_F(MetricsLogTest, TheLastTPassesOverLinesThatAreNotWholeRows) {
   EXPECT_EQ(MetricsLog(path_.string()).last_t(), 8.5);
 }
 
+TEST_F(MetricsLogTest, ActorEpisodesCountEveryLifeOfEveryActor) {
+  EXPECT_EQ(ActorEpisodes(path_.string()), 0);  // no file: a new run
+  {
+    std::ofstream out(path_);
+    out << "{\"t\": 1, \"role\": \"actor-0\", \"episodes\": 5}\n"
+        << "{\"t\": 1, \"role\": \"actor-1\", \"episodes\": 3}\n"
+        << "{\"t\": 1, \"role\": \"evaluator\", \"episodes\": 100}\n"  // not an actor's
+        << "{\"t\": 2, \"role\": \"actor-0\", \"episodes\": 9}\n"
+        << "{\"t\": 3, \"role\": \"actor-0\", \"episodes\": 2}\n"  // restarted after 9
+        << "not json\n"
+        << "{\"t\": 4, \"role\": \"actor-0\", \"episodes\": 4}\n"
+        << "{\"t\": 4, \"role\": \"actor-1\", \"episodes\": 7}\n"
+        << "{\"t\": 5, \"role\": \"actor-1\", \"epis";  // cut short
+  }
+  EXPECT_EQ(ActorEpisodes(path_.string()), 9 + 4 + 7);
+}
+
 TEST_F(MetricsLogTest, AnUnwritablePathIsRefusedWithItsName) {
   const std::string bad = (path_.parent_path() / "no_such_dir" / "m.jsonl").string();
   try {

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The monitor's --history: a resumed run's progress line starts from the evaluations of its earlier
 # parts (the last one scored and the best), before anything new is heard; a torn line of the file
-# is skipped and counted. Usage: monitor_history.sh MONITOR_BINARY
+# is skipped and counted. And with --metrics, its episodes count on from the metrics file's rows.
+# Usage: monitor_history.sh MONITOR_BINARY
 set -euo pipefail
 monitor=$1
 dir=$(mktemp -d)
@@ -35,4 +36,14 @@ grep -q 'eval -  learner' "$dir/without" || fail "a monitor without history show
 run_monitor "$dir/missing" --history "$dir/none.jsonl"
 grep -q 'eval -  learner' "$dir/missing" || fail "a missing history showed an evaluation"
 [ ! -s "$dir/missing.err" ] || fail "a missing history was complained about: $(cat "$dir/missing.err")"
-echo "PASS: $lines progress lines from the history (last 659.7, best 742.6), the torn line counted"
+# The metrics of earlier parts: actor-0 ran 40 episodes, was restarted and ran 12; actor-1 ran 30.
+cat > "$dir/metrics.jsonl" <<'LINES'
+{"t": 10, "role": "actor-0", "env_steps": 9000, "episodes": 40}
+{"t": 10, "role": "actor-1", "env_steps": 8000, "episodes": 30}
+{"t": 20, "role": "actor-0", "env_steps": 9500, "episodes": 12}
+LINES
+run_monitor "$dir/metrics" --metrics "$dir/metrics.jsonl"
+grep -q '\] steps 0  episodes 82  return' "$dir/metrics" ||
+  fail "the episodes of the earlier parts were not counted: $(cat "$dir/metrics")"
+echo "PASS: $lines progress lines from the history (last 659.7, best 742.6), the torn line" \
+  "counted; 82 episodes from the metrics file"
