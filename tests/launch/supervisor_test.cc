@@ -194,19 +194,26 @@ TEST_F(SupervisorTest, ACrashedProcessIsRestartedAndTheRestartSaysHowItDied) {
 }
 
 TEST_F(SupervisorTest, WhenTheLauncherIsKilledItsProcessesStopAndTheStuckOnesAreKilled) {
-  // One that stops cleanly on SIGTERM (as every program of a run does), one that ignores it.
+  // One that stops cleanly on SIGTERM (as every program of a run does), one that ignores it; one
+  // that writes its last file for 4 s (the watchdog waits for it past its 1 s), one that starts
+  // it and hangs (killed once it has not changed for 2 s).
   AddShell("polite", "trap 'echo stopped > " + dir_ +
                          "/polite.stopped; exit 0' TERM; "
                          "echo polite: ready; while :; do sleep 0.1; done");
   AddShell("stubborn", "trap '' TERM; echo stubborn: ready; exec sleep 60");
+  plan_.settings.limits.stop_stall_seconds = 2;
+  AddStopWriter("writer", /*seconds=*/4, /*hangs=*/false);
+  AddStopWriter("hung", 0, /*hangs=*/true);
   AddEnder("exec sleep 60");
   const pid_t launcher = LaunchInChild(/*grace=*/1);
   const std::map<std::string, pid_t> pids = Pids();
-  ASSERT_EQ(pids.size(), 3u);
+  ASSERT_EQ(pids.size(), 5u);
   kill(launcher, SIGKILL);
   waitpid(launcher, nullptr, 0);
-  EXPECT_TRUE(AllEnd(pids, 5)) << "a process outlived its launcher";
+  EXPECT_TRUE(AllEnd(pids, 30)) << "a process outlived its launcher";
   EXPECT_TRUE(fs::exists(dir_ + "/polite.stopped")) << "no SIGTERM for a clean stop";
+  EXPECT_TRUE(fs::exists(dir_ + "/writer/last.bin")) << "killed while it was writing";
+  EXPECT_FALSE(fs::exists(dir_ + "/hung/last.bin"));
 }
 
 TEST_F(SupervisorTest, AStopWaitsForALastFileBeingWrittenAndKillsAWriterThatHangs) {
@@ -225,21 +232,6 @@ TEST_F(SupervisorTest, AStopWaitsForALastFileBeingWrittenAndKillsAWriterThatHang
   EXPECT_NE(err.find("launch: hung did not stop; killing it"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(dir_ + "/hung/last.bin"));
   EXPECT_GE(seconds, 4);
-}
-
-TEST_F(SupervisorTest, WhenTheLauncherIsKilledTheWatchdogWaitsForALastFileBeingWritten) {
-  plan_.settings.limits.stop_stall_seconds = 2;
-  AddStopWriter("writer", /*seconds=*/4, /*hangs=*/false);
-  AddStopWriter("hung", 0, /*hangs=*/true);
-  AddEnder("exec sleep 60");
-  const pid_t launcher = LaunchInChild(/*grace=*/1);
-  const std::map<std::string, pid_t> pids = Pids();
-  ASSERT_EQ(pids.size(), 3u);
-  kill(launcher, SIGKILL);
-  waitpid(launcher, nullptr, 0);
-  EXPECT_TRUE(AllEnd(pids, 30)) << "a process outlived its launcher";
-  EXPECT_TRUE(fs::exists(dir_ + "/writer/last.bin")) << "killed while it was writing";
-  EXPECT_FALSE(fs::exists(dir_ + "/hung/last.bin"));
 }
 
 TEST_F(SupervisorTest, AHangUpStopsTheRunInOrder) {
