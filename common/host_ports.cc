@@ -1,6 +1,7 @@
 #include "common/host_ports.h"
 
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -24,6 +25,22 @@ int SocketsOnPort(std::string_view protocol, int port, std::string_view state) {
     }
   }
   return count;
+}
+
+bool RunPortsInUse(int port) {
+  return SocketsOnPort("udp", port) + SocketsOnPort("udp", port + 1) +
+             SocketsOnPort("udp", port + 2) >
+         0;
+}
+
+int PickRunPorts(int tries) {
+  std::random_device device;
+  std::uniform_int_distribution<int> pick(0, 13332);
+  for (int attempt = 0; attempt < tries; ++attempt) {
+    const int port = 20000 + 3 * pick(device);
+    if (!RunPortsInUse(port)) return port;
+  }
+  return 0;
 }
 
 }  // namespace rl

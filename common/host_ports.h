@@ -11,4 +11,11 @@ namespace rl {
 /// in `state` unless it is empty (/proc's hex code: "0A" is a TCP socket listening).
 int SocketsOnPort(std::string_view protocol, int port, std::string_view state = "");
 
+/// Whether one of a run's three UDP ports (P, P + 1, P + 2: main, bulk, samples) is bound here.
+bool RunPortsInUse(int port);
+
+/// A run's three free UDP ports: P in [20000, 60000), a multiple of 3 from 20000 (so that two
+/// picks never overlap), drawn at random up to `tries` times; 0 when every draw was in use.
+int PickRunPorts(int tries);
+
 }  // namespace rl

@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <random>
 #include <set>
 #include <sstream>
 #include <string>
@@ -49,24 +48,11 @@ std::string ReadText(const std::string& path) {
 // Opens `path` with `mode` and closes it: empty (trunc), or there as it was (app).
 void Touch(const std::string& path, std::ios::openmode mode) { std::ofstream file(path, mode); }
 
-// Whether a UDP socket of this host is bound to `port`.
-bool PortInUse(int port) { return rl::SocketsOnPort("udp", port) > 0; }
-
-// Whether one of a run's UDP ports (P, P + 1, P + 2: main, bulk, samples) is bound on this host.
-bool RunPortsInUse(int port) {
-  return PortInUse(port) || PortInUse(port + 1) || PortInUse(port + 2);
-}
-
-// Three free UDP ports (P, P + 1, P + 2), P in [20000, 60000) and a multiple of 3 from 20000, so
-// that two picks never overlap: only the port isolates two runs on one host.
+// A run's three free UDP ports (rl::PickRunPorts).
 int PickFreePort() {
-  std::random_device device;
-  std::uniform_int_distribution<int> pick(0, 13332);
-  for (int attempt = 0; attempt < 100; ++attempt) {
-    const int port = 20000 + 3 * pick(device);
-    if (!RunPortsInUse(port)) return port;
-  }
-  throw LaunchError("no three free UDP ports found in 100 tries (pass --port)");
+  const int port = rl::PickRunPorts(100);
+  if (port == 0) throw LaunchError("no three free UDP ports found in 100 tries (pass --port)");
+  return port;
 }
 
 bool OnPath(const std::string& program) {
@@ -313,7 +299,7 @@ int Launch(LaunchOptions o) {
     id.run_id = in.resumed->run_id;
     // The resumed run keeps its port, so that its config.ini and scripts/spy.sh stay right.
     id.port = o.port.value_or(in.resumed->Port());
-    if (!o.port && !slurm && (id.port == 0 || RunPortsInUse(id.port))) {
+    if (!o.port && !slurm && (id.port == 0 || rl::RunPortsInUse(id.port))) {
       throw LaunchError("the run's LCM port " + std::to_string(id.port) +
                         " is in use: is the run still going? (or pass --port)");
     }

@@ -54,5 +54,25 @@ TEST(SocketsOnPortTest, CountsTheSocketsOfAPortByProtocolAndState) {
   EXPECT_EQ(SocketsOnPort("tcp", tcp_port, "0A"), 0);
 }
 
+TEST(RunPortsTest, ARunsThreePortsAreInUseWhenAnyIsAndAPickAvoidsThem) {
+  BoundSocket udp(SOCK_DGRAM);
+  const int p = udp.port();
+  // A run on p - 2, p - 1 or p would share the bound port; one on p + 1 would not (unless another
+  // socket of this host happens to hold p + 1 .. p + 3).
+  EXPECT_TRUE(RunPortsInUse(p));
+  EXPECT_TRUE(RunPortsInUse(p - 1));
+  EXPECT_TRUE(RunPortsInUse(p - 2));
+  if (SocketsOnPort("udp", p + 1) + SocketsOnPort("udp", p + 2) + SocketsOnPort("udp", p + 3) ==
+      0) {
+    EXPECT_FALSE(RunPortsInUse(p + 1));
+  }
+  const int picked = PickRunPorts(10);
+  ASSERT_NE(picked, 0) << "ten draws all in use";
+  EXPECT_GE(picked, 20000);
+  EXPECT_LT(picked + 2, 60000);
+  EXPECT_EQ((picked - 20000) % 3, 0);
+  EXPECT_FALSE(RunPortsInUse(picked));
+}
+
 }  // namespace
 }  // namespace rl

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <random>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -631,26 +630,12 @@ TEST(MessageTableTest, RefusesAnotherTypeOrPortOnAChannelOfTheTable) {
   EXPECT_TRUE(bus.Publish("TEST_CHANNEL", &c));
 }
 
-// Three free UDP ports from a random one (0 when the first tries are taken).
-int FreePorts() {
-  std::random_device device;
-  for (int attempt = 0; attempt < 10; ++attempt) {
-    const int port = 20000 + 3 * std::uniform_int_distribution<int>(0, 13332)(device);
-    if (SocketsOnPort("udp", port) + SocketsOnPort("udp", port + 1) +
-            SocketsOnPort("udp", port + 2) ==
-        0) {
-      return port;
-    }
-  }
-  return 0;
-}
-
 // A bus binds (and joins the multicast group of) only the ports it subscribes on, when it handles
 // traffic: a process with no use for the bulk port (the monitor, the evaluator, the replay, which
 // only publishes there) must not receive the run's weights only to drop them, and one with no
 // use for the samples port (the actors, which listen for weights) the sample replies.
 TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
-  const int port = FreePorts();
+  const int port = PickRunPorts(10);
   if (port == 0) GTEST_SKIP() << "ports in use";
   BusConfig c = MemqConfig(5, "monitor");
   c.url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
@@ -698,7 +683,7 @@ TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
 // A samples URL equal to the bulk one (a run through TCP hubs) shares the bulk port's LCM
 // instance: one socket, and the replies are heard there.
 TEST(BusPortsTest, TheSamplesPortCanShareTheBulkPort) {
-  const int port = FreePorts();
+  const int port = PickRunPorts(10);
   if (port == 0) GTEST_SKIP() << "ports in use";
   BusConfig c = MemqConfig(5, "learner");
   c.url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
