@@ -66,6 +66,10 @@ ReportInfo RunReportInfo(const EvaluatorConfig& c, int64_t run_id) {
   if (!c.second_env.empty()) {
     info.second_name = (c.second_name.empty() ? c.second_env : c.second_name) + ", " +
                        std::to_string(c.second_episodes) + " episodes";
+    if (std::isfinite(c.second_min_mean)) {
+      info.second_name +=
+          ", for a standard mean of " + FormatDouble("%g", c.second_min_mean) + " or more";
+    }
   }
   if (!c.out_dir.empty()) {
     info.metrics_file = (fs::path(c.out_dir) / "metrics.jsonl").string();
@@ -112,6 +116,7 @@ void EvaluatorConfig::Validate() const {
   }
   if (std::isinf(goal)) throw std::invalid_argument("goal must be finite");
   if (!second_env.empty()) {
+    if (std::isnan(second_min_mean)) throw std::invalid_argument("second-min-mean is NaN");
     if (second_episodes < 1) {
       throw std::invalid_argument("second-episodes must be at least 1, got " +
                                   std::to_string(second_episodes));
@@ -154,7 +159,7 @@ EvaluatorService::EvaluatorService(EvaluatorConfig config, Bus* bus, std::FILE* 
       report_(RunReportInfo(config_, bus->config().run_id)),
       history_(OpenHistory(config_.out_dir)),
       second_({config_.second_env, config_.second_episodes, config_.epsilon, config_.seed_base,
-               config_.gamma, BestBefore(history_)},
+               config_.gamma, config_.second_min_mean, BestBefore(history_)},
               log_),
       media_({config_.env_id, config_.seed_base, config_.video_width, config_.video_height,
               config_.video_fps, report_dir_, BestBefore(history_)}),

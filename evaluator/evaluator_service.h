@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -66,6 +67,9 @@ struct EvaluatorConfig {
   std::string second_env;
   int second_episodes = 100;
   std::string second_name;  // what the report calls it (default: the env id)
+  // Only a new best whose standard mean is at least this is scored on the second metric (its
+  // episodes can be long, and the early bests of a run are not results anyone reports).
+  double second_min_mean = -std::numeric_limits<double>::infinity();
   // The screen: before its full evaluation, a checkpoint plays the evaluation's first
   // screen_episodes episodes (the same seeds, so nothing unseen is spent), and earns the full
   // evaluation only when their mean is at least the best full evaluation's mean less

@@ -150,6 +150,9 @@ int Main(int argc, char** argv) {
        "episodes of the second metric")  //
       ("second-name", rl::po::value(&config.second_name),
        "what the report calls the second metric (default: its env id)")  //
+      ("second-min-mean", rl::po::value(&config.second_min_mean),
+       "score a new best on the second metric only when its standard mean is at least this "
+       "(default: every new best)")  //
       ("screen-episodes",
        rl::po::value(&config.screen_episodes)->default_value(config.screen_episodes),
        "service mode: play a checkpoint's first N evaluation episodes first; only one whose mean "

@@ -10,6 +10,7 @@ void SecondMetric::ScoreIfBest(const nn::Checkpoint& ckpt, const std::string& pa
                                EvalRecord* record, const Tick& tick) {
   if (!enabled() || !(record->mean > best_mean_)) return;
   best_mean_ = record->mean;
+  if (record->mean < config_.min_mean) return;
   EvalRecord second;
   try {
     second = ScoreCheckpoint(ckpt, path, config_.env_id, config_.episodes, config_.epsilon,

@@ -20,6 +20,8 @@ struct SecondMetricConfig {
   double epsilon = 0;
   uint64_t seed_base = 0;  // episode i is reset with seed seed_base + i
   double gamma = 0;
+  // A new best below this standard-metric mean is not scored.
+  double min_mean = -std::numeric_limits<double>::infinity();
   // The best standard-metric mean of the evaluator's earlier life in this run folder (its
   // resumed history): only a checkpoint above it is a new best.
   double best_before = -std::numeric_limits<double>::infinity();
@@ -31,11 +33,11 @@ class SecondMetric {
   SecondMetric(SecondMetricConfig config, ProgressLog log)
       : config_(std::move(config)), log_(log), best_mean_(config_.best_before) {}
 
-  /// When `record` (scored on the standard metric) is a new best, scores the checkpoint `ckpt`
-  /// (read from `path`) on the second env into record's second_* fields and prints a progress line;
-  /// nothing otherwise or without a second env. A file that fails to score is logged, and a stop
-  /// request (Interrupted from `tick`, after a step) ends the scoring: both leave the record as
-  /// it is.
+  /// When `record` (scored on the standard metric) is a new best at config.min_mean or more, scores
+  /// the checkpoint `ckpt` (read from `path`) on the second env into record's second_* fields and
+  /// prints a progress line; nothing otherwise or without a second env. A file that fails to score
+  /// is logged, and a stop request (Interrupted from `tick`, after a step) ends the scoring: both
+  /// leave the record as it is.
   void ScoreIfBest(const nn::Checkpoint& ckpt, const std::string& path, EvalRecord* record,
                    const Tick& tick);
 

@@ -268,6 +268,22 @@ TEST_F(EvaluatorServiceTest, ScoresNewBestCheckpointsOnTheSecondMetricToo) {
   EXPECT_NE(html.find("second metric (update 100): "), std::string::npos);
 }
 
+TEST_F(EvaluatorServiceTest, ANewBestBelowTheSecondMetricsMinimumIsNotScoredOnIt) {
+  EvaluatorConfig c = Config();
+  c.second_env = "CartPole-v1";
+  c.second_episodes = 3;
+  c.second_name = "three episodes";
+  c.second_min_mean = 1000;  // above any CartPole score
+  EvaluatorService service(c, &bus_, nullptr);
+  ASSERT_TRUE(AnnounceUntilResults(&service, WriteCheckpoint(100), 100, 1));
+  const std::vector<std::string> lines = JsonLines(service);
+  ASSERT_EQ(lines.size(), 1U);
+  EXPECT_EQ(lines[0].find("second_mean"), std::string::npos) << lines[0];
+  EXPECT_NE(ReportHtml(service).find("Second metric (new best checkpoints only): three episodes, "
+                                     "3 episodes, for a standard mean of 1000 or more"),
+            std::string::npos);
+}
+
 TEST_F(EvaluatorServiceTest, RecordsAVideoOfEachNewBestCheckpointAndShowsItInTheReport) {
   EvaluatorService service(WithVideos(Config(), 96, 64), &bus_, nullptr);
   ASSERT_TRUE(AnnounceUntilResults(&service, WriteCheckpoint(100), 100, 1));
