@@ -8,6 +8,7 @@
 #include "common/options.h"
 #include "learner/algorithm_state.h"
 #include "nn/losses.h"
+#include "nn/parallel.h"
 #include "nn/presets.h"
 
 namespace rl::learner {
@@ -249,14 +250,19 @@ UpdateResult Td3::Update(const Batch& b) {
   action_ = Eigen::Map<const nn::Matrix>(b.action.data(), action_dim_, n);
   if (!action_.allFinite()) throw std::invalid_argument("action not finite");
 
-  // Targets: clipped double-Q at the smoothed target action.
+  // Targets: clipped double-Q at the smoothed target action. The twin critics are independent
+  // networks on the same inputs, so their passes run as two tasks of the nn thread pool (on one
+  // thread, one after the other): the heads' products are too small to split themselves, and
+  // each computed whole in a task gives the same result as on the calling thread.
   TargetActions(next_obs);
-  const nn::Matrix& t1 = q1_target_.Forward(next_obs, next_action_);
-  y_ = t1.row(0).transpose();
-  const nn::Matrix& t2 = q2_target_.Forward(next_obs, next_action_);
+  const nn::Matrix* target_q[2] = {nullptr, nullptr};
+  nn::internal::ParallelFor(2, [&](int k) {
+    target_q[k] = &(k == 0 ? q1_target_ : q2_target_).Forward(next_obs, next_action_);
+  });
+  y_ = target_q[0]->row(0).transpose();
   for (int i = 0; i < n; ++i) {
     const auto k = static_cast<size_t>(i);
-    y_[i] = b.reward[k] + b.discount[k] * std::min(y_[i], t2(0, i));
+    y_[i] = b.reward[k] + b.discount[k] * std::min(y_[i], (*target_q[1])(0, i));
   }
 
   const nn::Vector* w = nullptr;
@@ -264,36 +270,36 @@ UpdateResult Td3::Update(const Batch& b) {
     weights_ = Eigen::Map<const nn::Vector>(b.weight.data(), n);
     w = &weights_;
   }
-  // Critics: each regressed on y.
+  // Critics: each regressed on y, side by side as above; with a shared encoder each gives
+  // d(loss)/d(features) too, and the encoder learns from their sum.
   UpdateResult result;
-  q1_.ZeroGrad();
-  q2_.ZeroGrad();
-  q1_pred_ = q1_.Forward(obs, action_).row(0).transpose();
-  result.loss = nn::MseLoss(q1_pred_, y_, &loss_grad_, w);
-  grad_q_ = loss_grad_.transpose();
+  float losses[2] = {0.0f, 0.0f};
+  nn::internal::ParallelFor(2, [&](int k) {
+    nn::ActionValueNet& q = k == 0 ? q1_ : q2_;
+    q.ZeroGrad();
+    q_pred_[k] = q.Forward(obs, action_).row(0).transpose();
+    losses[k] = nn::MseLoss(q_pred_[k], y_, &loss_grad_[k], w);
+    grad_q_[k] = loss_grad_[k].transpose();
+    if (shared_encoder_) {
+      q.Backward(grad_q_[k]);
+    } else {
+      q.BackwardParams(grad_q_[k]);
+    }
+  });
+  result.loss = losses[0];
+  result.loss += losses[1];
   if (shared_encoder_) {
-    q1_.Backward(grad_q_);
     grad_features_ = q1_.grad_obs();
-  } else {
-    q1_.BackwardParams(grad_q_);
-  }
-  q2_pred_ = q2_.Forward(obs, action_).row(0).transpose();
-  result.loss += nn::MseLoss(q2_pred_, y_, &loss_grad_, w);
-  grad_q_ = loss_grad_.transpose();
-  if (shared_encoder_) {
-    q2_.Backward(grad_q_);
     grad_features_ += q2_.grad_obs();
-    encoder_.BackwardParams(grad_features_);  // the encoder learns from both critics
-  } else {
-    q2_.BackwardParams(grad_q_);
+    encoder_.BackwardParams(grad_features_);
   }
   if (config_.max_grad_norm > 0) {
     result.grad_norm = nn::ClipGradNorm(critic_params_, config_.max_grad_norm);
   }
   critic_optimizer_->Step();
-  result.mean_q = q1_pred_.mean();
+  result.mean_q = q_pred_[0].mean();
   td_abs_.resize(static_cast<size_t>(n));
-  for (int i = 0; i < n; ++i) td_abs_[static_cast<size_t>(i)] = std::abs(y_[i] - q1_pred_[i]);
+  for (int i = 0; i < n; ++i) td_abs_[static_cast<size_t>(i)] = std::abs(y_[i] - q_pred_[0][i]);
   ++updates_;
 
   if (updates_ % config_.policy_delay == 0) {
@@ -301,8 +307,8 @@ UpdateResult Td3::Update(const Batch& b) {
     actor_.ZeroGrad();
     const nn::Matrix& mu = actor_.Forward(obs);
     q1_.Forward(obs, mu);
-    grad_q_.setConstant(1, n, -1.0f / static_cast<float>(n));
-    q1_.BackwardParams(grad_q_);  // computes dQ/da too
+    grad_q_[0].setConstant(1, n, -1.0f / static_cast<float>(n));
+    q1_.BackwardParams(grad_q_[0]);  // computes dQ/da too
     grad_actor_ = q1_.grad_action();
     actor_.BackwardParams(grad_actor_);
     if (config_.max_grad_norm > 0) nn::ClipGradNorm(actor_params_, config_.max_grad_norm);

@@ -126,11 +126,14 @@ class Td3 final : public Algorithm {
   int64_t updates_ = 0;
   int64_t actor_updates_ = 0;
 
-  // Buffers reused by every update.
-  nn::Matrix action_, next_action_, grad_q_, grad_actor_;
+  // Buffers reused by every update. The two critics' passes run side by side (Update), each with
+  // its own prediction, loss gradient and dQ: index 0 for q1, 1 for q2.
+  nn::Matrix action_, next_action_, grad_actor_;
+  nn::Matrix grad_q_[2];
   nn::Matrix features_, next_features_, grad_features_;  // shared encoder only
   std::vector<float> flat_, head_flat_;
-  nn::Vector y_, q1_pred_, q2_pred_, loss_grad_, weights_;
+  nn::Vector y_, weights_;
+  nn::Vector q_pred_[2], loss_grad_[2];
   std::vector<float> td_abs_;
 };
 

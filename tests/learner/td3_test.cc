@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "envs/specs.h"
+#include "nn/parallel.h"
 #include "tests/learner/owned_batch.h"
 
 namespace rl::learner {
@@ -413,6 +414,36 @@ TEST(Td3Test, RestoredStateContinuesBitForBit) {
     Td3 wrong(spec, other);
     EXPECT_THROW(wrong.LoadState(state), std::runtime_error);
   }
+}
+
+TEST(Td3Test, TheTwinCriticsSideBySideOnTwoThreadsUpdateAsOnOne) {
+  // The two critics' passes run as two tasks of the nn pool: on two threads every loss, critic
+  // and actor equal those on one thread bit for bit (a head's products computed whole in a task
+  // are the same products), and the pool is used (two sections an update).
+  const envs::EnvSpec spec = envs::LunarLanderSpec(true);
+  Td3Config c;
+  c.hidden = {64, 64};
+  c.seed = 1;
+  c.target_noise = 0.2f;
+  std::mt19937 rng(5);
+  const OwnedBatch b = RandomBatch(spec, 256, &rng);
+  const int width = spec.action_width();
+  std::vector<float> losses[2], actor[2], critic[2];
+  for (int threads : {1, 2}) {
+    nn::SetNumThreads(threads);
+    const int64_t sections = nn::internal::ParallelSections();
+    Td3 td3(spec, c);
+    for (int k = 0; k < 4; ++k) losses[threads - 1].push_back(td3.Update(b.view(width)).loss);
+    actor[threads - 1] = Flat(td3.actor());
+    critic[threads - 1] = Flat(td3.critic(1));
+    if (threads == 2) {
+      EXPECT_GE(nn::internal::ParallelSections() - sections, 8);
+    }
+  }
+  nn::SetNumThreads(1);
+  EXPECT_EQ(losses[0], losses[1]);
+  EXPECT_EQ(actor[0], actor[1]);
+  EXPECT_EQ(critic[0], critic[1]);
 }
 
 }  // namespace
