@@ -19,7 +19,7 @@ std::string FindOnPath(const std::string& program) {
   const char* path = std::getenv("PATH");
   std::istringstream dirs(path != nullptr ? path : "");
   for (std::string dir; std::getline(dirs, dir, ':');) {
-    const std::string candidate = dir + "/" + program;
+    std::string candidate = dir + "/" + program;
     if (!dir.empty() && access(candidate.c_str(), X_OK) == 0) return candidate;
   }
   return "";
