@@ -17,7 +17,7 @@ status=0
 # loaded machine, and the embedding grows with the square of the states).
 launch car_racing_td3 --out "$dir/run" --seed 1 --goal 100000 --time-budget 90 \
   --learner-args "--checkpoint-every 50 --threads 1" \
-  --evaluator-args "--episodes 3 --second-episodes 2 --videos 1 --tsne 400" \
+  --evaluator-args "--episodes 3 --second-episodes 2 --second-min-mean -1000 --videos 1 --tsne 400" \
   > "$dir/launch.log" 2>&1 || status=$?
 tail -6 "$dir/launch.log"
 [ "$status" -eq 1 ] || fail "launch exited with $status (expected 1: the budget ran out unsolved)"
@@ -29,7 +29,8 @@ grep -q 'CarRacing-v3+pixels(skip=5,max-pool=0,crop-bottom=12,crop-left=6,crop-r
   "$dir/run/logs/evaluator.log" "$dir/run/report/index.html" ||
   fail "the evaluator did not name the unmodified env"
 if grep -q 'off-track=1' "$dir/run/logs/evaluator.log"; then fail "the evaluator used the off-track rule"; fi
-# And its first checkpoint (a new best) on the article's rules too, the second metric.
+# And its first checkpoint (a new best) on the article's rules too, the second metric (the preset
+# gives it only to bests at 800 or more; here every best, from -1000).
 grep -q '"second_episodes": 2' "$dir/run/eval.jsonl" || fail "no second metric in eval.jsonl"
 grep -q "the TD3 article&#39;s rules\|the TD3 article's rules" "$dir/run/report/index.html" ||
   fail "the report does not name the second metric"
