@@ -138,43 +138,54 @@ std::string RunAndCapture(const std::vector<std::string>& argv) {
   return text[0];
 }
 
-void StopWrites::Look() {
+FolderFiles LookInFolder(const std::string& dir,
+                         const std::function<bool(const std::string& name)>& match) {
   namespace fs = std::filesystem;
-  files_ = 0;
-  bytes_ = 0;
-  largest_.clear();
-  largest_bytes_ = -1;
+  FolderFiles found;
   std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(dir_, ec)) {
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
-    if (name.find(".tmp.") == std::string::npos) continue;
+    if (!match(name)) continue;
     std::error_code size_ec;
     const auto size = static_cast<int64_t>(entry.file_size(size_ec));
     if (size_ec) continue;
-    ++files_;
-    bytes_ += size;
-    if (size > largest_bytes_) {
-      largest_bytes_ = size;
-      largest_ = name;
+    ++found.files;
+    found.bytes += size;
+    if (size > found.largest_bytes) {
+      found.largest_bytes = size;
+      found.largest = name;
     }
   }
+  return found;
 }
 
-bool StopWrites::Changing(double now, double stall) {
+namespace {
+
+FolderFiles TemporaryFiles(const std::string& dir) {
+  return LookInFolder(
+      dir, [](const std::string& name) { return name.find(".tmp.") != std::string::npos; });
+}
+
+}  // namespace
+
+StopWrites::StopWrites(std::string dir, double began, double stall, double limit)
+    : dir_(std::move(dir)), stall_(stall), end_(began + limit), seen_(TemporaryFiles(dir_)) {}
+
+bool StopWrites::Writing(double now) {
+  if (now >= end_) return false;
   if (now - looked_ >= 0.25) {
     looked_ = now;
-    const int files = files_;
-    const int64_t bytes = bytes_;
-    Look();
-    if (files != files_ || bytes != bytes_) changed_ = now;
+    const FolderFiles seen = TemporaryFiles(dir_);
+    if (seen.files != seen_.files || seen.bytes != seen_.bytes) changed_ = now;
+    seen_ = seen;
   }
-  return changed_ >= 0 && now - changed_ < stall;
+  return changed_ >= 0 && now - changed_ < stall_;
 }
 
 std::string StopWrites::Describe() const {
-  if (files_ == 0) return "";
-  return " (" + largest_ + ": " + FormatDouble("%.0f", static_cast<double>(largest_bytes_) / 1e6) +
-         " MB so far)";
+  if (seen_.files == 0) return "";
+  return " (" + seen_.largest + ": " +
+         FormatDouble("%.0f", static_cast<double>(seen_.largest_bytes) / 1e6) + " MB so far)";
 }
 
 }  // namespace rl::launch

@@ -5,6 +5,7 @@
 #include <sys/types.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,26 +35,37 @@ bool HoldsFileOpen(pid_t pid, const std::string& path);
 /// Whether a TCP socket of this network namespace listens on `port` (/proc/net/tcp and tcp6).
 bool ListensOnTcp(int port);
 
+/// Files of one folder whose names a predicate accepts: how many, their total size, and the
+/// largest one (name and size; -1 when there is none).
+struct FolderFiles {
+  int files = 0;
+  int64_t bytes = 0;
+  std::string largest;
+  int64_t largest_bytes = -1;
+};
+FolderFiles LookInFolder(const std::string& dir,
+                         const std::function<bool(const std::string& name)>& match);
+
 /// Watches a folder where a stopping process writes files atomically (NAME.tmp.<pid>, renamed
 /// when complete: the replay's last snapshot, the learner's state), so that a stop can wait for a
-/// write that is under way and still kill a process that hangs.
+/// write that is under way and still kill a process that hangs. The rule, for the supervisor,
+/// its destructor and the watchdog alike: the process is still writing while a temporary file
+/// there appeared, grew or went within `stall` seconds, and until `limit` seconds after `began`
+/// (MonoSeconds() of its SIGTERM).
 class StopWrites {
  public:
-  explicit StopWrites(std::string dir) : dir_(std::move(dir)) { Look(); }
-  /// Looks at the folder again (at most every 0.25 s) and returns whether its temporary files
-  /// changed (one appeared, grew or went) within `stall` seconds of `now` (MonoSeconds()).
-  bool Changing(double now, double stall);
+  StopWrites(std::string dir, double began, double stall, double limit);
+  /// Looks at the folder again (at most every 0.25 s) and returns whether the process is still
+  /// writing at `now` (MonoSeconds()) by the rule above.
+  bool Writing(double now);
   /// " (NAME: N MB so far)" for the largest temporary file, "" when there is none.
   std::string Describe() const;
 
  private:
-  void Look();
-
   std::string dir_;
-  int files_ = 0;
-  int64_t bytes_ = 0;
-  std::string largest_;
-  int64_t largest_bytes_ = 0;
+  double stall_;
+  double end_;           // began + limit
+  FolderFiles seen_;     // the temporary files when it last looked
   double looked_ = -1;   // when it last looked
   double changed_ = -1;  // when it last saw a change (< 0: never)
 };

@@ -77,18 +77,11 @@ std::vector<std::string> LastLines(const std::string& path, off_t offset, size_t
 // The bytes of the files beside `file` whose names start with its stem (a recording's
 // main.lcmlog.0, .1, ...).
 int64_t RecordedBytes(const std::string& file) {
-  namespace fs = std::filesystem;
-  const fs::path path(file);
+  const std::filesystem::path path(file);
   const std::string stem = path.stem().string();
-  int64_t total = 0;
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator(path.parent_path(), ec)) {
-    if (entry.path().filename().string().rfind(stem, 0) != 0) continue;
-    std::error_code size_ec;
-    const auto size = entry.file_size(size_ec);
-    if (!size_ec) total += static_cast<int64_t>(size);
-  }
-  return total;
+  return LookInFolder(path.parent_path().string(),
+                      [&stem](const std::string& name) { return name.rfind(stem, 0) == 0; })
+      .bytes;
 }
 
 // How a process ended, as a sentence's verb: "exited with status 3", "was killed by signal 9
@@ -152,6 +145,12 @@ struct Supervisor::Proc {
   // launcher last said that it waits for them.
   std::optional<StopWrites> writes;
   double told_at = -1e9;
+
+  // Stopping since `began`: watches its writes_at_stop folder, if it names one.
+  void WatchWrites(double began, const RestartLimits& limits) {
+    if (plan->writes_at_stop.empty()) return;
+    writes.emplace(plan->writes_at_stop, began, limits.stop_stall_seconds, limits.stop_write_limit);
+  }
 };
 
 int ExitStatusOf(RunEnd end) {
@@ -199,10 +198,15 @@ Supervisor::Supervisor(const RunPlan& plan, const Placement& placement, int sign
 }
 
 Supervisor::~Supervisor() {
+  // The path of an exception in the launcher: the same rule as an orderly stop, every process
+  // at once.
+  const RestartLimits& limits = plan_.settings.limits;
+  const double began = MonoSeconds();
   for (Proc& p : procs_) {
-    if (p.pid > 0) kill(p.pid, placement_.StopSignal(*p.plan));
+    if (p.pid <= 0) continue;
+    kill(p.pid, placement_.StopSignal(*p.plan));
+    p.WatchWrites(began, limits);
   }
-  const double deadline = MonoSeconds() + plan_.settings.limits.stop_seconds;
   while (AnyRunning(true) || AnyRunning(false)) {
     int status = 0;
     const pid_t pid = waitpid(-1, &status, WNOHANG);
@@ -211,10 +215,13 @@ Supervisor::~Supervisor() {
     }
     if (pid < 0 && errno == ECHILD) break;
     if (pid > 0) continue;
-    if (MonoSeconds() >= deadline) {
-      for (Proc& p : procs_) {
-        if (p.pid > 0) kill(p.pid, SIGKILL);
-      }
+    const double now = MonoSeconds();
+    for (Proc& p : procs_) {
+      if (p.pid <= 0 || p.killed) continue;
+      const bool writing = p.writes && p.writes->Writing(now);
+      if (writing || now < began + limits.stop_seconds) continue;
+      kill(p.pid, SIGKILL);
+      p.killed = true;
     }
     poll(nullptr, 0, 50);
   }
@@ -400,24 +407,20 @@ void Supervisor::BeginStop(RunEnd end) {
   if (end == RunEnd::kHangUp) {
     Say(STDERR_FILENO, "launch: hang-up (its terminal closed?), stopping the run\n");
   }
+  stop_began_ = MonoSeconds();
+  stop_deadline_ = stop_began_ + plan_.settings.limits.stop_seconds;
   for (Proc& p : procs_) {
     p.restart_at = -1;
     if (p.pid > 0 && !p.plan->stops_last) {
       kill(p.pid, placement_.StopSignal(*p.plan));
       p.termed = true;
-      if (!p.plan->writes_at_stop.empty()) p.writes.emplace(p.plan->writes_at_stop);
+      p.WatchWrites(stop_began_, plan_.settings.limits);
     }
   }
-  stop_began_ = MonoSeconds();
-  stop_deadline_ = stop_began_ + plan_.settings.limits.stop_seconds;
 }
 
 bool Supervisor::StillWriting(Proc* p, double now) {
-  const RestartLimits& limits = plan_.settings.limits;
-  if (!p->writes || now >= stop_began_ + limits.stop_write_limit ||
-      !p->writes->Changing(now, limits.stop_stall_seconds)) {
-    return false;
-  }
+  if (!p->writes || !p->writes->Writing(now)) return false;
   if (now >= stop_deadline_ && now - p->told_at >= 10) {
     p->told_at = now;
     Tell(p, "launch: " + p->plan->role + " is still writing" + p->writes->Describe() +

@@ -53,9 +53,9 @@ class Supervisor {
   /// `plan`, `placement` and `watchdog` must outlive the supervisor; `signal_fd` is
   /// BlockRunSignals()'s.
   Supervisor(const RunPlan& plan, const Placement& placement, int signal_fd, Watchdog* watchdog);
-  /// Stops every process still running (SIGTERM; SIGKILL after RestartLimits::stop_seconds) and
-  /// reaps it: an exception in the
-  /// launcher leaves nothing behind.
+  /// Stops every process still running (SIGTERM; SIGKILL after RestartLimits::stop_seconds, or
+  /// later to one still writing its last files, as Run()'s stop does) and reaps it: an exception
+  /// in the launcher leaves nothing behind and loses no snapshot being written.
   ~Supervisor();
   Supervisor(const Supervisor&) = delete;
   Supervisor& operator=(const Supervisor&) = delete;

@@ -72,7 +72,10 @@ void Say(const std::string& line) { (void)!write(STDERR_FILENO, line.data(), lin
   const double start = MonoSeconds();
   std::vector<std::optional<StopWrites>> writes(watched.size());
   for (size_t i = 0; i < watched.size(); ++i) {
-    if (!watched[i].writes_at_stop.empty()) writes[i].emplace(watched[i].writes_at_stop);
+    if (!watched[i].writes_at_stop.empty()) {
+      writes[i].emplace(watched[i].writes_at_stop, start, limits.stop_stall_seconds,
+                        limits.stop_write_limit);
+    }
   }
   for (;;) {
     const double now = MonoSeconds();
@@ -85,8 +88,7 @@ void Say(const std::string& line) { (void)!write(STDERR_FILENO, line.data(), lin
         continue;
       }
       alive = true;
-      const bool writing = writes[i] && now < start + limits.stop_write_limit &&
-                           writes[i]->Changing(now, limits.stop_stall_seconds);
+      const bool writing = writes[i] && writes[i]->Writing(now);
       if (writing || now < start + limits.stop_seconds) continue;
       kill(w.pid, SIGKILL);
       Say("launch: the launcher is gone; killed " + w.role + " (pid " + std::to_string(w.pid) +

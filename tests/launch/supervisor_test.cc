@@ -11,6 +11,7 @@
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <utility>
@@ -232,6 +233,30 @@ TEST_F(SupervisorTest, AStopWaitsForALastFileBeingWrittenAndKillsAWriterThatHang
   EXPECT_NE(err.find("launch: hung did not stop; killing it"), std::string::npos) << err;
   EXPECT_FALSE(fs::exists(dir_ + "/hung/last.bin"));
   EXPECT_GE(seconds, 4);
+}
+
+TEST_F(SupervisorTest, AnExceptionInTheLauncherStillWaitsForALastFileBeingWritten) {
+  // The supervisor's destructor stops the run when the launcher throws (here: its ready
+  // callback), with the same rule as an orderly stop.
+  plan_.settings.limits.stop_seconds = 1;
+  plan_.settings.limits.stop_stall_seconds = 2;
+  AddStopWriter("writer", /*seconds=*/3, /*hangs=*/false);
+  AddStopWriter("hung", 0, /*hangs=*/true);
+  AddEnder("exec sleep 60");
+  const int signal_fd = BlockRunSignals();
+  const double start = MonoSeconds();
+  {
+    Supervisor supervisor(plan_, placement_, signal_fd, nullptr);
+    supervisor.OnAllReady([] { throw std::runtime_error("the launcher failed"); });
+    EXPECT_THROW(supervisor.Run(), std::runtime_error);
+  }
+  const double seconds = MonoSeconds() - start;
+  close(signal_fd);
+  EXPECT_TRUE(fs::exists(dir_ + "/writer/last.bin")) << "killed while it was writing";
+  EXPECT_FALSE(fs::exists(dir_ + "/hung/last.bin"));
+  EXPECT_GE(seconds, 3);
+  EXPECT_LT(seconds, 30) << "the hung writer was not killed after its stall";
+  EXPECT_TRUE(AllEnd(Pids(), 1)) << "a process outlived the supervisor";
 }
 
 TEST_F(SupervisorTest, AHangUpStopsTheRunInOrder) {
