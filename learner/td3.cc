@@ -297,6 +297,7 @@ UpdateResult Td3::Update(const Batch& b) {
     result.grad_norm = nn::ClipGradNorm(critic_params_, config_.max_grad_norm);
   }
   critic_optimizer_->Step();
+  // The first critic's prediction (index 0: q1) gives the mean Q and the TD errors, as in TD3.
   result.mean_q = q_pred_[0].mean();
   td_abs_.resize(static_cast<size_t>(n));
   for (int i = 0; i < n; ++i) td_abs_[static_cast<size_t>(i)] = std::abs(y_[i] - q_pred_[0][i]);
