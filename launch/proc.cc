@@ -168,11 +168,16 @@ FolderFiles TemporaryFiles(const std::string& dir) {
 
 }  // namespace
 
-StopWrites::StopWrites(std::string dir, double began, double stall, double limit)
-    : dir_(std::move(dir)), stall_(stall), end_(began + limit), seen_(TemporaryFiles(dir_)) {}
+StopWrites::StopWrites(std::string dir, double began, const RestartLimits& limits)
+    : dir_(std::move(dir)),
+      deadline_(began + limits.stop_seconds),
+      stall_(limits.stop_stall_seconds),
+      end_(began + limits.stop_write_limit) {
+  if (!dir_.empty()) seen_ = TemporaryFiles(dir_);
+}
 
 bool StopWrites::Writing(double now) {
-  if (now >= end_) return false;
+  if (dir_.empty() || now >= end_) return false;
   if (now - looked_ >= 0.25) {
     looked_ = now;
     const FolderFiles seen = TemporaryFiles(dir_);

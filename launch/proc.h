@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "launch/launch_options.h"
+
 namespace rl::launch {
 
 /// The start time of process `pid` (field 22 of /proc/PID/stat, in clock ticks since boot): with
@@ -46,25 +48,29 @@ struct FolderFiles {
 FolderFiles LookInFolder(const std::string& dir,
                          const std::function<bool(const std::string& name)>& match);
 
-/// Watches a folder where a stopping process writes files atomically (NAME.tmp.<pid>, renamed
-/// when complete: the replay's last snapshot, the learner's state), so that a stop can wait for a
-/// write that is under way and still kill a process that hangs. The rule, for the supervisor,
-/// its destructor and the watchdog alike: the process is still writing while a temporary file
-/// there appeared, grew or went within `stall` seconds, and until `limit` seconds after `began`
-/// (MonoSeconds() of its SIGTERM).
+/// A process being stopped, and when it may be killed. The rule, for the supervisor, its
+/// destructor and the watchdog alike: not before RestartLimits::stop_seconds after `began`
+/// (MonoSeconds() of its SIGTERM), and after that not while it is still writing in `dir`, the
+/// folder where it writes files atomically as it stops (NAME.tmp.<pid>, renamed when complete: the
+/// replay's last snapshot, the learner's state; "" for a process that writes nothing): while a
+/// temporary file there appeared, grew or went within stop_stall_seconds, and until
+/// stop_write_limit after `began`.
 class StopWrites {
  public:
-  StopWrites(std::string dir, double began, double stall, double limit);
+  StopWrites(std::string dir, double began, const RestartLimits& limits);
   /// Looks at the folder again (at most every 0.25 s) and returns whether the process is still
   /// writing at `now` (MonoSeconds()) by the rule above.
   bool Writing(double now);
+  /// Whether it may be killed at `now`: stop_seconds have passed and it is not writing.
+  bool Overdue(double now) { return now >= deadline_ && !Writing(now); }
   /// " (NAME: N MB so far)" for the largest temporary file, "" when there is none.
   std::string Describe() const;
 
  private:
   std::string dir_;
+  double deadline_;  // began + stop_seconds
   double stall_;
-  double end_;           // began + limit
+  double end_;           // began + stop_write_limit
   FolderFiles seen_;     // the temporary files when it last looked
   double looked_ = -1;   // when it last looked
   double changed_ = -1;  // when it last saw a change (< 0: never)

@@ -141,15 +141,13 @@ struct Supervisor::Proc {
   bool down = false;       // not to be started again
   bool termed = false;     // stopping: SIGTERM sent
   bool killed = false;     // stopping: SIGKILL sent
-  // Stopping, for a process that writes as it stops: its folder's temporary files, and when the
-  // launcher last said that it waits for them.
-  std::optional<StopWrites> writes;
+  // Stopping: when it may be killed (its writes_at_stop folder watched), and when the launcher
+  // last said that it waits for its writes.
+  std::optional<StopWrites> stop;
   double told_at = -1e9;
 
-  // Stopping since `began`: watches its writes_at_stop folder, if it names one.
-  void WatchWrites(double began, const RestartLimits& limits) {
-    if (plan->writes_at_stop.empty()) return;
-    writes.emplace(plan->writes_at_stop, began, limits.stop_stall_seconds, limits.stop_write_limit);
+  void StopBegan(double began, const RestartLimits& limits) {
+    stop.emplace(plan->writes_at_stop, began, limits);
   }
 };
 
@@ -200,12 +198,11 @@ Supervisor::Supervisor(const RunPlan& plan, const Placement& placement, int sign
 Supervisor::~Supervisor() {
   // The path of an exception in the launcher: the same rule as an orderly stop, every process
   // at once.
-  const RestartLimits& limits = plan_.settings.limits;
   const double began = MonoSeconds();
   for (Proc& p : procs_) {
     if (p.pid <= 0) continue;
     kill(p.pid, placement_.StopSignal(*p.plan));
-    p.WatchWrites(began, limits);
+    p.StopBegan(began, plan_.settings.limits);
   }
   while (AnyRunning(true) || AnyRunning(false)) {
     int status = 0;
@@ -217,9 +214,7 @@ Supervisor::~Supervisor() {
     if (pid > 0) continue;
     const double now = MonoSeconds();
     for (Proc& p : procs_) {
-      if (p.pid <= 0 || p.killed) continue;
-      const bool writing = p.writes && p.writes->Writing(now);
-      if (writing || now < began + limits.stop_seconds) continue;
+      if (p.pid <= 0 || p.killed || !p.stop->Overdue(now)) continue;
       kill(p.pid, SIGKILL);
       p.killed = true;
     }
@@ -414,16 +409,16 @@ void Supervisor::BeginStop(RunEnd end) {
     if (p.pid > 0 && !p.plan->stops_last) {
       kill(p.pid, placement_.StopSignal(*p.plan));
       p.termed = true;
-      p.WatchWrites(stop_began_, plan_.settings.limits);
+      p.StopBegan(stop_began_, plan_.settings.limits);
     }
   }
 }
 
 bool Supervisor::StillWriting(Proc* p, double now) {
-  if (!p->writes || !p->writes->Writing(now)) return false;
+  if (!p->stop || !p->stop->Writing(now)) return false;
   if (now >= stop_deadline_ && now - p->told_at >= 10) {
     p->told_at = now;
-    Tell(p, "launch: " + p->plan->role + " is still writing" + p->writes->Describe() +
+    Tell(p, "launch: " + p->plan->role + " is still writing" + p->stop->Describe() +
                 "; waiting for it");
   }
   return true;

@@ -10,7 +10,6 @@
 #include <csignal>
 #include <cstdint>
 #include <cstring>
-#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -70,13 +69,9 @@ void Say(const std::string& line) { (void)!write(STDERR_FILENO, line.data(), lin
   }
   // The launcher is gone (or done): wait for the processes, then kill the ones left.
   const double start = MonoSeconds();
-  std::vector<std::optional<StopWrites>> writes(watched.size());
-  for (size_t i = 0; i < watched.size(); ++i) {
-    if (!watched[i].writes_at_stop.empty()) {
-      writes[i].emplace(watched[i].writes_at_stop, start, limits.stop_stall_seconds,
-                        limits.stop_write_limit);
-    }
-  }
+  std::vector<StopWrites> stops;
+  stops.reserve(watched.size());
+  for (const Watched& w : watched) stops.emplace_back(w.writes_at_stop, start, limits);
   for (;;) {
     const double now = MonoSeconds();
     bool alive = false;
@@ -88,8 +83,7 @@ void Say(const std::string& line) { (void)!write(STDERR_FILENO, line.data(), lin
         continue;
       }
       alive = true;
-      const bool writing = writes[i] && writes[i]->Writing(now);
-      if (writing || now < start + limits.stop_seconds) continue;
+      if (!stops[i].Overdue(now)) continue;
       kill(w.pid, SIGKILL);
       Say("launch: the launcher is gone; killed " + w.role + " (pid " + std::to_string(w.pid) +
           "), still running " + FormatDouble("%.0f", now - start) + " s after\n");

@@ -76,6 +76,14 @@ class SupervisorTest : public ::testing::Test {
     plan_.processes.back().writes_at_stop = folder;
   }
 
+  // A writer that writes its last file for `seconds` after SIGTERM and one that starts its file
+  // and hangs, with stops that wait for a file until it has not changed for 2 s.
+  void AddWriterAndHung(double seconds) {
+    plan_.settings.limits.stop_stall_seconds = 2;
+    AddStopWriter("writer", seconds, /*hangs=*/false);
+    AddStopWriter("hung", 0, /*hangs=*/true);
+  }
+
   // Runs the supervisor in this process with its output in files; returns how the run ended.
   RunEnd RunHere(double* seconds) {
     const int saved_out = dup(STDOUT_FILENO), saved_err = dup(STDERR_FILENO);
@@ -202,9 +210,7 @@ TEST_F(SupervisorTest, WhenTheLauncherIsKilledItsProcessesStopAndTheStuckOnesAre
                          "/polite.stopped; exit 0' TERM; "
                          "echo polite: ready; while :; do sleep 0.1; done");
   AddShell("stubborn", "trap '' TERM; echo stubborn: ready; exec sleep 60");
-  plan_.settings.limits.stop_stall_seconds = 2;
-  AddStopWriter("writer", /*seconds=*/4, /*hangs=*/false);
-  AddStopWriter("hung", 0, /*hangs=*/true);
+  AddWriterAndHung(/*seconds=*/4);
   AddEnder("exec sleep 60");
   const pid_t launcher = LaunchInChild(/*grace=*/1);
   const std::map<std::string, pid_t> pids = Pids();
@@ -219,9 +225,7 @@ TEST_F(SupervisorTest, WhenTheLauncherIsKilledItsProcessesStopAndTheStuckOnesAre
 
 TEST_F(SupervisorTest, AStopWaitsForALastFileBeingWrittenAndKillsAWriterThatHangs) {
   plan_.settings.limits.stop_seconds = 1;
-  plan_.settings.limits.stop_stall_seconds = 2;
-  AddStopWriter("writer", /*seconds=*/4, /*hangs=*/false);
-  AddStopWriter("hung", 0, /*hangs=*/true);
+  AddWriterAndHung(/*seconds=*/4);
   AddEnder("echo 'monitor: goal reached'; sleep 0.5; exit 0");
   double seconds = 0;
   EXPECT_EQ(RunHere(&seconds), RunEnd::kGoalReached);
@@ -239,9 +243,7 @@ TEST_F(SupervisorTest, AnExceptionInTheLauncherStillWaitsForALastFileBeingWritte
   // The supervisor's destructor stops the run when the launcher throws (here: its ready
   // callback), with the same rule as an orderly stop.
   plan_.settings.limits.stop_seconds = 1;
-  plan_.settings.limits.stop_stall_seconds = 2;
-  AddStopWriter("writer", /*seconds=*/3, /*hangs=*/false);
-  AddStopWriter("hung", 0, /*hangs=*/true);
+  AddWriterAndHung(/*seconds=*/3);
   AddEnder("exec sleep 60");
   const int signal_fd = BlockRunSignals();
   const double start = MonoSeconds();
