@@ -18,6 +18,7 @@
 #include "evaluator/announced_checkpoint.h"
 #include "evaluator/tsne_map.h"
 #include "evaluator/video.h"
+#include "nn/checkpoint.h"
 #include "rlmsg/eval_result_t.hpp"
 #include "rlmsg/stats_evaluator_t.hpp"
 
@@ -207,8 +208,12 @@ void EvaluatorService::QueueUnscoredCheckpoints() {
   int queued = 0;
   for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
     const std::string name = entry.path().filename().string();
-    // The learner's files end in .bin (a temporary one of a write cut short does not).
-    if (scored.count(name) > 0 || entry.path().extension() != ".bin") continue;
+    // The learner's files end in .bin (a temporary one of a write cut short does not); its state
+    // file is not a checkpoint.
+    if (scored.count(name) > 0 || entry.path().extension() != ".bin" ||
+        name == nn::kLearnerStateFile) {
+      continue;
+    }
     rlmsg::checkpoint_t unscored{};
     try {
       const nn::Checkpoint ckpt = ReadAnnouncedCheckpoint(entry.path().string(), folder);

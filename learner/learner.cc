@@ -208,7 +208,7 @@ void Learner::TrainOn(const rlmsg::sample_batch_t& m) {
 }
 
 std::string Learner::StatePath() const {
-  return (std::filesystem::path(config_.out_dir) / "checkpoints" / "learner-state.bin").string();
+  return (std::filesystem::path(config_.out_dir) / "checkpoints" / nn::kLearnerStateFile).string();
 }
 
 std::string Learner::StateKind() const { return "learner " + config_.algorithm; }

@@ -52,4 +52,8 @@ Checkpoint LoadCheckpoint(const std::string& path);
 /// `name` where LoadCheckpoint's name the path.
 Checkpoint ParseCheckpoint(std::string_view bytes, const std::string& name);
 
+/// The learner's state (its networks, optimizers and counters: common/state_file.h), kept in the
+/// run's checkpoint folder beside the checkpoints, under this name: not a checkpoint file.
+inline constexpr std::string_view kLearnerStateFile = "learner-state.bin";
+
 }  // namespace rl::nn

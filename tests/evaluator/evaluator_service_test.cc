@@ -517,12 +517,19 @@ TEST_F(EvaluatorServiceTest, QueuesTheCheckpointsAnEarlierLifeLeftUnscored) {
   Save(foreign);
   { std::ofstream(checkpoints_ + "/ckpt_50.bin") << "not a checkpoint"; }
   { std::ofstream(checkpoints_ + "/ckpt_60.bin.tmp.123") << "a write cut short"; }
+  { std::ofstream(checkpoints_ + "/" + std::string(nn::kLearnerStateFile)) << "the learner's"; }
   Bus bus2(MemqConfig());
   std::FILE* log = std::tmpfile();
   ASSERT_NE(log, nullptr);
   EvaluatorConfig c = Config();
   c.backlog = 1;
+  ::testing::internal::CaptureStderr();
   EvaluatorService second(c, &bus2, log);
+  const std::string errors = ::testing::internal::GetCapturedStderr();
+  // The file that is not a checkpoint is refused by name, the learner's state passed over.
+  EXPECT_TRUE(Contains(errors, "not queued: checkpoint " + checkpoints_ + "/ckpt_50.bin"))
+      << errors;
+  EXPECT_FALSE(Contains(errors, std::string(nn::kLearnerStateFile))) << errors;
   EXPECT_TRUE(second.has_pending());
   EXPECT_EQ(second.backlog(), 1);
   EXPECT_EQ(second.checkpoints_skipped(), 1);  // the oldest, 20, beyond the backlog
