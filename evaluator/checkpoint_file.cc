@@ -65,6 +65,7 @@ EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
   r.min = score.min;
   r.max = score.max;
   r.episodes = score.episodes;
+  r.returns = score.returns;
   r.eval_seconds = MonoSeconds() - start;
   if (score.values) {
     r.value_steps = score.values->steps;

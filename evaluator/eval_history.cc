@@ -39,6 +39,7 @@ std::string ToJson(const EvalRecord& r) {
     j["second_std"] = r.second_std;
     j["second_episodes"] = r.second_episodes;
   }
+  if (!r.returns.empty()) j["returns"] = r.returns;
   return JsonLine(j);
 }
 
@@ -76,6 +77,7 @@ bool ParseJson(const std::string& line, EvalRecord* record) {
     r.second_mean = number("second_mean", 0);
     r.second_std = number("second_std", 0);
   }
+  r.returns = JsonNumbersAt(*j, "returns").value_or(std::vector<double>{});
   *record = std::move(r);
   return true;
 }

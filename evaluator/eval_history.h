@@ -33,6 +33,9 @@ struct EvalRecord {
   int second_episodes = 0;
   double second_mean = 0;
   double second_std = 0;
+  // Each evaluation episode's return, in episode order: how a mean was made (a few failed
+  // episodes or a uniform shortfall). Empty in lines written before they were kept.
+  std::vector<double> returns;
 
   bool operator==(const EvalRecord&) const = default;
 };
@@ -41,13 +44,15 @@ struct EvalRecord {
 /// ..., "wall_seconds": ..., "mean": ..., "std": ..., "min": ..., "max": ..., "episodes": ...,
 /// "eval_seconds": ...}, and when value_steps > 0 also "value_steps", "value_estimate",
 /// "value_return" and "value_correlation" (null when unset), and when second_episodes > 0
-/// "second_mean", "second_std" and "second_episodes" (json_line.h: numbers in their shortest
-/// form that reads back exactly; a non-finite number is written as null).
+/// "second_mean", "second_std" and "second_episodes", and last, when there are any, "returns"
+/// (an array) (json_line.h: numbers in their shortest form that reads back exactly; a non-finite
+/// number is written as null).
 std::string ToJson(const EvalRecord& record);
 
 /// Parses one line written by ToJson (keys in any order, unknown keys ignored, whitespace
 /// allowed). Returns false, leaving *record unchanged, when the line is not such an object or
-/// lacks "checkpoint", "update" or "mean".
+/// lacks "checkpoint", "update" or "mean". "returns" that is not an array of numbers is read as
+/// none.
 bool ParseJson(const std::string& line, EvalRecord* record);
 
 /// Appends ToJson(record) and a newline to the file at `path` (created if missing), then

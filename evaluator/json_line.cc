@@ -55,6 +55,23 @@ std::optional<int64_t> JsonIntegerAt(const nlohmann::json& object, const char* k
   return static_cast<int64_t>(d);
 }
 
+std::optional<std::vector<double>> JsonNumbersAt(const nlohmann::json& object, const char* key) {
+  const auto it = object.find(key);
+  if (it == object.end() || !it->is_array()) return std::nullopt;
+  std::vector<double> numbers;
+  numbers.reserve(it->size());
+  for (const nlohmann::json& element : *it) {
+    if (element.is_null()) {
+      numbers.push_back(std::nan(""));
+    } else if (element.is_number()) {
+      numbers.push_back(element.get<double>());
+    } else {
+      return std::nullopt;
+    }
+  }
+  return numbers;
+}
+
 std::optional<std::string> JsonStringAt(const nlohmann::json& object, const char* key) {
   const auto it = object.find(key);
   if (it == object.end() || !it->is_string()) return std::nullopt;

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -30,6 +31,10 @@ std::optional<double> JsonNumberAt(const nlohmann::json& object, const char* key
 /// The whole number under `key` (also one written as a double, e.g. 1e6); nullopt when it is
 /// missing, null, not a number, not whole or beyond int64.
 std::optional<int64_t> JsonIntegerAt(const nlohmann::json& object, const char* key);
+
+/// The array of numbers under `key` (null elements as NaN); nullopt when it is missing, not an
+/// array or holds anything but numbers and nulls.
+std::optional<std::vector<double>> JsonNumbersAt(const nlohmann::json& object, const char* key);
 
 /// The string under `key`; nullopt when it is missing or not a string.
 std::optional<std::string> JsonStringAt(const nlohmann::json& object, const char* key);

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 #include "common/atomic_file.h"
 #include "common/text_format.h"
@@ -261,9 +262,21 @@ std::string MediaSections(const ReportInfo& info) {
   return h;
 }
 
+// The q-quantile (0 to 1) of the finite `values`, interpolated between the two nearest order
+// statistics; NaN when there is none.
+double Quantile(std::vector<double> values, double q) {
+  std::erase_if(values, [](double v) { return !std::isfinite(v); });
+  if (values.empty()) return std::nan("");
+  std::sort(values.begin(), values.end());
+  const double at = q * static_cast<double>(values.size() - 1);
+  const auto below = static_cast<size_t>(at);
+  const size_t above = std::min(below + 1, values.size() - 1);
+  return values[below] + (at - static_cast<double>(below)) * (values[above] - values[below]);
+}
+
 // One row of the checkpoint table.
 std::string CheckpointRow(const EvalRecord& r, const Highlights& hl, const ReportInfo& info,
-                          double bar_scale, bool has_values, bool has_second) {
+                          double bar_scale, bool has_values, bool has_returns, bool has_second) {
   std::string cls;
   if (&r == hl.best) cls += "best";
   if (std::isfinite(info.goal) && r.mean >= info.goal) cls += cls.empty() ? "goal" : " goal";
@@ -273,8 +286,13 @@ std::string CheckpointRow(const EvalRecord& r, const Highlights& hl, const Repor
        Thousands(r.env_steps) + "</td><td>" + Duration(r.wall_seconds) + "</td>";
   h += "<td class=\"mean\"><span class=\"bar\" style=\"width:" + Format("%.1f", bar) +
        "%\"></span>" + Score(r.mean) + "</td>";
-  h += "<td>" + Score(r.std) + "</td><td>" + Format("%g", r.min) + "</td><td>" +
-       Format("%g", r.max) + "</td><td>" + std::to_string(r.episodes) + "</td><td>" +
+  h += "<td>" + Score(r.std) + "</td><td>" + Format("%g", r.min) + "</td>";
+  if (has_returns) {
+    h += r.returns.empty() ? std::string("<td></td><td></td>")
+                           : "<td>" + Score(Quantile(r.returns, 0.1)) + "</td><td>" +
+                                 Score(Quantile(r.returns, 0.5)) + "</td>";
+  }
+  h += "<td>" + Format("%g", r.max) + "</td><td>" + std::to_string(r.episodes) + "</td><td>" +
        Format("%.2f s", r.eval_seconds) + "</td>";
   if (has_values && r.value_steps > 0) {
     h += "<td>" + Score(r.value_estimate) + "</td><td>" + Score(r.value_return) + "</td><td>" +
@@ -311,19 +329,27 @@ std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Hig
          "2016: Q well above G is overestimation); r is the correlation of the two across the "
          "steps (near 0: the network cannot tell good states from bad ones).</p>\n";
   }
+  const bool has_returns = std::any_of(records.begin(), records.end(),
+                                       [](const EvalRecord& r) { return !r.returns.empty(); });
+  if (has_returns) {
+    h += "<p>10 % and median: the returns that a tenth and a half of the evaluation episodes fell "
+         "below. A mean well under its median comes from a few failed episodes, a low median "
+         "from a shortfall in most of them.</p>\n";
+  }
   const bool has_second = !info.second_name.empty();
   if (has_second) {
     h +=
         "<p>Second metric (new best checkpoints only): " + HtmlEscape(info.second_name) + ".</p>\n";
   }
   h += "<div class=\"scroll\"><table>\n<thead><tr><th>checkpoint</th><th>update</th>"
-       "<th>env steps</th><th>wall time</th><th>mean</th><th>std</th><th>min</th><th>max</th>"
-       "<th>episodes</th><th>eval time</th>";
+       "<th>env steps</th><th>wall time</th><th>mean</th><th>std</th><th>min</th>";
+  if (has_returns) h += "<th>10 %</th><th>median</th>";
+  h += "<th>max</th><th>episodes</th><th>eval time</th>";
   if (has_values) h += "<th>Q</th><th>G</th><th>r</th>";
   if (has_second) h += "<th>second metric</th>";
   h += "</tr></thead>\n<tbody>\n";
   for (const EvalRecord* r : rows)
-    h += CheckpointRow(*r, hl, info, bar_scale, has_values, has_second);
+    h += CheckpointRow(*r, hl, info, bar_scale, has_values, has_returns, has_second);
   return h + "</tbody>\n</table></div>\n</section>\n";
 }
 

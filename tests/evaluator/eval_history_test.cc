@@ -1,5 +1,6 @@
 #include "evaluator/eval_history.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -38,12 +39,15 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   d.second_episodes = 100;
   d.second_mean = 642.125;
   d.second_std = -0.5;
+  // With the episodes' returns.
+  d.returns = {-0.1, 912.5, 1.0 / 3.0};
   for (const EvalRecord& r : {a, b, c, d}) AppendJsonLine(path, r);
 
   const std::string text = ReadFile(path);
   EXPECT_EQ(testing::CountOccurrences(text, "\n"), 4);
   EXPECT_EQ(testing::CountOccurrences(text, "\"second_mean\": 642.125"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"value_correlation\": null"), 1);
+  EXPECT_EQ(testing::CountOccurrences(text, "\"returns\": [-0.1,912.5,"), 1);
   int skipped = -1;
   const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
   EXPECT_EQ(skipped, 0);
@@ -93,6 +97,15 @@ TEST(JsonLinesTest, ParseAcceptsOtherKeyOrderAndRejectsNonObjects) {
   EXPECT_EQ(r.checkpoint, "x");
   EXPECT_EQ(r.update, 3);
   EXPECT_EQ(r.mean, 12.5);
+  EXPECT_TRUE(r.returns.empty());
+  // Returns that are not an array of numbers are read as none; the record stands.
+  ASSERT_TRUE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1, "returns": [1, "a"]})", &r));
+  EXPECT_TRUE(r.returns.empty());
+  ASSERT_TRUE(
+      ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1, "returns": [1, null]})", &r));
+  ASSERT_EQ(r.returns.size(), 2U);
+  EXPECT_EQ(r.returns[0], 1);
+  EXPECT_TRUE(std::isnan(r.returns[1]));
   EXPECT_FALSE(ParseJson("[1, 2]", &r));
   EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3})", &r));  // no mean
   EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1} trailing)", &r));

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -31,6 +32,22 @@ TEST(JsonLineTest, ReadsStringsNumbersBooleansAndNull) {
   EXPECT_FALSE(JsonIntegerAt(*numbers, "b").has_value());
   EXPECT_FALSE(JsonIntegerAt(*numbers, "c").has_value());
   EXPECT_FALSE(JsonIntegerAt(*numbers, "d").has_value());
+}
+
+TEST(JsonLineTest, ReadsArraysOfNumbersAndRefusesOtherArrays) {
+  const std::optional<nlohmann::json> obj =
+      ParseJsonLine(R"({"a": [1, -2.5, null], "e": [], "s": [1, "x"], "n": 3, "o": [[1]]})");
+  ASSERT_TRUE(obj.has_value());
+  const std::optional<std::vector<double>> a = JsonNumbersAt(*obj, "a");
+  ASSERT_TRUE(a.has_value());
+  ASSERT_EQ(a->size(), 3U);
+  EXPECT_EQ((*a)[0], 1.0);
+  EXPECT_EQ((*a)[1], -2.5);
+  EXPECT_TRUE(std::isnan((*a)[2]));
+  EXPECT_EQ(JsonNumbersAt(*obj, "e"), std::vector<double>{});
+  for (const char* key : {"s", "n", "o", "missing"}) {
+    EXPECT_FALSE(JsonNumbersAt(*obj, key).has_value()) << key;
+  }
 }
 
 TEST(JsonLineTest, RejectsTornAndMalformedLinesAndOtherValues) {

@@ -104,6 +104,22 @@ TEST_F(ReportTest, ShowsValueEstimatesOnlyWhenMeasuredAndSmallScoresWithTwoDecim
   EXPECT_NE(html.find("van Hasselt"), std::string::npos);
 }
 
+TEST_F(ReportTest, ShowsTheTenthPercentileAndMedianOfTheReturnsOnlyWhenKept) {
+  const std::string report = dir_ / "report";
+  std::string html = WriteAndRead(report, {Record("a.bin", 1000, 450)}, Info(900));
+  EXPECT_EQ(html.find("<th>median</th>"), std::string::npos);
+
+  // An older line without returns beside one with them (the order of the episodes is not
+  // sorted): 10 % at 90, interpolated between 0 and 100; the median at 450.
+  EvalRecord r = Record("b.bin", 2000, 450);
+  r.returns = {900, 0, 800, 100, 700, 200, 600, 300, 500, 400};
+  html = WriteAndRead(report, {Record("a.bin", 1000, 450), r}, Info(900));
+  EXPECT_NE(html.find("<th>min</th><th>10 %</th><th>median</th><th>max</th>"), std::string::npos);
+  EXPECT_NE(html.find("<td>90.0</td><td>450.0</td><td>675</td>"), std::string::npos) << html;
+  EXPECT_NE(html.find("<td>225</td><td></td><td></td><td>675</td>"), std::string::npos);
+  EXPECT_NE(html.find("a few failed episodes"), std::string::npos);
+}
+
 TEST_F(ReportTest, SaysWhenAndWhereTheGoalWasFirstReached) {
   const std::vector<EvalRecord> records = {
       Record("a.bin", 1000, 100.0), Record("b.bin", 2000, 480.0), Record("c.bin", 3000, 500.0)};
