@@ -66,6 +66,7 @@ EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
   r.max = score.max;
   r.episodes = score.episodes;
   r.returns = score.returns;
+  r.steps = score.steps;
   r.eval_seconds = MonoSeconds() - start;
   if (score.values) {
     r.value_steps = score.values->steps;

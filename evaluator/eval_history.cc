@@ -40,6 +40,7 @@ std::string ToJson(const EvalRecord& r) {
     j["second_episodes"] = r.second_episodes;
   }
   if (!r.returns.empty()) j["returns"] = r.returns;
+  if (!r.steps.empty()) j["steps"] = r.steps;
   return JsonLine(j);
 }
 
@@ -78,6 +79,13 @@ bool ParseJson(const std::string& line, EvalRecord* record) {
     r.second_std = number("second_std", 0);
   }
   r.returns = JsonNumbersAt(*j, "returns").value_or(std::vector<double>{});
+  for (double steps : JsonNumbersAt(*j, "steps").value_or(std::vector<double>{})) {
+    if (!(steps >= 0 && steps <= 1e9 && steps == std::floor(steps))) {
+      r.steps.clear();
+      break;
+    }
+    r.steps.push_back(static_cast<int>(steps));
+  }
   *record = std::move(r);
   return true;
 }

@@ -36,6 +36,9 @@ struct EvalRecord {
   // Each evaluation episode's return, in episode order: how a mean was made (a few failed
   // episodes or a uniform shortfall). Empty in lines written before they were kept.
   std::vector<double> returns;
+  // Each evaluation episode's env steps, in episode order: with the env's time limit, which
+  // episodes ended early (a lap finished, a crash) and which ran out of time. Empty as above.
+  std::vector<int> steps;
 
   bool operator==(const EvalRecord&) const = default;
 };
@@ -45,14 +48,14 @@ struct EvalRecord {
 /// "eval_seconds": ...}, and when value_steps > 0 also "value_steps", "value_estimate",
 /// "value_return" and "value_correlation" (null when unset), and when second_episodes > 0
 /// "second_mean", "second_std" and "second_episodes", and last, when there are any, "returns"
-/// (an array) (json_line.h: numbers in their shortest form that reads back exactly; a non-finite
-/// number is written as null).
+/// and "steps" (arrays) (json_line.h: numbers in their shortest form that reads back exactly; a
+/// non-finite number is written as null).
 std::string ToJson(const EvalRecord& record);
 
 /// Parses one line written by ToJson (keys in any order, unknown keys ignored, whitespace
 /// allowed). Returns false, leaving *record unchanged, when the line is not such an object or
-/// lacks "checkpoint", "update" or "mean". "returns" that is not an array of numbers is read as
-/// none.
+/// lacks "checkpoint", "update" or "mean". "returns" that is not an array of numbers, or
+/// "steps" that is not one of whole numbers from 0, is read as none.
 bool ParseJson(const std::string& line, EvalRecord* record);
 
 /// Appends ToJson(record) and a newline to the file at `path` (created if missing), then

@@ -35,7 +35,7 @@ constexpr char kUsage[] =
     "      update, env_steps, wall_seconds, mean, std, min, max, episodes, eval_seconds,\n"
     "      value_steps, value_estimate, value_return, value_correlation: the network's value\n"
     "      estimates of the actions taken against the discounted returns that followed, and\n"
-    "      returns: each episode's return).\n"
+    "      returns and steps: each episode's return and length).\n"
     "      --frames also writes the grid of camera frames the report shows (pixel envs),\n"
     "      --tsne-map the t-SNE map of its last hidden layer (pixel envs; N states, 2000 by\n"
     "      default).\n"

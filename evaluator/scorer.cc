@@ -135,10 +135,13 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
   bool has_values = false;
 
   std::vector<double> returns;
+  std::vector<int> steps;
   returns.reserve(static_cast<size_t>(episodes));
+  steps.reserve(static_cast<size_t>(episodes));
   for (int i = 0; i < episodes; ++i) {
     env->Reset(first_seed + static_cast<uint64_t>(i));
     double episode_return = 0;
+    int episode_steps = 0;
     // Act until the env terminates or its time limit truncates the episode.
     for (;;) {
       policy->Act(env->observation(), 0, action);
@@ -146,6 +149,7 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
       const std::optional<double> value = policy->last_value();
       const envs::StepResult step = env->Step(action);
       episode_return += step.reward;
+      ++episode_steps;
       if (value) {
         has_values = true;
         calibration.Step(*value, step.reward);
@@ -157,8 +161,10 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
       }
     }
     returns.push_back(episode_return);
+    steps.push_back(episode_steps);
   }
   EvalScore score = Summarize(std::move(returns));
+  score.steps = std::move(steps);
   if (has_values) score.values = calibration.Result();
   return score;
 }

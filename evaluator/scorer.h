@@ -54,6 +54,7 @@ struct EvalScore {
   double min = 0;
   double max = 0;
   std::vector<double> returns;  // one per episode, in episode order
+  std::vector<int> steps;       // each episode's env steps (Score() only), in episode order
   /// Set when the policy gave value estimates (a Q network's, see Policy::last_value) and some
   /// steps could be compared.
   std::optional<ValueCalibration> values;

@@ -41,6 +41,7 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   d.second_std = -0.5;
   // With the episodes' returns.
   d.returns = {-0.1, 912.5, 1.0 / 3.0};
+  d.steps = {1, 200, 0};
   for (const EvalRecord& r : {a, b, c, d}) AppendJsonLine(path, r);
 
   const std::string text = ReadFile(path);
@@ -48,6 +49,7 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   EXPECT_EQ(testing::CountOccurrences(text, "\"second_mean\": 642.125"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"value_correlation\": null"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"returns\": [-0.1,912.5,"), 1);
+  EXPECT_EQ(testing::CountOccurrences(text, "\"steps\": [1,200,0]"), 1);
   int skipped = -1;
   const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
   EXPECT_EQ(skipped, 0);
@@ -106,6 +108,14 @@ TEST(JsonLinesTest, ParseAcceptsOtherKeyOrderAndRejectsNonObjects) {
   ASSERT_EQ(r.returns.size(), 2U);
   EXPECT_EQ(r.returns[0], 1);
   EXPECT_TRUE(std::isnan(r.returns[1]));
+  // Steps must be whole numbers from 0.
+  for (const char* steps : {"[1, 2.5]", "[-1]", "[1, null]", "[\"1\"]"}) {
+    ASSERT_TRUE(ParseJson(
+        std::string(R"({"checkpoint": "x", "update": 3, "mean": 1, "steps": )") + steps + "}", &r));
+    EXPECT_TRUE(r.steps.empty()) << steps;
+  }
+  ASSERT_TRUE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1, "steps": [7, 0]})", &r));
+  EXPECT_EQ(r.steps, (std::vector<int>{7, 0}));
   EXPECT_FALSE(ParseJson("[1, 2]", &r));
   EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3})", &r));  // no mean
   EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1} trailing)", &r));

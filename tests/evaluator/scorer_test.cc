@@ -136,6 +136,9 @@ TEST(ScorerTest, CallsTheTickOnceAfterEveryStep) {
   for (double r : s.returns) steps += r;
   EXPECT_EQ(policy.calls, static_cast<int>(steps));
   EXPECT_EQ(calls, policy.calls);
+  // Each episode's length, for the same reason its return.
+  ASSERT_EQ(s.steps.size(), s.returns.size());
+  for (size_t i = 0; i < s.steps.size(); ++i) EXPECT_EQ(s.steps[i], s.returns[i]) << i;
 }
 
 TEST(ScorerTest, EpsilonZeroIsGreedyAndEpsilonOneUniformlyRandom) {
