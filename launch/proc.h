@@ -61,8 +61,12 @@ class StopWrites {
   /// Looks at the folder again (at most every 0.25 s) and returns whether the process is still
   /// writing at `now` (MonoSeconds()) by the rule above.
   bool Writing(double now);
-  /// Whether it may be killed at `now`: stop_seconds have passed and it is not writing.
-  bool Overdue(double now) { return now >= deadline_ && !Writing(now); }
+  /// Whether it may be killed at `now`: stop_seconds have passed and it is not writing. Looks at
+  /// the folder before the deadline too, so that a stall is timed from the last change seen.
+  bool Overdue(double now) {
+    const bool writing = Writing(now);
+    return now >= deadline_ && !writing;
+  }
   /// " (NAME: N MB so far)" for the largest temporary file, "" when there is none.
   std::string Describe() const;
 
