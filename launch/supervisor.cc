@@ -414,16 +414,6 @@ void Supervisor::BeginStop(RunEnd end) {
   }
 }
 
-bool Supervisor::StillWriting(Proc* p, double now) {
-  if (!p->stop || !p->stop->Writing(now)) return false;
-  if (now >= stop_deadline_ && now - p->told_at >= 10) {
-    p->told_at = now;
-    Tell(p, "launch: " + p->plan->role + " is still writing" + p->stop->Describe() +
-                "; waiting for it");
-  }
-  return true;
-}
-
 bool Supervisor::AnyRunning(bool last) const {
   for (const Proc& p : procs_) {
     if (p.pid > 0 && p.plan->stops_last == last) return true;
@@ -436,7 +426,15 @@ void Supervisor::AdvanceStop(double now) {
     if (AnyRunning(false)) {
       for (Proc& p : procs_) {
         if (p.pid <= 0 || p.plan->stops_last || p.killed) continue;
-        if (StillWriting(&p, now) || now < stop_deadline_) continue;
+        if (!p.stop->Overdue(now)) {
+          // Not overdue past the usual seconds: still writing its last files. Said every 10 s.
+          if (now >= stop_deadline_ && now - p.told_at >= 10) {
+            p.told_at = now;
+            Tell(&p, "launch: " + p.plan->role + " is still writing" + p.stop->Describe() +
+                         "; waiting for it");
+          }
+          continue;
+        }
         Tell(&p, "launch: " + p.plan->role + " did not stop; killing it");
         kill(p.pid, SIGKILL);
         p.killed = true;

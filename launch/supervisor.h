@@ -80,10 +80,6 @@ class Supervisor {
   void StartNextInOrder();
   void BeginStop(RunEnd end);
   void AdvanceStop(double now);
-  // Stopping, past the usual seconds: whether `p` is still writing its last files (a temporary
-  // file of writes_at_stop changed within stop_stall_seconds, and stop_write_limit not reached).
-  // Past stop_seconds, says so every 10 s.
-  bool StillWriting(Proc* p, double now);
   void ForwardShownOutput();
   void HandleSignals();
   double NextWakeup(double now) const;
