@@ -29,6 +29,7 @@ void ActorConfig::Validate() const {
   if (n_step < 1) throw std::invalid_argument("n-step must be >= 1");
   if (!(gamma >= 0 && gamma <= 1)) throw std::invalid_argument("gamma must be in [0, 1]");
   if (!(stats_hz > 0)) throw std::invalid_argument("stats-hz must be > 0");
+  if (later_env_after < 0) throw std::invalid_argument("later-env-after must be >= 0");
 }
 
 uint64_t TrainingSeed(uint64_t run_seed, int actor_id, int env_index) {
@@ -37,6 +38,19 @@ uint64_t TrainingSeed(uint64_t run_seed, int actor_id, int env_index) {
 }
 
 namespace {
+
+// Added to TrainingSeed for the first reset of a later env, so that its episodes are not those
+// the first env played (below 10^9 with any run seed, and distinct for up to 5,000 actors).
+constexpr uint64_t kLaterEnvSeedOffset = 500000;
+
+// Whether `a` and `b` give the same observations and actions, so that one actor's transitions
+// and the learner's network fit both.
+bool SameShape(const envs::EnvSpec& a, const envs::EnvSpec& b) {
+  return a.observation_size == b.observation_size && a.num_actions == b.num_actions &&
+         a.action_dim == b.action_dim && a.action_low == b.action_low &&
+         a.action_high == b.action_high && a.frame_height == b.frame_height &&
+         a.frame_width == b.frame_width && a.frame_stack == b.frame_stack;
+}
 
 // Flat envs: a transition carries the observation's floats.
 struct FlatCodec {
@@ -151,6 +165,12 @@ Actor::Actor(ActorConfig config, Bus* bus)
     s.action.resize(static_cast<size_t>(spec_.action_width()));
     s.encoder = MakeEncoder();
     s.encoder->Start(*s.env);
+  }
+  if (!config_.later_env_id.empty() &&
+      !SameShape(envs::MakeEnv(config_.later_env_id)->spec(), spec_)) {
+    throw std::invalid_argument("later-env '" + config_.later_env_id +
+                                "' gives other observations or actions than env '" +
+                                config_.env_id + "'");
   }
   policy_ = MakePolicy(spec_, config_.exploration, config_.actor_id, config_.num_actors,
                        TrainingSeed(config_.seed, config_.actor_id, 99));
@@ -300,12 +320,29 @@ int Actor::StepEnvs() {
       ++episodes_;
       ++s.episode_id;
       s.episode_return = 0;
-      s.env->Reset();
+      if (!s.later && !config_.later_env_id.empty() && env_steps_ >= config_.later_env_after) {
+        TakeLaterEnv(&s);
+      } else {
+        s.env->Reset();
+      }
       s.encoder->Start(*s.env);
     }
   }
   env_steps_ += static_cast<int64_t>(slots_.size());
   return static_cast<int>(slots_.size());
+}
+
+void Actor::TakeLaterEnv(EnvSlot* s) {
+  const auto j = static_cast<int>(s - slots_.data());
+  s->env = envs::MakeEnv(config_.later_env_id);
+  s->env->Reset(TrainingSeed(config_.seed, config_.actor_id, j) + kLaterEnvSeedOffset);
+  s->later = true;
+  if (j == 0) {
+    std::printf("actor-%d: after %lld steps, its episodes are on %s from now on\n",
+                config_.actor_id, static_cast<long long>(env_steps_) + 1,
+                config_.later_env_id.c_str());
+    std::fflush(stdout);
+  }
 }
 
 double Actor::mean_return() const {

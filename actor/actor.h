@@ -51,6 +51,12 @@ struct ActorConfig {
   double stats_hz = 4.0;               // stats messages per second
   int64_t max_steps = 0;               // stop after this many env steps (0: run until stopped)
   bool clip_rewards = false;           // clamp each step's reward to [-1, 1] in transitions
+  // A second environment for the episodes that begin once this actor has taken
+  // `later_env_after` steps (its earlier lives included): a schedule of training rules, such as
+  // CarRacing's off-track rule, which speeds early learning, dropped once the policy drives. It
+  // must give the observations and actions env_id gives. "": env_id throughout.
+  std::string later_env_id;
+  int64_t later_env_after = 0;
 
   // Throws std::invalid_argument naming the bad field.
   void Validate() const;
@@ -144,6 +150,7 @@ class Actor {
     std::unique_ptr<ObservationEncoder> encoder;
     double episode_return = 0;
     int64_t episode_id = 0;
+    bool later = false;  // env is the later env
   };
 
   void OnWeights(const rlmsg::weights_chunk_t& chunk);
@@ -151,6 +158,9 @@ class Actor {
   // env (the policy's own, or a candidate built now and kept for when its version completes),
   // or -1 with the reason logged.
   int64_t WeightsSize(const std::string& architecture);
+  // Puts the later env in slot `s` at an episode's end and resets it (the first reset of slot
+  // j: TrainingSeed(seed, actor_id, j) + an offset); says so for slot 0.
+  void TakeLaterEnv(EnvSlot* s);
   // The encoder of an env of this actor's spec.
   std::unique_ptr<ObservationEncoder> MakeEncoder();
   // Appends a transition's other fields to the batch (its encoder has appended its

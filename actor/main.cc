@@ -59,7 +59,14 @@ int Main(int argc, char** argv) {
        "clamp rewards to [-1, 1] in transitions, as Mnih et al. 2015 (1/0; returns in the stats "
        "stay unclipped)")  //
       ("max-steps", rl::po::value(&c.max_steps)->default_value(c.max_steps),
-       "stop after this many env steps (0: until stopped)");
+       "stop after this many env steps (0: until stopped)")  //
+      ("later-env", rl::po::value(&c.later_env_id),
+       "environment id of the episodes that begin after --later-env-after steps of this actor "
+       "(a schedule of training rules, e.g. CarRacing's off-track rule dropped once the policy "
+       "drives); it must give the observations and actions --env gives")  //
+      ("later-env-after", rl::po::value(&c.later_env_after)->default_value(c.later_env_after),
+       "with --later-env: steps of this actor (its earlier lives included) before its episodes "
+       "begin on the later env");
   rl::po::variables_map vm;
   if (!rl::ParseOptions(argc, argv, "actor",
                         "Usage: actor [options]\n"
@@ -76,6 +83,9 @@ int Main(int argc, char** argv) {
   } else {
     rl::RefuseGiven(vm, {"sigma", "sigma-end", "sigma-anneal-steps", "noise-spread", "start-steps"},
                     "exploration is " + e.mode + " (epsilon-greedy), and it is a gaussian option");
+  }
+  if (c.later_env_id.empty()) {
+    rl::RefuseGiven(vm, {"later-env-after"}, "no --later-env is given");
   }
   rl::InstallStopHandlers();
   rl::Bus bus(common.MakeBusConfig("actor-" + std::to_string(c.actor_id)));

@@ -448,6 +448,39 @@ TEST(ActorPixelsTest, SendsEveryFrameOnceAndStacksThatRebuildTheEnvsObservations
   EXPECT_EQ(episode_starts, 7);
 }
 
+// Catch's episodes last 9 steps; the later env cuts them at 3. Episodes that begin from step 20
+// on are played on it: the first episode end at or after step 20 is step 27's.
+TEST(ActorLaterEnvTest, PlaysTheEpisodesThatBeginAfterItsStepsOnTheLaterEnv) {
+  Bus bus(Memq());
+  ActorConfig config;
+  config.env_id = "Catch-v0+pixels(width=5,height=10,stack=3,max-pool=0)";
+  config.later_env_id = "Catch-v0+pixels(width=5,height=10,stack=3,max-pool=0,time-limit=3)";
+  config.later_env_after = 20;
+  Actor actor(config, &bus);
+  for (int i = 0; i < 27; ++i) actor.StepEnvs();
+  EXPECT_EQ(actor.episodes(), 3);
+  for (int i = 0; i < 33; ++i) actor.StepEnvs();
+  EXPECT_EQ(actor.episodes(), 3 + 11);
+
+  config.later_env_id.clear();
+  Actor without(config, &bus);
+  for (int i = 0; i < 60; ++i) without.StepEnvs();
+  EXPECT_EQ(without.episodes(), 6);
+}
+
+TEST(ActorLaterEnvTest, RefusesALaterEnvWithOtherObservationsOrActions) {
+  Bus bus(Memq());
+  ActorConfig config;
+  config.env_id = "Catch-v0+pixels(width=5,height=10,stack=3,max-pool=0)";
+  config.later_env_id = "Catch-v0+pixels(width=6,height=10,stack=3,max-pool=0)";
+  EXPECT_THROW(Actor(config, &bus), std::invalid_argument);
+  config.later_env_id = "CartPole-v1";
+  EXPECT_THROW(Actor(config, &bus), std::invalid_argument);
+  config.later_env_id = config.env_id;
+  config.later_env_after = -1;
+  EXPECT_THROW(Actor(config, &bus), std::invalid_argument);
+}
+
 TEST(ActorConfigTest, RefusesAnActorIdOutsideTheRun) {
   ActorConfig c;
   c.num_actors = 2;
