@@ -11,6 +11,7 @@
 #include "common/clock.h"
 #include "common/shutdown.h"
 #include "envs/registry.h"
+#include "envs/specs.h"
 #include "rlmsg/flow_control_t.hpp"
 #include "rlmsg/stats_actor_t.hpp"
 
@@ -166,8 +167,7 @@ Actor::Actor(ActorConfig config, Bus* bus)
     s.encoder = MakeEncoder();
     s.encoder->Start(*s.env);
   }
-  if (!config_.later_env_id.empty() &&
-      !SameShape(envs::MakeEnv(config_.later_env_id)->spec(), spec_)) {
+  if (!config_.later_env_id.empty() && !SameShape(envs::LookupSpec(config_.later_env_id), spec_)) {
     throw std::invalid_argument("later-env '" + config_.later_env_id +
                                 "' gives other observations or actions than env '" +
                                 config_.env_id + "'");
