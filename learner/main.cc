@@ -149,7 +149,12 @@ int Main(int argc, char** argv) {
   // The kernels the networks will run on (throws, naming the reason, when RL_KERNELS asks for a
   // path this CPU cannot run).
   std::string kernels = "precision " + c.precision + ", " + rl::nn::KernelPath() + " kernels";
-  if (c.precision == "bf16" && !rl::nn::NativeBf16()) {
+  const std::string& encoder_precision = c.Get<rl::learner::Td3Config>().encoder_precision;
+  if (c.algorithm == rl::learner::Td3Config::kName && !encoder_precision.empty()) {
+    kernels = "precision " + c.precision + " (the shared encoder's: " + encoder_precision + "), " +
+              rl::nn::KernelPath() + " kernels";
+  }
+  if ((c.precision == "bf16" || encoder_precision == "bf16") && !rl::nn::NativeBf16()) {
     kernels += ", bf16 emulated: no AVX512_BF16";
     std::fprintf(stderr,
                  "learner: warning: this CPU (or RL_KERNELS) gives no AVX512_BF16: bf16 products "

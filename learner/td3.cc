@@ -53,6 +53,16 @@ void Td3Config::Validate() const {
     throw std::invalid_argument("target-noise-clip must be >= 0");
   }
   if (!(max_grad_norm >= 0)) throw std::invalid_argument("max-grad-norm must be >= 0");
+  if (!encoder_precision.empty()) {
+    if (encoder_precision != "fp32" && encoder_precision != "bf16") {
+      throw std::invalid_argument("encoder-precision must be fp32 or bf16, not '" +
+                                  encoder_precision + "'");
+    }
+    if (network != "drq") {
+      throw std::invalid_argument("encoder-precision is for network drq (a shared encoder), not '" +
+                                  network + "'");
+    }
+  }
 }
 
 void Td3Config::AddOptions(po::options_description* desc) {
@@ -67,7 +77,10 @@ void Td3Config::AddOptions(po::options_description* desc) {
       ("target-noise", po::value(&target_noise)->default_value(target_noise),
        "target policy smoothing noise, relative to each action dimension's half-range")  //
       ("target-noise-clip", po::value(&target_noise_clip)->default_value(target_noise_clip),
-       "clip of that noise, relative to the half-range");
+       "clip of that noise, relative to the half-range")  //
+      ("encoder-precision", po::value(&encoder_precision),
+       "network drq: the shared encoder's matrix products, fp32 or bf16, where they should "
+       "differ from --precision, which the heads keep (default: --precision)");
 }
 
 std::unique_ptr<Algorithm> Td3Config::Make(const envs::EnvSpec& spec) const {
@@ -157,7 +170,10 @@ Td3::Td3(const envs::EnvSpec& spec, Td3Config config)
   }
   q1_ = BuildCritic(config_, spec_, &rng);
   q2_ = BuildCritic(config_, spec_, &rng);
-  for (nn::Sequential* net : {&encoder_, &actor_}) net->set_precision(config_.precision);
+  encoder_.set_precision(config_.encoder_precision.empty()
+                             ? config_.precision
+                             : nn::ParsePrecision(config_.encoder_precision));
+  actor_.set_precision(config_.precision);
   for (nn::ActionValueNet* net : {&q1_, &q2_}) net->set_precision(config_.precision);
   actor_target_ = actor_;
   q1_target_ = q1_;

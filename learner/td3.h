@@ -60,6 +60,9 @@ struct Td3Config {
   float max_grad_norm = 0.0f;      // global gradient-norm clip of each optimizer (0: none)
   uint64_t seed = 0;               // initialisation and target-noise seed
   nn::Precision precision = nn::Precision::kFp32;  // the networks' products (nn/precision.h)
+  // Network drq: the shared encoder's products when they differ from `precision` ("fp32" or
+  // "bf16"; empty: `precision`), e.g. bf16 convolutions beside fp32 heads.
+  std::string encoder_precision;
 
   // Throws std::invalid_argument naming the bad field.
   void Validate() const;

@@ -368,6 +368,38 @@ TEST(Td3Test, SharedEncoderLearnsFromTheCriticsOnly) {
   EXPECT_EQ(Flat(c.policy()), joined);
 }
 
+// encoder-precision bf16 beside precision fp32: the encoder computes as the whole network does in
+// bf16, the actor head as in fp32; refused for a network without a shared encoder and for a name
+// that is no precision.
+TEST(Td3Test, SharedEncoderCanComputeInItsOwnPrecision) {
+  const envs::EnvSpec spec = CarPixelSpec();
+  Td3Config c;
+  c.network = "drq";
+  c.hidden = {32};
+  c.encoder_precision = "bf16";
+  Td3 mixed(spec, c);
+  EXPECT_EQ(mixed.encoder().precision(), nn::Precision::kBf16);
+  EXPECT_EQ(mixed.actor().precision(), nn::Precision::kFp32);
+  c.encoder_precision.clear();
+  c.precision = nn::Precision::kBf16;
+  Td3 bf16(spec, c);
+  c.precision = nn::Precision::kFp32;
+  Td3 fp32(spec, c);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(0, 1);
+  nn::Matrix x(4 * 84 * 84, 2);
+  for (Eigen::Index k = 0; k < x.size(); ++k) x.data()[k] = unit(rng);
+  const nn::Matrix features = mixed.encoder().Forward(x);
+  EXPECT_TRUE((features.array() == bf16.encoder().Forward(x).array()).all());
+  EXPECT_FALSE((features.array() == fp32.encoder().Forward(x).array()).all());
+
+  c.encoder_precision = "fp16";
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.encoder_precision = "bf16";
+  c.network = "mlp";
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
 TEST(Td3Test, SharedEncoderNeedsCarRacingStacks) {
   envs::EnvSpec spec = CarPixelSpec();
   spec.observation_size = 4 * 42 * 42;
