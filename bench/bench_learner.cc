@@ -10,7 +10,10 @@
 //                        128). One call is one critic update; every 2nd also updates the actor and
 //                        the targets (policy delay 2), as the peer's. Also the GFLOP/s this
 //                        reaches, from the forward multiply-adds of the networks (see Td3Flops),
-//                        and "td3_car_drq": the car_racing_td3 preset's network (drq), batch 128.
+//                        and "td3_car_drq": the car_racing_td3 preset's network (drq), batch 128,
+//                        and "td3_car_preset": the same network as the preset trains it (batch
+//                        64), at 1 and 2 threads (nn::SetNumThreads; the preset's learner runs 2),
+//                        also with bf16 in the shared encoder only ("encoder_precision").
 // Every row is measured in fp32 and in bf16 (nn/precision.h) and says which ("precision"), on
 // which kernel path ("kernels") and whether bf16 ran on the CPU's instructions ("bf16_native").
 #include <random>
@@ -23,6 +26,7 @@
 #include "learner/td3.h"
 #include "nn/conv2d.h"
 #include "nn/linear.h"
+#include "nn/parallel.h"
 #include "nn/pixels.h"
 #include "nn/precision.h"
 
@@ -170,6 +174,7 @@ int main(int argc, char** argv) {
     int batch;
     float actor_lr, critic_lr, tau;
     bool pixels;
+    int threads = 1;
   };
   rl::envs::EnvSpec mlp_spec = rl::envs::LunarLanderSpec(true);  // 8-d observation, 2-d action
   rl::envs::EnvSpec car_spec = rl::envs::CarRacingSpec(true);    // 3-d action
@@ -181,9 +186,21 @@ int main(int argc, char** argv) {
       {"td3_car", car_spec, "car", 128, 2.5e-4f, 1e-3f, 0.05f, true},
       // The car_racing_td3 preset: the article's encoder shared, DrQ-v2 heads of 256.
       {"td3_car_drq", car_spec, "drq", 128, 2.5e-4f, 1e-3f, 0.05f, true},
+      // As configs/car_racing_td3.ini trains it: batch 64, rates 3e-4, tau 0.01, 2 threads.
+      {"td3_car_preset", car_spec, "drq", 64, 3e-4f, 3e-4f, 0.01f, true, 1},
+      {"td3_car_preset", car_spec, "drq", 64, 3e-4f, 3e-4f, 0.01f, true, 2},
   };
+  struct Variant {
+    rl::nn::Precision precision;
+    const char* encoder_precision;  // "": as precision
+  };
+  const Variant variants[] = {{rl::nn::Precision::kFp32, ""},
+                              {rl::nn::Precision::kBf16, ""},
+                              {rl::nn::Precision::kFp32, "bf16"}};
   for (const Td3Case& t : cases) {
-    for (const rl::nn::Precision precision : kPrecisions) {
+    for (const auto& [precision, encoder_precision] : variants) {
+      const bool own_encoder = *encoder_precision != '\0';
+      if (own_encoder && t.network != "drq") continue;
       rl::learner::Td3Config c;
       c.network = t.network;
       c.hidden = {256, 256};
@@ -191,6 +208,8 @@ int main(int argc, char** argv) {
       c.critic_learning_rate = t.critic_lr;
       c.tau = t.tau;
       c.precision = precision;
+      c.encoder_precision = encoder_precision;
+      rl::nn::SetNumThreads(t.threads);
       rl::learner::Td3 td3(t.spec, c);
       const std::vector<Data> data = MakeData(t.spec, t.batch, t.pixels);
       const int width = t.spec.action_width();
@@ -203,9 +222,13 @@ int main(int argc, char** argv) {
       rl::bench::Emit(
           "learner_updates_td3", "updates/s", s, repeats,
           "\"net\": \"" + std::string(t.name) + "\", \"batch\": " + std::to_string(t.batch) +
-              ", \"threads\": 1, \"gflop_per_update\": " + std::to_string(gflop) +
-              ", \"gflops\": " + std::to_string(gflop * s.median) + PrecisionFields(precision));
+              ", \"threads\": " + std::to_string(t.threads) +
+              ", \"gflop_per_update\": " + std::to_string(gflop) +
+              ", \"gflops\": " + std::to_string(gflop * s.median) + PrecisionFields(precision) +
+              (own_encoder ? ", \"encoder_precision\": \"" + std::string(encoder_precision) + "\""
+                           : ""));
     }
   }
+  rl::nn::SetNumThreads(1);
   return 0;
 }
