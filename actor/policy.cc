@@ -136,11 +136,11 @@ std::unique_ptr<Policy> MakePolicy(const envs::EnvSpec& spec, const ExplorationC
   return std::make_unique<EpsilonGreedy>(spec, exploration, actor_index, num_actors, seed);
 }
 
-ExplorationConfig EvaluationExploration(const envs::EnvSpec& spec, double epsilon) {
+ExplorationConfig EvaluationExploration(const envs::EnvSpec& spec, double epsilon, double sigma) {
   ExplorationConfig c;
   if (spec.continuous()) {
     c.mode = "gaussian";
-    c.sigma = c.sigma_end = 0.0;
+    c.sigma = c.sigma_end = sigma;
     c.start_steps = 0;
   } else {
     c.mode = "constant";

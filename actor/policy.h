@@ -74,8 +74,10 @@ class Policy {
 std::unique_ptr<Policy> MakePolicy(const envs::EnvSpec& spec, const ExplorationConfig& exploration,
                                    int actor_index, int num_actors, uint64_t seed);
 
-/// The exploration of an evaluation: epsilon `epsilon` (constant) for a discrete env, no noise
-/// and no random start for a continuous one.
-ExplorationConfig EvaluationExploration(const envs::EnvSpec& spec, double epsilon);
+/// The exploration of an evaluation: epsilon `epsilon` (constant) for a discrete env; for a
+/// continuous one no random start and Gaussian noise of constant `sigma` (0: none, the
+/// deterministic policy).
+ExplorationConfig EvaluationExploration(const envs::EnvSpec& spec, double epsilon,
+                                        double sigma = 0.0);
 
 }  // namespace rl::actor

@@ -40,21 +40,22 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
 }
 
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
-                               double epsilon, uint64_t first_seed, double gamma,
-                               const Tick& tick) {
+                               double epsilon, uint64_t first_seed, double gamma, const Tick& tick,
+                               double sigma) {
   return ScoreCheckpoint(nn::LoadCheckpoint(path), path, env_id, episodes, epsilon, first_seed,
-                         gamma, tick);
+                         gamma, tick, sigma);
 }
 
 EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
                            const std::string& env_id, int episodes, double epsilon,
-                           uint64_t first_seed, double gamma, const Tick& tick) {
+                           uint64_t first_seed, double gamma, const Tick& tick, double sigma) {
   const nn::CheckpointMeta& meta = ckpt.meta;
   nn::Sequential net = PolicyNetwork(ckpt, path, env_id);
 
   // Score.
   const double start = MonoSeconds();
-  const EvalScore score = ScorePolicy(&net, env_id, episodes, epsilon, first_seed, gamma, tick);
+  const EvalScore score =
+      ScorePolicy(&net, env_id, episodes, epsilon, first_seed, gamma, tick, sigma);
   EvalRecord r;
   r.checkpoint = std::filesystem::path(path).filename().string();
   r.update = meta.update;

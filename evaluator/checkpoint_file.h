@@ -29,17 +29,17 @@ nn::Sequential LoadPolicyNetwork(const std::string& path, const std::string& env
 /// ScorePolicy), with its value estimates against the returns (discount gamma). `path` names
 /// the checkpoint in the record and in errors. The record's update, env_steps and wall_seconds
 /// come from the checkpoint's metadata. Throws std::runtime_error as PolicyNetwork.
-/// `tick` as in ScorePolicy.
+/// `tick` and `sigma` as in ScorePolicy.
 EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
                            const std::string& env_id, int episodes, double epsilon,
-                           uint64_t first_seed, double gamma = kDefaultGamma,
-                           const Tick& tick = {});
+                           uint64_t first_seed, double gamma = kDefaultGamma, const Tick& tick = {},
+                           double sigma = 0.0);
 
 /// Loads a checkpoint file and scores it (ScoreCheckpoint). Throws std::runtime_error with the
 /// reason when the file is refused: it does not load (missing, truncated, corrupted, foreign),
 /// or ScoreCheckpoint refuses it.
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
                                double epsilon, uint64_t first_seed, double gamma = kDefaultGamma,
-                               const Tick& tick = {});
+                               const Tick& tick = {}, double sigma = 0.0);
 
 }  // namespace rl::evaluator

@@ -1,5 +1,6 @@
 // The evaluator: scores the checkpoints of a run and writes its report (service mode), or scores
 // one checkpoint file (standalone mode). See README.md.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -29,13 +30,16 @@ constexpr char kUsage[] =
     "      RL_STATS_EVALUATOR. Prints 'evaluator: ready' once subscribed. Stops on SIGINT or\n"
     "      SIGTERM, or with --stop-at-goal once a checkpoint reaches the goal, and then prints\n"
     "      'evaluator: goal reached' or 'evaluator: goal not reached (best X)'; exit status 0.\n"
-    "  evaluator --checkpoint FILE [--env ID] [--episodes N] [--epsilon E] [--seed-base S]\n"
-    "            [--gamma G] [--frames PNG] [--tsne-map PNG [--tsne N]]\n"
+    "  evaluator --checkpoint FILE [--env ID] [--episodes N] [--epsilon E] [--noise S]\n"
+    "            [--seed-base S] [--gamma G] [--frames PNG] [--tsne-map PNG [--tsne N]]\n"
     "      Standalone mode: scores one checkpoint file and prints one JSON object (checkpoint,\n"
     "      update, env_steps, wall_seconds, mean, std, min, max, episodes, eval_seconds,\n"
     "      value_steps, value_estimate, value_return, value_correlation: the network's value\n"
     "      estimates of the actions taken against the discounted returns that followed, and\n"
     "      returns and steps: each episode's return and length).\n"
+    "      --noise (continuous actions) scores the policy with the actors' Gaussian noise at\n"
+    "      that constant sigma (of the half-range) instead of its deterministic action, to\n"
+    "      compare the two; the standard metric is without noise.\n"
     "      --frames also writes the grid of camera frames the report shows (pixel envs),\n"
     "      --tsne-map the t-SNE map of its last hidden layer (pixel envs; N states, 2000 by\n"
     "      default).\n"
@@ -92,6 +96,7 @@ int Main(int argc, char** argv) {
   std::string eval_env;
   std::string frames_file;
   std::string tsne_file;
+  double noise_sigma = 0;
   std::string sched_policy;
   int nice = 0;
   double goal = 0;
@@ -111,6 +116,9 @@ int Main(int argc, char** argv) {
       ("epsilon", rl::po::value(&config.epsilon)->default_value(config.epsilon, "0.05"),
        "discrete actions: exploration rate while scoring (0.05 as in Mnih et al. 2015); "
        "continuous actions are scored without noise")  //
+      ("noise", rl::po::value(&noise_sigma),
+       "standalone mode, continuous actions: score with the actors' Gaussian noise at this "
+       "constant sigma (a fraction of each action's half-range), not the deterministic action")  //
       ("gamma", rl::po::value(&config.gamma)->default_value(config.gamma, "0.99"),
        "discount of the returns the network's value estimates are compared with: the actors' "
        "gamma (put gamma at the top of a preset so that both read it)")  //
@@ -196,13 +204,22 @@ int Main(int argc, char** argv) {
   if (rl::envs::LookupSpec(config.env_id).continuous()) {
     rl::RefuseGiven(vm, {"epsilon"},
                     config.env_id + " has continuous actions, scored without exploration");
+  } else {
+    rl::RefuseGiven(vm, {"noise"}, config.env_id + " has discrete actions (see --epsilon)");
+  }
+  if (checkpoint.empty()) {
+    rl::RefuseGiven(vm, {"noise"}, "the service scores without noise, the standard metric");
+  }
+  if (!(noise_sigma >= 0 && std::isfinite(noise_sigma))) {
+    throw std::invalid_argument("--noise must be finite and >= 0");
   }
 
   // Standalone mode: one file, one JSON object.
   if (!checkpoint.empty()) {
     config.Validate();
     rl::evaluator::EvalRecord record = rl::evaluator::ScoreCheckpointFile(
-        checkpoint, config.env_id, config.episodes, config.epsilon, config.seed_base, config.gamma);
+        checkpoint, config.env_id, config.episodes, config.epsilon, config.seed_base, config.gamma,
+        {}, noise_sigma);
     record.checkpoint = checkpoint;
     std::cout << rl::evaluator::ToJson(record) << std::endl;
     if (!frames_file.empty()) {

@@ -108,12 +108,12 @@ class CalibrationAccumulator {
 
 std::unique_ptr<actor::Policy> EvaluationPolicy(const nn::Sequential& net,
                                                 const envs::EnvSpec& spec, double epsilon,
-                                                uint64_t seed) {
+                                                uint64_t seed, double sigma) {
   if (!(epsilon >= 0.0 && epsilon <= 1.0)) {
     throw std::invalid_argument("epsilon must be in [0, 1], got " + std::to_string(epsilon));
   }
   std::unique_ptr<actor::Policy> policy =
-      actor::MakePolicy(spec, actor::EvaluationExploration(spec, epsilon), 0, 1, seed);
+      actor::MakePolicy(spec, actor::EvaluationExploration(spec, epsilon, sigma), 0, 1, seed);
   policy->SetNetwork(net);
   return policy;
 }
@@ -170,9 +170,10 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
 }
 
 EvalScore ScorePolicy(nn::Sequential* net, const std::string& env_id, int episodes, double epsilon,
-                      uint64_t first_seed, double gamma, const std::function<void()>& tick) {
+                      uint64_t first_seed, double gamma, const std::function<void()>& tick,
+                      double sigma) {
   std::unique_ptr<actor::Policy> policy =
-      EvaluationPolicy(*net, envs::LookupSpec(env_id), epsilon, first_seed);
+      EvaluationPolicy(*net, envs::LookupSpec(env_id), epsilon, first_seed, sigma);
   return Score(policy.get(), env_id, episodes, first_seed, gamma, tick);
 }
 

@@ -69,11 +69,13 @@ double Correlation(std::span<const double> x, std::span<const double> y);
 
 /// The evaluation policy of `net` for `spec` (actor/policy.h): the greedy action of a Q-network
 /// with a uniform random action with probability `epsilon` (discrete envs), or the actor
-/// network's action without noise (continuous envs); random draws seeded with `seed`. Throws
-/// std::invalid_argument when the network does not fit the env or epsilon is outside [0, 1].
+/// network's action without noise (continuous envs; with `sigma` > 0, the actors' Gaussian noise
+/// at a constant sigma, for comparing the noisy policy with the deterministic one); random
+/// draws seeded with `seed`. Throws std::invalid_argument when the network does not fit the env
+/// or epsilon is outside [0, 1].
 std::unique_ptr<actor::Policy> EvaluationPolicy(const nn::Sequential& net,
                                                 const envs::EnvSpec& spec, double epsilon,
-                                                uint64_t seed);
+                                                uint64_t seed, double sigma = 0.0);
 
 /// Runs `episodes` episodes of a fresh `env_id` env with `policy` (step 0 of its schedule): episode
 /// i is reset with seed first_seed + i and runs until terminated or truncated. When the policy
@@ -86,12 +88,12 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes,
                 uint64_t first_seed = kDefaultEvalSeedBase, double gamma = kDefaultGamma,
                 const std::function<void()>& tick = {});
 
-/// Score() with EvaluationPolicy(*net, env's spec, epsilon, first_seed). The network is copied,
-/// not changed.
+/// Score() with EvaluationPolicy(*net, env's spec, epsilon, first_seed, sigma). The network is
+/// copied, not changed.
 EvalScore ScorePolicy(nn::Sequential* net, const std::string& env_id, int episodes,
                       double epsilon = kDefaultEvalEpsilon,
                       uint64_t first_seed = kDefaultEvalSeedBase, double gamma = kDefaultGamma,
-                      const std::function<void()>& tick = {});
+                      const std::function<void()>& tick = {}, double sigma = 0.0);
 
 /// Empty when `net` can drive a policy of `spec` (input size = observation size, output size =
 /// number of actions or action dimension), else a sentence saying what differs.

@@ -241,14 +241,21 @@ TEST(ScorerTest, RefusesAGammaOutsideTheUnitInterval) {
 // A continuous env is scored with the actor network's action, without noise or epsilon: the
 // same returns as the same constant action played by hand, and no value calibration (an actor has
 // no value estimates).
-TEST(ScorerTest, ScoresAContinuousActorWithItsDeterministicAction) {
-  constexpr char kLander[] = "LunarLanderContinuous-v3";
-  std::mt19937 rng(1);
-  nn::Sequential actor = nn::MakeMlp(8, {4}, 2, &rng);
+constexpr char kLander[] = "LunarLanderContinuous-v3";
+
+// An actor network for kLander whose action is always (0.6, -0.4).
+nn::Sequential ConstantLanderActor(std::mt19937* rng) {
+  nn::Sequential actor = nn::MakeMlp(8, {4}, 2, rng);
   std::vector<float> flat(static_cast<size_t>(actor.NumParams()), 0.0f);
   flat[flat.size() - 2] = 0.6f;   // main engine
   flat[flat.size() - 1] = -0.4f;  // side engine
   actor.SetFlat(flat.data(), flat.size());
+  return actor;
+}
+
+TEST(ScorerTest, ScoresAContinuousActorWithItsDeterministicAction) {
+  std::mt19937 rng(1);
+  nn::Sequential actor = ConstantLanderActor(&rng);
   const EvalScore score = ScorePolicy(&actor, kLander, 3, /*epsilon=*/0.05, 40);
   auto env = envs::MakeEnv(kLander);
   const float action[] = {0.6f, -0.4f};
@@ -268,6 +275,23 @@ TEST(ScorerTest, ScoresAContinuousActorWithItsDeterministicAction) {
   // A Q-network's output size (4 actions) does not fit the 2 action dimensions.
   nn::Sequential q = nn::MakeMlp(8, {4}, 4, &rng);
   EXPECT_THROW(ScorePolicy(&q, kLander, 1, 0.05, 1), std::invalid_argument);
+}
+
+// With a sigma, the actor's action gets the actors' Gaussian noise: other returns than the
+// deterministic action's, the same ones again for the same seeds, and a negative sigma refused.
+TEST(ScorerTest, ScoresAContinuousActorWithTheActorsNoiseWhenGivenASigma) {
+  std::mt19937 rng(1);
+  nn::Sequential actor = ConstantLanderActor(&rng);
+  const EvalScore plain = ScorePolicy(&actor, kLander, 3, 0.05, 40, kDefaultGamma, {}, 0.0);
+  const EvalScore noisy = ScorePolicy(&actor, kLander, 3, 0.05, 40, kDefaultGamma, {}, 0.3);
+  const EvalScore again = ScorePolicy(&actor, kLander, 3, 0.05, 40, kDefaultGamma, {}, 0.3);
+  EXPECT_EQ(plain.returns, ScorePolicy(&actor, kLander, 3, 0.05, 40).returns);
+  for (size_t i = 0; i < plain.returns.size(); ++i) {
+    EXPECT_NE(noisy.returns[i], plain.returns[i]) << "episode " << i;
+  }
+  EXPECT_EQ(noisy.returns, again.returns);
+  EXPECT_THROW(ScorePolicy(&actor, kLander, 1, 0.05, 1, kDefaultGamma, {}, -0.1),
+               std::invalid_argument);
 }
 
 TEST(ScorerTest, TheDefaultSeedBaseIsFarFromTrainingSeeds) {
