@@ -44,15 +44,6 @@ namespace {
 // the first env played (below 10^9 with any run seed, and distinct for up to 5,000 actors).
 constexpr uint64_t kLaterEnvSeedOffset = 500000;
 
-// Whether `a` and `b` give the same observations and actions, so that one actor's transitions
-// and the learner's network fit both.
-bool SameShape(const envs::EnvSpec& a, const envs::EnvSpec& b) {
-  return a.observation_size == b.observation_size && a.num_actions == b.num_actions &&
-         a.action_dim == b.action_dim && a.action_low == b.action_low &&
-         a.action_high == b.action_high && a.frame_height == b.frame_height &&
-         a.frame_width == b.frame_width && a.frame_stack == b.frame_stack;
-}
-
 // Flat envs: a transition carries the observation's floats.
 struct FlatCodec {
   using Value = float;
@@ -167,7 +158,8 @@ Actor::Actor(ActorConfig config, Bus* bus)
     s.encoder = MakeEncoder();
     s.encoder->Start(*s.env);
   }
-  if (!config_.later_env_id.empty() && !SameShape(envs::LookupSpec(config_.later_env_id), spec_)) {
+  if (!config_.later_env_id.empty() &&
+      !envs::SameShape(envs::LookupSpec(config_.later_env_id), spec_)) {
     throw std::invalid_argument("later-env '" + config_.later_env_id +
                                 "' gives other observations or actions than env '" +
                                 config_.env_id + "'");

@@ -87,6 +87,13 @@ EnvSpec LookupSpec(const std::string& id) {
   throw std::invalid_argument("unknown environment id \"" + id + "\"; known ids: " + known);
 }
 
+bool SameShape(const EnvSpec& a, const EnvSpec& b) {
+  return a.observation_size == b.observation_size && a.frame_height == b.frame_height &&
+         a.frame_width == b.frame_width && a.frame_stack == b.frame_stack &&
+         a.num_actions == b.num_actions && a.action_dim == b.action_dim &&
+         a.action_low == b.action_low && a.action_high == b.action_high;
+}
+
 std::vector<std::string> SpecIds() {
   std::vector<std::string> ids;
   for (const EnvSpec& spec : ListedSpecs()) ids.push_back(spec.id);

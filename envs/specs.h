@@ -37,6 +37,11 @@ EnvSpec PixelSpec(const EnvSpec& inner, const ImagePipelineConfig& config);
 /// std::invalid_argument as MakeEnv does for an unknown id or a bad pixels setting.
 EnvSpec LookupSpec(const std::string& id);
 
+/// Whether `a` and `b` give the same observations (size, frame geometry and stack) and the same
+/// actions (count, dimension and bounds), so that one's transitions and networks fit the other:
+/// an env for another phase of training, or for another metric, of the same run.
+bool SameShape(const EnvSpec& a, const EnvSpec& b);
+
 /// The ids LookupSpec knows (those of env_list.inc, without pixel pipelines), sorted: the same
 /// list as RegisteredEnvs() (registry.h), which needs the envs linked.
 std::vector<std::string> SpecIds();

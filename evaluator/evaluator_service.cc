@@ -122,10 +122,7 @@ void EvaluatorConfig::Validate() const {
       throw std::invalid_argument("second-episodes must be at least 1, got " +
                                   std::to_string(second_episodes));
     }
-    const envs::EnvSpec a = envs::LookupSpec(env_id), b = envs::LookupSpec(second_env);
-    if (a.observation_size != b.observation_size || a.frame_height != b.frame_height ||
-        a.frame_width != b.frame_width || a.frame_stack != b.frame_stack ||
-        a.num_actions != b.num_actions || a.action_dim != b.action_dim) {
+    if (!envs::SameShape(envs::LookupSpec(env_id), envs::LookupSpec(second_env))) {
       throw std::invalid_argument("second-env " + second_env +
                                   " does not take the observations and actions of " + env_id);
     }

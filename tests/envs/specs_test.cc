@@ -155,6 +155,20 @@ TEST(CheckActionTest, ContinuousActionsStayInTheirBoundsUpToTheTolerance) {
   EXPECT_STREQ(CheckAction(spec, inf, 1e9f), "action not finite");
 }
 
+// The same observations and actions: rules and limits may differ, shapes and bounds may not.
+TEST(SameShapeTest, ComparesObservationsAndActionsNotRules) {
+  const std::string pixels = "CarRacing-v3+pixels(skip=5,crop-bottom=12,width=84,height=84,stack=4";
+  const EnvSpec training = LookupSpec(pixels + ",noop-start=45,off-track=1)");
+  const EnvSpec standard = LookupSpec(pixels + ")");
+  EXPECT_TRUE(SameShape(training, standard));
+  EXPECT_FALSE(SameShape(standard, LookupSpec(pixels.substr(0, pixels.size() - 1) + "3)")));
+  EXPECT_FALSE(SameShape(CarRacingSpec(true), CarRacingSpec(false)));
+  EnvSpec narrower = standard;
+  narrower.action_high[1] = 0.5f;  // gas
+  EXPECT_FALSE(SameShape(standard, narrower));
+  EXPECT_TRUE(SameShape(CartPoleSpec(), CartPoleSpec()));
+}
+
 TEST(EnvActTest, DispatchesByActionKindAndRefusesBadActions) {
   auto cartpole = MakeEnv("CartPole-v1");
   cartpole->Reset(3);
