@@ -1,5 +1,6 @@
 #include "evaluator/checkpoint_file.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -46,16 +47,11 @@ EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_i
                          gamma, tick, sigma);
 }
 
-EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
-                           const std::string& env_id, int episodes, double epsilon,
-                           uint64_t first_seed, double gamma, const Tick& tick, double sigma) {
-  const nn::CheckpointMeta& meta = ckpt.meta;
-  nn::Sequential net = PolicyNetwork(ckpt, path, env_id);
+namespace {
 
-  // Score.
-  const double start = MonoSeconds();
-  const EvalScore score =
-      ScorePolicy(&net, env_id, episodes, epsilon, first_seed, gamma, tick, sigma);
+// The record of checkpoint `path` (its metadata `meta`) scored `score` in `seconds`.
+EvalRecord Record(const std::string& path, const nn::CheckpointMeta& meta, const EvalScore& score,
+                  double seconds) {
   EvalRecord r;
   r.checkpoint = std::filesystem::path(path).filename().string();
   r.update = meta.update;
@@ -68,7 +64,7 @@ EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
   r.episodes = score.episodes;
   r.returns = score.returns;
   r.steps = score.steps;
-  r.eval_seconds = MonoSeconds() - start;
+  r.eval_seconds = seconds;
   if (score.values) {
     r.value_steps = score.values->steps;
     r.value_estimate = score.values->estimate;
@@ -76,6 +72,54 @@ EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
     if (std::isfinite(score.values->correlation)) r.value_correlation = score.values->correlation;
   }
   return r;
+}
+
+}  // namespace
+
+EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
+                           const std::string& env_id, int episodes, double epsilon,
+                           uint64_t first_seed, double gamma, const Tick& tick, double sigma) {
+  nn::Sequential net = PolicyNetwork(ckpt, path, env_id);
+  const double start = MonoSeconds();
+  const EvalScore score =
+      ScorePolicy(&net, env_id, episodes, epsilon, first_seed, gamma, tick, sigma);
+  return Record(path, ckpt.meta, score, MonoSeconds() - start);
+}
+
+std::vector<std::string> EnsembleFiles(const std::string& path, int count) {
+  if (count < 1) throw std::invalid_argument("an ensemble needs at least 1 checkpoint");
+  namespace fs = std::filesystem;
+  const fs::path given = fs::absolute(path).lexically_normal();
+  const std::vector<std::string> files = nn::CheckpointFilesIn(given.parent_path().string());
+  const auto it = std::find_if(files.begin(), files.end(), [&](const std::string& f) {
+    return fs::path(f).lexically_normal() == given;
+  });
+  if (it == files.end()) {
+    throw std::runtime_error(path + " is not a checkpoint file of its folder (ckpt-<update>.bin)");
+  }
+  const auto before = it - files.begin();
+  if (before + 1 < count) {
+    throw std::runtime_error("an ensemble of " + std::to_string(count) + " needs " +
+                             std::to_string(count - 1) + " checkpoints before " + path +
+                             " in its folder; it has " + std::to_string(before));
+  }
+  std::vector<std::string> chosen;
+  for (int k = 0; k < count; ++k) chosen.push_back(*(it - k));
+  return chosen;
+}
+
+EvalRecord ScoreEnsembleFiles(const std::vector<std::string>& paths, const std::string& env_id,
+                              int episodes, uint64_t first_seed, double gamma) {
+  if (paths.empty()) throw std::invalid_argument("an ensemble needs at least one checkpoint");
+  std::vector<nn::Sequential> nets;
+  nn::CheckpointMeta meta;
+  for (const std::string& path : paths) {
+    nets.push_back(LoadPolicyNetwork(path, env_id, nets.empty() ? &meta : nullptr));
+  }
+  const std::unique_ptr<actor::Policy> policy = EnsemblePolicy(nets, envs::LookupSpec(env_id));
+  const double start = MonoSeconds();
+  const EvalScore score = Score(policy.get(), env_id, episodes, first_seed, gamma);
+  return Record(paths.front(), meta, score, MonoSeconds() - start);
 }
 
 }  // namespace rl::evaluator

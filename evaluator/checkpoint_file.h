@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "evaluator/eval_history.h"
 #include "evaluator/progress.h"
@@ -41,5 +42,18 @@ EvalRecord ScoreCheckpoint(const nn::Checkpoint& ckpt, const std::string& path,
 EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_id, int episodes,
                                double epsilon, uint64_t first_seed, double gamma = kDefaultGamma,
                                const Tick& tick = {}, double sigma = 0.0);
+
+/// The checkpoint file `path` and the `count` - 1 checkpoints before it in its folder (by
+/// update: nn::CheckpointFilesIn), newest first. Throws std::runtime_error when `path` is not
+/// one of the folder's checkpoint files or fewer than `count` - 1 come before it, and
+/// std::invalid_argument for count < 1.
+std::vector<std::string> EnsembleFiles(const std::string& path, int count);
+
+/// Scores the mean action of the checkpoint files `paths` (EnsemblePolicy; continuous envs) as
+/// ScoreCheckpointFile scores one: the record names paths[0] and has its metadata. Throws
+/// std::runtime_error as ScoreCheckpointFile for any of the files, std::invalid_argument for a
+/// discrete env or no file.
+EvalRecord ScoreEnsembleFiles(const std::vector<std::string>& paths, const std::string& env_id,
+                              int episodes, uint64_t first_seed, double gamma = kDefaultGamma);
 
 }  // namespace rl::evaluator

@@ -2,17 +2,20 @@
 // one checkpoint file (standalone mode). See README.md.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "common/clock.h"
 #include "common/lcm_bus.h"
 #include "common/options.h"
 #include "common/shutdown.h"
 #include "envs/specs.h"
+#include "evaluator/checkpoint_file.h"
 #include "evaluator/evaluator_service.h"
 #include "evaluator/frame_grid.h"
 #include "evaluator/report.h"
@@ -31,7 +34,8 @@ constexpr char kUsage[] =
     "      SIGTERM, or with --stop-at-goal once a checkpoint reaches the goal, and then prints\n"
     "      'evaluator: goal reached' or 'evaluator: goal not reached (best X)'; exit status 0.\n"
     "  evaluator --checkpoint FILE [--env ID] [--episodes N] [--epsilon E] [--noise S]\n"
-    "            [--seed-base S] [--gamma G] [--frames PNG] [--tsne-map PNG [--tsne N]]\n"
+    "            [--ensemble K] [--seed-base S] [--gamma G] [--frames PNG]\n"
+    "            [--tsne-map PNG [--tsne N]]\n"
     "      Standalone mode: scores one checkpoint file and prints one JSON object (checkpoint,\n"
     "      update, env_steps, wall_seconds, mean, std, min, max, episodes, eval_seconds,\n"
     "      value_steps, value_estimate, value_return, value_correlation: the network's value\n"
@@ -40,6 +44,8 @@ constexpr char kUsage[] =
     "      --noise (continuous actions) scores the policy with the actors' Gaussian noise at\n"
     "      that constant sigma (of the half-range) instead of its deterministic action, to\n"
     "      compare the two; the standard metric is without noise.\n"
+    "      --ensemble K (continuous actions) scores the mean action of FILE and the K - 1\n"
+    "      checkpoints before it in its folder (the learner's ckpt-<update>.bin files).\n"
     "      --frames also writes the grid of camera frames the report shows (pixel envs),\n"
     "      --tsne-map the t-SNE map of its last hidden layer (pixel envs; N states, 2000 by\n"
     "      default).\n"
@@ -97,6 +103,7 @@ int Main(int argc, char** argv) {
   std::string frames_file;
   std::string tsne_file;
   double noise_sigma = 0;
+  int ensemble = 1;
   std::string sched_policy;
   int nice = 0;
   double goal = 0;
@@ -119,6 +126,9 @@ int Main(int argc, char** argv) {
       ("noise", rl::po::value(&noise_sigma),
        "standalone mode, continuous actions: score with the actors' Gaussian noise at this "
        "constant sigma (a fraction of each action's half-range), not the deterministic action")  //
+      ("ensemble", rl::po::value(&ensemble),
+       "standalone mode, continuous actions: score the mean action of the checkpoint and the "
+       "K - 1 checkpoints before it in its folder, an ensemble of K networks")  //
       ("gamma", rl::po::value(&config.gamma)->default_value(config.gamma, "0.99"),
        "discount of the returns the network's value estimates are compared with: the actors' "
        "gamma (put gamma at the top of a preset so that both read it)")  //
@@ -205,16 +215,38 @@ int Main(int argc, char** argv) {
     rl::RefuseGiven(vm, {"epsilon"},
                     config.env_id + " has continuous actions, scored without exploration");
   } else {
-    rl::RefuseGiven(vm, {"noise"}, config.env_id + " has discrete actions (see --epsilon)");
+    rl::RefuseGiven(vm, {"noise", "ensemble"},
+                    config.env_id + " has discrete actions (see --epsilon)");
   }
   if (checkpoint.empty()) {
     rl::RefuseGiven(vm, {"noise"}, "the service scores without noise, the standard metric");
+    rl::RefuseGiven(vm, {"ensemble"}, "the service scores one checkpoint at a time");
+  }
+  if (vm.count("ensemble") > 0) {
+    rl::RefuseGiven(vm, {"noise", "frames", "tsne-map"},
+                    "not with --ensemble, which scores the mean action of several networks");
+    if (ensemble < 1) throw std::invalid_argument("--ensemble must be at least 1");
   }
   if (!(noise_sigma >= 0 && std::isfinite(noise_sigma))) {
     throw std::invalid_argument("--noise must be finite and >= 0");
   }
 
   // Standalone mode: one file, one JSON object.
+  if (!checkpoint.empty() && vm.count("ensemble") > 0) {
+    config.Validate();
+    const std::vector<std::string> files = rl::evaluator::EnsembleFiles(checkpoint, ensemble);
+    std::string names;
+    for (const std::string& f : files) {
+      names += (names.empty() ? "" : ", ") + std::filesystem::path(f).filename().string();
+    }
+    std::fprintf(stderr, "evaluator: the mean action of %d checkpoints: %s\n", ensemble,
+                 names.c_str());
+    rl::evaluator::EvalRecord record = rl::evaluator::ScoreEnsembleFiles(
+        files, config.env_id, config.episodes, config.seed_base, config.gamma);
+    record.checkpoint = checkpoint;
+    std::cout << rl::evaluator::ToJson(record) << std::endl;
+    return 0;
+  }
   if (!checkpoint.empty()) {
     config.Validate();
     rl::evaluator::EvalRecord record = rl::evaluator::ScoreCheckpointFile(

@@ -104,7 +104,45 @@ class CalibrationAccumulator {
   std::vector<double> estimates_, returns_;  // the steps that count, all episodes
 };
 
+// The mean of the members' actions.
+class MeanAction final : public actor::Policy {
+ public:
+  MeanAction(const envs::EnvSpec& spec, std::vector<std::unique_ptr<actor::Policy>> members)
+      : Policy(spec, actor::EvaluationExploration(spec, 0.0), 0, 1, 0),
+        members_(std::move(members)),
+        one_(static_cast<size_t>(spec.action_width())) {}
+
+  void Act(std::span<const float> obs, int64_t step, std::span<float> action) override {
+    std::fill(action.begin(), action.end(), 0.0f);
+    for (const std::unique_ptr<actor::Policy>& member : members_) {
+      member->Act(obs, step, one_);
+      for (size_t i = 0; i < action.size(); ++i) action[i] += one_[i];
+    }
+    const auto n = static_cast<float>(members_.size());
+    for (float& a : action) a /= n;
+  }
+
+  double exploration(int64_t /*step*/) const override { return 0.0; }
+
+ private:
+  std::vector<std::unique_ptr<actor::Policy>> members_;
+  std::vector<float> one_;
+};
+
 }  // namespace
+
+std::unique_ptr<actor::Policy> EnsemblePolicy(const std::vector<nn::Sequential>& nets,
+                                              const envs::EnvSpec& spec) {
+  if (!spec.continuous()) {
+    throw std::invalid_argument(spec.id +
+                                " has discrete actions; an ensemble averages continuous ones");
+  }
+  if (nets.empty()) throw std::invalid_argument("an ensemble needs at least one network");
+  std::vector<std::unique_ptr<actor::Policy>> members;
+  members.reserve(nets.size());
+  for (const nn::Sequential& net : nets) members.push_back(EvaluationPolicy(net, spec, 0.0, 0));
+  return std::make_unique<MeanAction>(spec, std::move(members));
+}
 
 std::unique_ptr<actor::Policy> EvaluationPolicy(const nn::Sequential& net,
                                                 const envs::EnvSpec& spec, double epsilon,

@@ -77,6 +77,13 @@ std::unique_ptr<actor::Policy> EvaluationPolicy(const nn::Sequential& net,
                                                 const envs::EnvSpec& spec, double epsilon,
                                                 uint64_t seed, double sigma = 0.0);
 
+/// The mean action of the deterministic policies of `nets` (EvaluationPolicy without noise) for
+/// a continuous env: an ensemble of checkpoints of one run, each network run on every
+/// observation. Throws std::invalid_argument for a discrete env, no network, or a network that
+/// does not fit the env.
+std::unique_ptr<actor::Policy> EnsemblePolicy(const std::vector<nn::Sequential>& nets,
+                                              const envs::EnvSpec& spec);
+
 /// Runs `episodes` episodes of a fresh `env_id` env with `policy` (step 0 of its schedule): episode
 /// i is reset with seed first_seed + i and runs until terminated or truncated. When the policy
 /// gives value estimates (a Q-network), the value of every action taken is compared with the

@@ -36,32 +36,6 @@ std::unique_ptr<Algorithm> MakeAlgorithm(const LearnerConfig& c, const envs::Env
   return made;
 }
 
-// The checkpoint files ("ckpt-<update>.bin") in `dir`, by update, oldest first: what earlier
-// lives of the learner (a restart, a resumed run) left there.
-std::deque<std::string> CheckpointFiles(const std::filesystem::path& dir) {
-  std::vector<std::pair<int64_t, std::string>> found;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
-    const std::string name = entry.path().filename().string();
-    constexpr std::string_view kPrefix = "ckpt-", kSuffix = ".bin";
-    if (!name.starts_with(kPrefix) || !name.ends_with(kSuffix)) continue;
-    const std::string digits =
-        name.substr(kPrefix.size(), name.size() - kPrefix.size() - kSuffix.size());
-    // Update counts of at most 18 digits (int64_t).
-    if (digits.empty() || digits.size() > 18 ||
-        digits.find_first_not_of("0123456789") != std::string::npos) {
-      continue;
-    }
-    std::error_code regular;
-    if (!entry.is_regular_file(regular)) continue;
-    found.emplace_back(std::stoll(digits), entry.path().string());
-  }
-  std::sort(found.begin(), found.end());
-  std::deque<std::string> files;
-  for (auto& [update, path] : found) files.push_back(std::move(path));
-  return files;
-}
-
 }  // namespace
 
 void LearnerConfig::Validate() const {
@@ -109,7 +83,11 @@ Learner::Learner(LearnerConfig config, Bus* bus)
   // An earlier life killed while it wrote a checkpoint or the state left its temporary file.
   RemoveStaleTemporaries((std::filesystem::path(config_.out_dir) / "checkpoints").string());
   // Earlier lives' checkpoints count towards keep_checkpoints, and go first.
-  written_ = CheckpointFiles(std::filesystem::path(config_.out_dir) / "checkpoints");
+  // The checkpoints that earlier lives of the learner (a restart, a resumed run) left there.
+  for (std::string& path :
+       nn::CheckpointFilesIn((std::filesystem::path(config_.out_dir) / "checkpoints").string())) {
+    written_.push_back(std::move(path));
+  }
   if (config_.resume && std::filesystem::exists(StatePath())) {
     LoadState(StateFile::Load(StatePath(), StateKind()));
     resumed_ = true;
@@ -254,10 +232,9 @@ void Learner::LoadState(const StateFile& state) {
 }
 
 std::string Learner::Checkpoint() {
-  char name[64];
-  std::snprintf(name, sizeof(name), "ckpt-%09lld.bin",
-                static_cast<long long>(algorithm_->updates()));
-  std::string path = (std::filesystem::path(config_.out_dir) / "checkpoints" / name).string();
+  std::string path = (std::filesystem::path(config_.out_dir) / "checkpoints" /
+                      nn::CheckpointFileName(algorithm_->updates()))
+                         .string();
   nn::Checkpoint ckpt;
   ckpt.architecture = algorithm_->policy().Architecture();
   ckpt.meta.update = algorithm_->updates();

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <random>
 #include <stdexcept>
 
@@ -219,6 +220,37 @@ Checkpoint ParseCheckpoint(std::string_view bytes, const std::string& path) {
                " has " + std::to_string(expected) + " (parameters and buffers)");
   }
   return ckpt;
+}
+
+std::string CheckpointFileName(int64_t update) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "ckpt-%09lld.bin", static_cast<long long>(update));
+  return name;
+}
+
+std::vector<std::string> CheckpointFilesIn(const std::string& dir) {
+  std::vector<std::pair<int64_t, std::string>> found;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    constexpr std::string_view kPrefix = "ckpt-", kSuffix = ".bin";
+    if (!name.starts_with(kPrefix) || !name.ends_with(kSuffix)) continue;
+    const std::string digits =
+        name.substr(kPrefix.size(), name.size() - kPrefix.size() - kSuffix.size());
+    // Update counts of at most 18 digits (int64_t).
+    if (digits.empty() || digits.size() > 18 ||
+        digits.find_first_not_of("0123456789") != std::string::npos) {
+      continue;
+    }
+    std::error_code regular;
+    if (!entry.is_regular_file(regular)) continue;
+    found.emplace_back(std::stoll(digits), entry.path().string());
+  }
+  std::sort(found.begin(), found.end());
+  std::vector<std::string> files;
+  files.reserve(found.size());
+  for (auto& [update, path] : found) files.push_back(std::move(path));
+  return files;
 }
 
 }  // namespace rl::nn

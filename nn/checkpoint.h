@@ -52,6 +52,14 @@ Checkpoint LoadCheckpoint(const std::string& path);
 /// `name` where LoadCheckpoint's name the path.
 Checkpoint ParseCheckpoint(std::string_view bytes, const std::string& name);
 
+/// The name the learner gives the checkpoint of update `update`: "ckpt-<update, 9 digits or
+/// more>.bin".
+std::string CheckpointFileName(int64_t update);
+
+/// The checkpoint files the learner wrote in `dir` (regular files named as CheckpointFileName
+/// names them), their paths by update, oldest first; none when `dir` cannot be read.
+std::vector<std::string> CheckpointFilesIn(const std::string& dir);
+
 /// The learner's state (its networks, optimizers and counters: common/state_file.h), kept in the
 /// run's checkpoint folder beside the checkpoints, under this name: not a checkpoint file.
 inline constexpr std::string_view kLearnerStateFile = "learner-state.bin";

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <random>
 #include <span>
@@ -292,6 +293,36 @@ TEST(ScorerTest, ScoresAContinuousActorWithTheActorsNoiseWhenGivenASigma) {
   EXPECT_EQ(noisy.returns, again.returns);
   EXPECT_THROW(ScorePolicy(&actor, kLander, 1, 0.05, 1, kDefaultGamma, {}, -0.1),
                std::invalid_argument);
+}
+
+// An ensemble acts with the mean of its members' actions: two constant actors give the constant
+// action between them, played by hand; a discrete env and no member are refused.
+TEST(ScorerTest, AnEnsembleActsWithTheMeanOfItsMembersActions) {
+  std::mt19937 rng(1);
+  std::vector<nn::Sequential> members = {ConstantLanderActor(&rng), ConstantLanderActor(&rng)};
+  std::vector<float> flat;
+  members[1].GetFlat(&flat);
+  flat[flat.size() - 2] = 0.2f;
+  flat[flat.size() - 1] = 0.0f;
+  members[1].SetFlat(flat.data(), flat.size());
+  const envs::EnvSpec spec = envs::LookupSpec(kLander);
+  const std::unique_ptr<actor::Policy> ensemble = EnsemblePolicy(members, spec);
+  const EvalScore score = Score(ensemble.get(), kLander, 2, 40);
+  auto env = envs::MakeEnv(kLander);
+  const float mean_action[] = {(0.6f + 0.2f) / 2, (-0.4f + 0.0f) / 2};  // in its order
+  for (int i = 0; i < 2; ++i) {
+    env->Reset(40 + static_cast<uint64_t>(i));
+    double total = 0;
+    for (;;) {
+      const envs::StepResult r = env->Step(mean_action);
+      total += r.reward;
+      if (r.terminated || r.truncated) break;
+    }
+    EXPECT_EQ(score.returns[static_cast<size_t>(i)], total) << "episode " << i;
+  }
+  EXPECT_THROW(EnsemblePolicy({}, spec), std::invalid_argument);
+  std::vector<nn::Sequential> q = {nn::MakeMlp(4, {4}, 2, &rng)};
+  EXPECT_THROW(EnsemblePolicy(q, envs::CartPoleSpec()), std::invalid_argument);
 }
 
 TEST(ScorerTest, TheDefaultSeedBaseIsFarFromTrainingSeeds) {

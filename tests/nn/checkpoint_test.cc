@@ -215,5 +215,24 @@ TEST_F(CheckpointTest, ConvNetWithBatchNormRoundTripsIncludingRunningStatistics)
   EXPECT_THROW(LoadCheckpoint(path_), std::runtime_error);
 }
 
+// The learner's names, and the folder's checkpoint files by update: not another name, a
+// temporary file, the learner's state or a folder that has a checkpoint's name.
+TEST_F(CheckpointTest, ListsTheLearnersCheckpointFilesByUpdate) {
+  EXPECT_EQ(CheckpointFileName(7), "ckpt-000000007.bin");
+  EXPECT_EQ(CheckpointFileName(1234567890), "ckpt-1234567890.bin");
+  const Checkpoint ckpt = MakeCheckpoint();
+  for (const char* name : {"ckpt-000000100.bin", "ckpt-000000020.bin", "ckpt-1234567890.bin",
+                           "ckpt-000000030.bin.tmp.77", "ckpt-12a.bin", "ckpt-.bin",
+                           "learner-state.bin", "model.ckpt"}) {
+    SaveCheckpoint((dir_ / name).string(), ckpt);
+  }
+  fs::create_directory(dir_ / "ckpt-000000050.bin");
+  EXPECT_EQ(CheckpointFilesIn(dir_.string()),
+            (std::vector<std::string>{(dir_ / "ckpt-000000020.bin").string(),
+                                      (dir_ / "ckpt-000000100.bin").string(),
+                                      (dir_ / "ckpt-1234567890.bin").string()}));
+  EXPECT_TRUE(CheckpointFilesIn((dir_ / "missing").string()).empty());
+}
+
 }  // namespace
 }  // namespace rl::nn
