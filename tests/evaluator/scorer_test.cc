@@ -254,24 +254,30 @@ nn::Sequential ConstantLanderActor(std::mt19937* rng) {
   return actor;
 }
 
-TEST(ScorerTest, ScoresAContinuousActorWithItsDeterministicAction) {
-  std::mt19937 rng(1);
-  nn::Sequential actor = ConstantLanderActor(&rng);
-  const EvalScore score = ScorePolicy(&actor, kLander, 3, /*epsilon=*/0.05, 40);
+// The returns of `episodes` kLander episodes from seed first_seed on, `action` played throughout.
+std::vector<double> ConstantActionReturns(std::span<const float> action, int episodes,
+                                          uint64_t first_seed) {
   auto env = envs::MakeEnv(kLander);
-  const float action[] = {0.6f, -0.4f};
-  std::vector<double> by_hand;
-  for (int i = 0; i < 3; ++i) {
-    env->Reset(40 + static_cast<uint64_t>(i));
+  std::vector<double> returns;
+  for (int i = 0; i < episodes; ++i) {
+    env->Reset(first_seed + static_cast<uint64_t>(i));
     double total = 0;
     for (;;) {
       const envs::StepResult r = env->Step(action);
       total += r.reward;
       if (r.terminated || r.truncated) break;
     }
-    by_hand.push_back(total);
+    returns.push_back(total);
   }
-  EXPECT_EQ(score.returns, by_hand);
+  return returns;
+}
+
+TEST(ScorerTest, ScoresAContinuousActorWithItsDeterministicAction) {
+  std::mt19937 rng(1);
+  nn::Sequential actor = ConstantLanderActor(&rng);
+  const EvalScore score = ScorePolicy(&actor, kLander, 3, /*epsilon=*/0.05, 40);
+  const float action[] = {0.6f, -0.4f};
+  EXPECT_EQ(score.returns, ConstantActionReturns(action, 3, 40));
   EXPECT_FALSE(score.values.has_value());
   // A Q-network's output size (4 actions) does not fit the 2 action dimensions.
   nn::Sequential q = nn::MakeMlp(8, {4}, 4, &rng);
@@ -308,18 +314,8 @@ TEST(ScorerTest, AnEnsembleActsWithTheMeanOfItsMembersActions) {
   const envs::EnvSpec spec = envs::LookupSpec(kLander);
   const std::unique_ptr<actor::Policy> ensemble = EnsemblePolicy(members, spec);
   const EvalScore score = Score(ensemble.get(), kLander, 2, 40);
-  auto env = envs::MakeEnv(kLander);
   const float mean_action[] = {(0.6f + 0.2f) / 2, (-0.4f + 0.0f) / 2};  // in its order
-  for (int i = 0; i < 2; ++i) {
-    env->Reset(40 + static_cast<uint64_t>(i));
-    double total = 0;
-    for (;;) {
-      const envs::StepResult r = env->Step(mean_action);
-      total += r.reward;
-      if (r.terminated || r.truncated) break;
-    }
-    EXPECT_EQ(score.returns[static_cast<size_t>(i)], total) << "episode " << i;
-  }
+  EXPECT_EQ(score.returns, ConstantActionReturns(mean_action, 2, 40));
   EXPECT_THROW(EnsemblePolicy({}, spec), std::invalid_argument);
   std::vector<nn::Sequential> q = {nn::MakeMlp(4, {4}, 2, &rng)};
   EXPECT_THROW(EnsemblePolicy(q, envs::CartPoleSpec()), std::invalid_argument);
