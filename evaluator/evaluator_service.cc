@@ -203,19 +203,14 @@ void EvaluatorService::QueueUnscoredCheckpoints() {
   std::set<std::string> scored;
   for (const EvalRecord& r : history_.records()) scored.insert(r.checkpoint);
   int queued = 0;
-  for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
-    const std::string name = entry.path().filename().string();
-    // The learner's files end in .bin (a temporary one of a write cut short does not); its state
-    // file is not a checkpoint.
-    if (scored.count(name) > 0 || entry.path().extension() != ".bin" ||
-        name == nn::kLearnerStateFile) {
-      continue;
-    }
+  // The learner's checkpoint files (not its state file, nor a temporary one of a write cut short).
+  for (const std::string& path : nn::CheckpointFilesIn(folder)) {
+    if (scored.count(fs::path(path).filename().string()) > 0) continue;
     rlmsg::checkpoint_t unscored{};
     try {
-      const nn::Checkpoint ckpt = ReadAnnouncedCheckpoint(entry.path().string(), folder);
+      const nn::Checkpoint ckpt = ReadAnnouncedCheckpoint(path, folder);
       if (ckpt.meta.run_id != static_cast<uint64_t>(bus_->config().run_id)) continue;
-      unscored.path = entry.path().string();
+      unscored.path = path;
       unscored.update = ckpt.meta.update;
       unscored.env_steps = ckpt.meta.env_steps;
       unscored.wall_seconds = ckpt.meta.wall_seconds;

@@ -142,9 +142,9 @@ class EvaluatorServiceTest : public ::testing::Test {
     return c;
   }
 
-  // Saves `ckpt` in the run's checkpoint folder as ckpt_<update>.bin; returns its path.
+  // Saves `ckpt` in the run's checkpoint folder under the learner's name for it; returns its path.
   std::string Save(const nn::Checkpoint& ckpt) {
-    std::string path = checkpoints_ + "/ckpt_" + std::to_string(ckpt.meta.update) + ".bin";
+    std::string path = checkpoints_ + "/" + nn::CheckpointFileName(ckpt.meta.update);
     nn::SaveCheckpoint(path, ckpt);
     return path;
   }
@@ -226,11 +226,11 @@ TEST_F(EvaluatorServiceTest, ScoresAnAnnouncedCheckpointAndPublishesTheResult) {
   ASSERT_EQ(lines.size(), 1U);
   EvalRecord rec;
   ASSERT_TRUE(ParseJson(lines[0], &rec));
-  EXPECT_EQ(rec.checkpoint, "ckpt_1200.bin");
+  EXPECT_EQ(rec.checkpoint, "ckpt-000001200.bin");
   EXPECT_EQ(rec.update, 1200);
   EXPECT_EQ(rec.mean, r.mean);
   const std::string html = ReportHtml(service);
-  EXPECT_NE(html.find("ckpt_1200.bin"), std::string::npos);
+  EXPECT_NE(html.find("ckpt-000001200.bin"), std::string::npos);
   EXPECT_NE(html.find("run-a"), std::string::npos);
 
   // Stats follow within a stats period.
@@ -290,13 +290,13 @@ TEST_F(EvaluatorServiceTest, RecordsAVideoOfEachNewBestCheckpointAndShowsItInThe
   ASSERT_TRUE(HasReportFile(service, "best.webm", 100));
   const std::string html = ReportHtml(service);
   EXPECT_NE(html.find("<video src=\"best.webm\""), std::string::npos);
-  EXPECT_NE(html.find("ckpt_100.bin (update 100"), std::string::npos);
+  EXPECT_NE(html.find("ckpt-000000100.bin (update 100"), std::string::npos);
   // CartPole has no camera frames: no frame grid.
   EXPECT_FALSE(std::filesystem::exists(service.report_dir() + "/frames.png"));
   EXPECT_EQ(html.find("frames.png"), std::string::npos);
   // The same policy scores the same: no new best, so the video stays that of update 100.
   ASSERT_TRUE(AnnounceUntilResults(&service, WriteCheckpoint(200), 200, 2));
-  EXPECT_NE(ReportHtml(service).find("ckpt_100.bin (update 100"), std::string::npos);
+  EXPECT_NE(ReportHtml(service).find("ckpt-000000100.bin (update 100"), std::string::npos);
 }
 
 TEST_F(EvaluatorServiceTest, ShowsAGridOfCameraFramesForAPixelEnv) {
@@ -324,12 +324,13 @@ TEST_F(EvaluatorServiceTest, DrawsATsneMapOfACheckpointAtTheGoalBeforeItsResult)
   EXPECT_NE(html.find("in 100 states ("), std::string::npos);
   EXPECT_NE(html.find("of 12 greedy episodes"), std::string::npos);
   EXPECT_NE(html.find("max_a Q(s, a)"), std::string::npos);
-  EXPECT_NE(html.find("ckpt_50.bin (update 50"), std::string::npos);
+  EXPECT_NE(html.find("ckpt-000000050.bin (update 50"), std::string::npos);
   // One line says what the map took.
   const std::string text = ReadAndClose(log);
   EXPECT_EQ(CountOccurrences(text, "evaluator: t-SNE map of "), 1) << text;
-  EXPECT_TRUE(Contains(
-      text, "evaluator: t-SNE map of ckpt_50.bin (update 50): 100 states of 12 greedy episodes ("));
+  EXPECT_TRUE(Contains(text,
+                       "evaluator: t-SNE map of ckpt-000000050.bin (update 50): 100 states of 12 "
+                       "greedy episodes ("));
 }
 
 TEST_F(EvaluatorServiceTest, KeepsTheTsneMapOfANewBestDueWhileTheTimeShareIsSpent) {
@@ -484,8 +485,8 @@ TEST_F(EvaluatorServiceTest, SkipsSupersededCheckpointsWithoutABacklogOrWhoseFil
   // With a backlog: a superseded checkpoint the learner deleted before its turn is skipped
   // quietly, not refused. (A new service would queue the files the first one skipped: gone.)
   results_.clear();
-  ASSERT_TRUE(std::filesystem::remove(checkpoints_ + "/ckpt_10.bin"));
-  ASSERT_TRUE(std::filesystem::remove(checkpoints_ + "/ckpt_20.bin"));
+  ASSERT_TRUE(std::filesystem::remove(checkpoints_ + "/ckpt-000000010.bin"));
+  ASSERT_TRUE(std::filesystem::remove(checkpoints_ + "/ckpt-000000020.bin"));
   EvaluatorService service(Config(), &bus_, nullptr);
   const std::string d = WriteCheckpoint(40);
   Announce(d, 40);
@@ -515,8 +516,9 @@ TEST_F(EvaluatorServiceTest, QueuesTheCheckpointsAnEarlierLifeLeftUnscored) {
   nn::Checkpoint foreign = AlwaysLeftCheckpoint(40);
   foreign.meta.run_id = 78;
   Save(foreign);
-  { std::ofstream(checkpoints_ + "/ckpt_50.bin") << "not a checkpoint"; }
-  { std::ofstream(checkpoints_ + "/ckpt_60.bin.tmp.123") << "a write cut short"; }
+  { std::ofstream(checkpoints_ + "/ckpt-000000050.bin") << "not a checkpoint"; }
+  { std::ofstream(checkpoints_ + "/ckpt-000000060.bin.tmp.123") << "a write cut short"; }
+  { std::ofstream(checkpoints_ + "/best.bin") << "a copy by hand"; }
   { std::ofstream(checkpoints_ + "/" + std::string(nn::kLearnerStateFile)) << "the learner's"; }
   Bus bus2(MemqConfig());
   std::FILE* log = std::tmpfile();
@@ -526,10 +528,12 @@ TEST_F(EvaluatorServiceTest, QueuesTheCheckpointsAnEarlierLifeLeftUnscored) {
   ::testing::internal::CaptureStderr();
   EvaluatorService second(c, &bus2, log);
   const std::string errors = ::testing::internal::GetCapturedStderr();
-  // The file that is not a checkpoint is refused by name, the learner's state passed over.
-  EXPECT_TRUE(Contains(errors, "not queued: checkpoint " + checkpoints_ + "/ckpt_50.bin"))
+  // The file of a checkpoint's name that is not one is refused by name; the learner's state and
+  // files of other names are passed over.
+  EXPECT_TRUE(Contains(errors, "not queued: checkpoint " + checkpoints_ + "/ckpt-000000050.bin"))
       << errors;
   EXPECT_FALSE(Contains(errors, std::string(nn::kLearnerStateFile))) << errors;
+  EXPECT_FALSE(Contains(errors, "best.bin")) << errors;
   EXPECT_TRUE(second.has_pending());
   EXPECT_EQ(second.backlog(), 1);
   EXPECT_EQ(second.checkpoints_skipped(), 1);  // the oldest, 20, beyond the backlog
@@ -586,7 +590,7 @@ TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsTheHistoryAndIgnoresRepeats) 
   EXPECT_EQ(second.duplicates_ignored(), 1);
   EXPECT_EQ(second.checkpoints_scored(), 0);
   const std::string html = ReportHtml(second);
-  EXPECT_EQ(CountOccurrences(html, "<td>ckpt_40.bin</td>"), 1);
+  EXPECT_EQ(CountOccurrences(html, "<td>ckpt-000000040.bin</td>"), 1);
 }
 
 TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsItsBestsMediaAndScoresNoWorseOneAsABest) {
@@ -601,7 +605,7 @@ TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsItsBestsMediaAndScoresNoWorse
   EvaluatorService second(c, &bus2, nullptr);
   // Before it scores anything, its report shows the video of the first life's best.
   EXPECT_TRUE(Contains(ReportHtml(second), "<video src=\"best.webm\""));
-  EXPECT_TRUE(Contains(ReportHtml(second), "ckpt_100.bin (update 100"));
+  EXPECT_TRUE(Contains(ReportHtml(second), "ckpt-000000100.bin (update 100"));
   // A worse checkpoint is no new best: no second metric, and the video stays that of update 100.
   rlmsg::checkpoint_t m{};
   m.path = WriteCheckpoint(200);
@@ -613,8 +617,8 @@ TEST_F(EvaluatorServiceTest, ARestartedServiceKeepsItsBestsMediaAndScoresNoWorse
   EXPECT_NE(lines[0].find("second_mean"), std::string::npos);
   EXPECT_EQ(lines[1].find("second_mean"), std::string::npos);
   const std::string html = ReportHtml(second);
-  EXPECT_TRUE(Contains(html, "ckpt_100.bin (update 100"));
-  EXPECT_EQ(html.find("ckpt_200.bin (update 200"), std::string::npos);
+  EXPECT_TRUE(Contains(html, "ckpt-000000100.bin (update 100"));
+  EXPECT_EQ(html.find("ckpt-000000200.bin (update 200"), std::string::npos);
 }
 
 TEST_F(EvaluatorServiceTest, ARestartedServiceShowsItsBestsFrameGridAndTsneMap) {
@@ -631,7 +635,7 @@ TEST_F(EvaluatorServiceTest, ARestartedServiceShowsItsBestsFrameGridAndTsneMap) 
   std::string html = ReportHtml(second);
   EXPECT_TRUE(Contains(html, "<img src=\"frames.png\""));
   EXPECT_TRUE(Contains(html, "<img src=\"tsne.png\""));
-  EXPECT_TRUE(Contains(html, "ckpt_50.bin (update 50"));
+  EXPECT_TRUE(Contains(html, "ckpt-000000050.bin (update 50"));
   // The same policy scores the same: no new best, no new map.
   rlmsg::checkpoint_t m{};
   m.path = Save(CatchCheckpoint(60));
@@ -642,7 +646,7 @@ TEST_F(EvaluatorServiceTest, ARestartedServiceShowsItsBestsFrameGridAndTsneMap) 
   EXPECT_EQ(second.tsne_seconds(), 0.0);
   html = ReportHtml(second);
   EXPECT_TRUE(Contains(html, "<img src=\"tsne.png\""));
-  EXPECT_EQ(html.find("ckpt_60.bin (update 60"), std::string::npos);
+  EXPECT_EQ(html.find("ckpt-000000060.bin (update 60"), std::string::npos);
 }
 
 TEST(CaptionTest, IsThatOfTheMediaFileAsItWasWhenCaptioned) {
