@@ -108,18 +108,27 @@ std::vector<std::string> EnsembleFiles(const std::string& path, int count) {
   return chosen;
 }
 
-EvalRecord ScoreEnsembleFiles(const std::vector<std::string>& paths, const std::string& env_id,
-                              int episodes, uint64_t first_seed, double gamma) {
-  if (paths.empty()) throw std::invalid_argument("an ensemble needs at least one checkpoint");
-  std::vector<nn::Sequential> nets;
-  nn::CheckpointMeta meta;
-  for (const std::string& path : paths) {
-    nets.push_back(LoadPolicyNetwork(path, env_id, nets.empty() ? &meta : nullptr));
+EvalRecord ScoreEnsemble(const std::vector<nn::Checkpoint>& ckpts,
+                         const std::vector<std::string>& paths, const std::string& env_id,
+                         int episodes, uint64_t first_seed, double gamma, const Tick& tick) {
+  if (ckpts.empty()) throw std::invalid_argument("an ensemble needs at least one checkpoint");
+  if (paths.size() != ckpts.size()) {
+    throw std::invalid_argument("an ensemble needs a path for each checkpoint");
   }
+  std::vector<nn::Sequential> nets;
+  for (size_t k = 0; k < ckpts.size(); ++k)
+    nets.push_back(PolicyNetwork(ckpts[k], paths[k], env_id));
   const std::unique_ptr<actor::Policy> policy = EnsemblePolicy(nets, envs::LookupSpec(env_id));
   const double start = MonoSeconds();
-  const EvalScore score = Score(policy.get(), env_id, episodes, first_seed, gamma);
-  return Record(paths.front(), meta, score, MonoSeconds() - start);
+  const EvalScore score = Score(policy.get(), env_id, episodes, first_seed, gamma, tick);
+  return Record(paths.front(), ckpts.front().meta, score, MonoSeconds() - start);
+}
+
+EvalRecord ScoreEnsembleFiles(const std::vector<std::string>& paths, const std::string& env_id,
+                              int episodes, uint64_t first_seed, double gamma) {
+  std::vector<nn::Checkpoint> ckpts;
+  for (const std::string& path : paths) ckpts.push_back(nn::LoadCheckpoint(path));
+  return ScoreEnsemble(ckpts, paths, env_id, episodes, first_seed, gamma);
 }
 
 }  // namespace rl::evaluator

@@ -49,10 +49,18 @@ EvalRecord ScoreCheckpointFile(const std::string& path, const std::string& env_i
 /// std::invalid_argument for count < 1.
 std::vector<std::string> EnsembleFiles(const std::string& path, int count);
 
-/// Scores the mean action of the checkpoint files `paths` (EnsemblePolicy; continuous envs) as
-/// ScoreCheckpointFile scores one: the record names paths[0] and has its metadata. Throws
-/// std::runtime_error as ScoreCheckpointFile for any of the files, std::invalid_argument for a
-/// discrete env or no file.
+/// Scores the mean action of the loaded checkpoints `ckpts`, read from `paths` (EnsemblePolicy;
+/// continuous envs), as ScoreCheckpoint scores one: the record names paths[0] and has its
+/// metadata. Throws std::runtime_error as PolicyNetwork for any of them, std::invalid_argument
+/// for a discrete env, no checkpoint, or as many paths as checkpoints. `tick` as in ScorePolicy.
+EvalRecord ScoreEnsemble(const std::vector<nn::Checkpoint>& ckpts,
+                         const std::vector<std::string>& paths, const std::string& env_id,
+                         int episodes, uint64_t first_seed, double gamma = kDefaultGamma,
+                         const Tick& tick = {});
+
+/// Loads the checkpoint files `paths` and scores their mean action (ScoreEnsemble). Throws
+/// std::runtime_error as ScoreCheckpointFile for any of the files, std::invalid_argument as
+/// ScoreEnsemble.
 EvalRecord ScoreEnsembleFiles(const std::vector<std::string>& paths, const std::string& env_id,
                               int episodes, uint64_t first_seed, double gamma = kDefaultGamma);
 

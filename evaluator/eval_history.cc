@@ -39,6 +39,15 @@ std::string ToJson(const EvalRecord& r) {
     j["second_std"] = r.second_std;
     j["second_episodes"] = r.second_episodes;
   }
+  if (r.ensemble_size > 0) {
+    j["ensemble_size"] = r.ensemble_size;
+    j["ensemble_from"] = r.ensemble_from;
+    j["ensemble_mean"] = r.ensemble_mean;
+    j["ensemble_std"] = r.ensemble_std;
+    j["ensemble_min"] = r.ensemble_min;
+    j["ensemble_max"] = r.ensemble_max;
+    j["ensemble_returns"] = r.ensemble_returns;
+  }
   if (!r.returns.empty()) j["returns"] = r.returns;
   if (!r.steps.empty()) j["steps"] = r.steps;
   return JsonLine(j);
@@ -77,6 +86,18 @@ bool ParseJson(const std::string& line, EvalRecord* record) {
   if (r.second_episodes > 0) {
     r.second_mean = number("second_mean", 0);
     r.second_std = number("second_std", 0);
+  }
+  r.ensemble_size = static_cast<int>(integer("ensemble_size"));
+  const std::optional<double> ensemble_mean = JsonNumberAt(*j, "ensemble_mean");
+  if (r.ensemble_size > 0 && ensemble_mean) {
+    r.ensemble_from = integer("ensemble_from");
+    r.ensemble_mean = *ensemble_mean;
+    r.ensemble_std = number("ensemble_std", 0);
+    r.ensemble_min = number("ensemble_min", r.ensemble_mean);
+    r.ensemble_max = number("ensemble_max", r.ensemble_mean);
+    r.ensemble_returns = JsonNumbersAt(*j, "ensemble_returns").value_or(std::vector<double>{});
+  } else {
+    r.ensemble_size = 0;
   }
   r.returns = JsonNumbersAt(*j, "returns").value_or(std::vector<double>{});
   for (double steps : JsonNumbersAt(*j, "steps").value_or(std::vector<double>{})) {

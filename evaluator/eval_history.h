@@ -33,6 +33,16 @@ struct EvalRecord {
   int second_episodes = 0;
   double second_mean = 0;
   double second_std = 0;
+  // The mean action of this checkpoint and the ensemble_size - 1 checkpoints before it in the
+  // run's folder (EvaluatorConfig::ensemble), the oldest at update ensemble_from, scored on the
+  // same episodes as the checkpoint; ensemble_size 0: not scored.
+  int ensemble_size = 0;
+  int64_t ensemble_from = 0;
+  double ensemble_mean = 0;
+  double ensemble_std = 0;
+  double ensemble_min = 0;
+  double ensemble_max = 0;
+  std::vector<double> ensemble_returns;  // each episode's return, in episode order
   // Each evaluation episode's return, in episode order: how a mean was made (a few failed
   // episodes or a uniform shortfall). Empty in lines written before they were kept.
   std::vector<double> returns;
@@ -47,7 +57,9 @@ struct EvalRecord {
 /// ..., "wall_seconds": ..., "mean": ..., "std": ..., "min": ..., "max": ..., "episodes": ...,
 /// "eval_seconds": ...}, and when value_steps > 0 also "value_steps", "value_estimate",
 /// "value_return" and "value_correlation" (null when unset), and when second_episodes > 0
-/// "second_mean", "second_std" and "second_episodes", and last, when there are any, "returns"
+/// "second_mean", "second_std" and "second_episodes", when ensemble_size > 0 "ensemble_size",
+/// "ensemble_from", "ensemble_mean", "ensemble_std", "ensemble_min", "ensemble_max" and
+/// "ensemble_returns", and last, when there are any, "returns"
 /// and "steps" (arrays) (json_line.h: numbers in their shortest form that reads back exactly; a
 /// non-finite number is written as null).
 std::string ToJson(const EvalRecord& record);

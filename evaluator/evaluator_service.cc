@@ -64,6 +64,16 @@ ReportInfo RunReportInfo(const EvaluatorConfig& c, int64_t run_id) {
                        (spec.continuous() ? std::string(" with the actor's action, without noise")
                                           : " with epsilon " + FormatDouble("%g", c.epsilon)) +
                        "; returns G are discounted with gamma " + FormatDouble("%g", c.gamma) + ".";
+  if (c.ensemble > 1) {
+    info.eval_settings +=
+        " An ensemble of " + std::to_string(c.ensemble) +
+        " is the mean action of a checkpoint and the " + std::to_string(c.ensemble - 1) +
+        " before it, scored on the same episodes" +
+        (std::isfinite(c.ensemble_min_mean) ? " for checkpoints whose own mean is at least " +
+                                                  FormatDouble("%g", c.ensemble_min_mean)
+                                            : std::string()) +
+        ".";
+  }
   if (!c.second_env.empty()) {
     info.second_name = (c.second_name.empty() ? c.second_env : c.second_name) + ", " +
                        std::to_string(c.second_episodes) + " episodes";
@@ -135,6 +145,15 @@ void EvaluatorConfig::Validate() const {
   if (!(screen_margin >= 0.0) || std::isinf(screen_margin)) {
     throw std::invalid_argument("screen-margin must be finite and at least 0");
   }
+  if (ensemble < 1) {
+    throw std::invalid_argument("ensemble must be at least 1 (1: no ensembles), got " +
+                                std::to_string(ensemble));
+  }
+  if (ensemble > 1 && !envs::LookupSpec(env_id).continuous()) {
+    throw std::invalid_argument("ensemble needs continuous actions (the members' mean action); " +
+                                env_id + " has discrete ones");
+  }
+  if (std::isnan(ensemble_min_mean)) throw std::invalid_argument("ensemble-min-mean is NaN");
   if (backlog < 0) {
     throw std::invalid_argument("backlog must be at least 0, got " + std::to_string(backlog));
   }
@@ -295,8 +314,50 @@ std::optional<EvalRecord> EvaluatorService::Score(const rlmsg::checkpoint_t& ann
   record.env_steps = announced.env_steps;
   record.wall_seconds = announced.wall_seconds;
   second_.ScoreIfBest(*ckpt, announced.path, &record, [this] { Tick(); });
+  ScoreEnsembleIfDue(*ckpt, announced.path, &record);
   busy_ = false;
   return record;
+}
+
+void EvaluatorService::ScoreEnsembleIfDue(const nn::Checkpoint& ckpt, const std::string& path,
+                                          EvalRecord* record) {
+  if (config_.ensemble <= 1 || record->mean < config_.ensemble_min_mean) return;
+  EvalRecord ensemble;
+  int64_t oldest = 0;
+  try {
+    const std::vector<std::string> paths = EnsembleFiles(path, config_.ensemble);
+    std::vector<nn::Checkpoint> members = {ckpt};
+    for (size_t k = 1; k < paths.size(); ++k) {
+      members.push_back(ReadAnnouncedCheckpoint(paths[k], CheckpointFolder()));
+      if (members.back().meta.run_id != ckpt.meta.run_id) {
+        throw std::runtime_error(paths[k] + " is of run " +
+                                 std::to_string(members.back().meta.run_id) + ", not " +
+                                 std::to_string(ckpt.meta.run_id));
+      }
+    }
+    ensemble = ScoreEnsemble(members, paths, config_.env_id, config_.episodes, config_.seed_base,
+                             config_.gamma, [this] { Tick(); });
+    oldest = members.back().meta.update;
+  } catch (const Interrupted&) {
+    return;
+  } catch (const std::exception& e) {
+    log_("evaluator: update %lld: no ensemble of %d: %s\n", static_cast<long long>(record->update),
+         config_.ensemble, e.what());
+    return;
+  }
+  record->ensemble_size = config_.ensemble;
+  record->ensemble_from = oldest;
+  record->ensemble_mean = ensemble.mean;
+  record->ensemble_std = ensemble.std;
+  record->ensemble_min = ensemble.min;
+  record->ensemble_max = ensemble.max;
+  record->ensemble_returns = ensemble.returns;
+  log_(
+      "evaluator: update %lld: ensemble of %d (updates %lld to %lld): mean %.2f \xC2\xB1 %.1f "
+      "(min %g, max %g, %.2f s)\n",
+      static_cast<long long>(record->update), config_.ensemble,
+      static_cast<long long>(record->ensemble_from), static_cast<long long>(record->update),
+      ensemble.mean, ensemble.std, ensemble.min, ensemble.max, ensemble.eval_seconds);
 }
 
 bool EvaluatorService::PassesScreen(const nn::Checkpoint& ckpt,

@@ -14,8 +14,11 @@ namespace {
 
 using plot::Point;
 
-// The legend's room right of the title (or on a line of its own below it).
+// The legend's least room right of the title (or on a line of its own below it).
 constexpr double kLegendWidth = 250;
+
+// The overlay's line.
+constexpr plot::Colour kOverlayColour = plot::Colour::Hex(0xbc4c00);
 
 // The goal's value, e.g. 475 or 195.5.
 std::string GoalLabel(double v) {
@@ -39,7 +42,8 @@ void BandEdges(const std::vector<CurvePoint>& points, std::vector<Point>* lo,
 // The chart: x from 0 (or below), y covering the band, 0 and the goal; the legend right of the
 // title when both fit on one line, else below it.
 plot::ChartSpec Spec(const std::vector<CurvePoint>& points, const std::vector<Point>& lo,
-                     const std::vector<Point>& hi, const CurveStyle& style, double title_width) {
+                     const std::vector<Point>& hi, const std::vector<CurvePoint>& overlay,
+                     const CurveStyle& style, double title_width, double legend_width) {
   const bool has_goal = std::isfinite(style.goal);
   plot::ChartSpec spec;
   spec.width = style.width;
@@ -59,6 +63,12 @@ plot::ChartSpec Spec(const std::vector<CurvePoint>& points, const std::vector<Po
       spec.y_min = std::min(spec.y_min, lo[i].y);
       spec.y_max = std::max(spec.y_max, hi[i].y);
     }
+    for (const CurvePoint& p : overlay) {
+      spec.x_min = std::min(spec.x_min, p.x);
+      spec.x_max = std::max(spec.x_max, p.x);
+      spec.y_min = std::min(spec.y_min, p.mean);
+      spec.y_max = std::max(spec.y_max, p.mean);
+    }
   } else if (has_goal) {
     spec.y_max = std::max(style.goal, 1.0);
   }
@@ -71,24 +81,42 @@ plot::ChartSpec Spec(const std::vector<CurvePoint>& points, const std::vector<Po
     spec.x_format = plot::TickFormat::kCount;
   }
   const bool legend_below =
-      plot::Chart::kLeft + title_width + 16 > style.width - plot::Chart::kRight - kLegendWidth;
+      plot::Chart::kLeft + title_width + 16 > style.width - plot::Chart::kRight - legend_width;
   spec.legend_height = legend_below ? 18 : 0;
   return spec;
 }
 
-void DrawLegend(plot::Canvas* canvas, const plot::Chart& chart, bool has_goal) {
+// The legend's entries: the mean, its band, the overlay (when `overlay_label` is not empty) and
+// the goal.
+std::vector<plot::LegendEntry> LegendEntries(bool has_goal, const std::string& overlay_label) {
   std::vector<plot::LegendEntry> entries = {
       {plot::LegendEntry::Key::kLine, "mean", plot::Paint::Stroke(plot::kLineColour, 2)},
       {plot::LegendEntry::Key::kSwatch, "\xC2\xB1 1 std",
        plot::Paint::Fill(plot::kLineColour, 0.18)},
   };
+  if (!overlay_label.empty()) {
+    entries.push_back(
+        {plot::LegendEntry::Key::kLine, overlay_label, plot::Paint::Stroke(kOverlayColour, 2)});
+  }
   if (has_goal) {
     plot::Paint goal = plot::Paint::Stroke(plot::kGoalColour, 1.5);
     goal.dash = {5, 3};
     entries.push_back({plot::LegendEntry::Key::kLine, "goal", goal});
   }
-  const double y = chart.spec().legend_height > 0 ? 40 : 18;
-  plot::DrawLegend(canvas, {chart.spec().width - plot::Chart::kRight - kLegendWidth, y}, entries);
+  return entries;
+}
+
+// The line of the points' means (with their dots, when there are not too many), id `id`.
+void DrawMeans(plot::Canvas* canvas, const plot::Chart& chart,
+               const std::vector<CurvePoint>& points, plot::Colour colour, const char* id) {
+  std::vector<Point> line;
+  for (const CurvePoint& p : points) line.push_back(chart.At(p.x, p.mean));
+  plot::Paint paint = plot::Paint::Stroke(colour, 2);
+  paint.round_joins = true;
+  canvas->Polyline(line, paint, {id, ""});
+  if (points.size() <= 200) {
+    for (const Point& p : line) canvas->Circle(p, 2.5, plot::Paint::Fill(colour));
+  }
 }
 
 // The band of plus/minus one std, then the mean line and its points.
@@ -102,38 +130,45 @@ void DrawCurve(plot::Canvas* canvas, const plot::Chart& chart,
   band_paint.stroke_opacity = 0.35;
   band_paint.stroke_width = 0.8;
   canvas->Path(band, true, band_paint, {"band", ""});
-  std::vector<Point> line;
-  for (const CurvePoint& p : points) line.push_back(chart.At(p.x, p.mean));
-  plot::Paint line_paint = plot::Paint::Stroke(plot::kLineColour, 2);
-  line_paint.round_joins = true;
-  canvas->Polyline(line, line_paint, {"mean", ""});
-  if (points.size() <= 200) {
-    for (const Point& p : line) canvas->Circle(p, 2.5, plot::Paint::Fill(plot::kLineColour));
-  }
+  DrawMeans(canvas, chart, points, plot::kLineColour, "mean");
 }
 
 }  // namespace
 
-std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveStyle& style) {
+std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveStyle& style,
+                                   CurveOverlay overlay) {
   // Keep the finite points, in x order.
   std::erase_if(points, [](const CurvePoint& p) {
     return !std::isfinite(p.x) || !std::isfinite(p.mean) || !std::isfinite(p.std);
   });
   std::stable_sort(points.begin(), points.end(),
                    [](const CurvePoint& a, const CurvePoint& b) { return a.x < b.x; });
+  std::erase_if(overlay.points,
+                [](const CurvePoint& p) { return !std::isfinite(p.x) || !std::isfinite(p.mean); });
+  std::stable_sort(overlay.points.begin(), overlay.points.end(),
+                   [](const CurvePoint& a, const CurvePoint& b) { return a.x < b.x; });
+  if (points.empty()) overlay.points.clear();
   std::vector<Point> lo, hi;
   BandEdges(points, &lo, &hi);
   const bool has_goal = std::isfinite(style.goal);
 
   plot::SvgCanvas canvas(style.width, style.height, style.title, plot::kTextColour);
-  const plot::Chart chart(Spec(points, lo, hi, style, canvas.TextWidth(style.title, 14)));
-  DrawLegend(&canvas, chart, has_goal);
+  const std::vector<plot::LegendEntry> legend =
+      LegendEntries(has_goal, overlay.points.empty() ? "" : overlay.label);
+  const double legend_width = std::max(kLegendWidth, plot::LegendWidth(canvas, legend));
+  const plot::Chart chart(
+      Spec(points, lo, hi, overlay.points, style, canvas.TextWidth(style.title, 14), legend_width));
+  plot::DrawLegend(&canvas,
+                   {style.width - plot::Chart::kRight - legend_width,
+                    chart.spec().legend_height > 0 ? 40.0 : 18.0},
+                   legend);
   chart.DrawFrame(&canvas);
   if (points.empty()) {
     chart.DrawNote(&canvas, "no checkpoint scored yet");
   } else {
     DrawCurve(&canvas, chart, points, lo, hi);
   }
+  if (!overlay.points.empty()) DrawMeans(&canvas, chart, overlay.points, kOverlayColour, "overlay");
   // The goal, dashed, labelled at its left end (where a learning curve is usually low).
   if (has_goal) {
     plot::Paint goal = plot::Paint::Stroke(plot::kGoalColour, 1.5);

@@ -36,8 +36,16 @@ struct CurveStyle {
   int height = 380;
 };
 
+/// A second line over the curve, without a band (e.g. the means of the checkpoints' ensembles).
+struct CurveOverlay {
+  std::string label;               // its legend entry
+  std::vector<CurvePoint> points;  // their means are drawn; std, min and max are not
+};
+
 /// Renders the curve (points are sorted by x; points with a non-finite x, mean or std are left
-/// out). With no points the plot shows its axes and a "no checkpoint scored yet" note.
-std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveStyle& style);
+/// out) and the overlay's line, if it has points, in another colour. With no points the plot
+/// shows its axes and a "no checkpoint scored yet" note.
+std::string RenderLearningCurveSvg(std::vector<CurvePoint> points, const CurveStyle& style,
+                                   CurveOverlay overlay = {});
 
 }  // namespace rl::evaluator

@@ -103,7 +103,6 @@ int Main(int argc, char** argv) {
   std::string frames_file;
   std::string tsne_file;
   double noise_sigma = 0;
-  int ensemble = 1;
   std::string sched_policy;
   int nice = 0;
   double goal = 0;
@@ -126,9 +125,14 @@ int Main(int argc, char** argv) {
       ("noise", rl::po::value(&noise_sigma),
        "standalone mode, continuous actions: score with the actors' Gaussian noise at this "
        "constant sigma (a fraction of each action's half-range), not the deterministic action")  //
-      ("ensemble", rl::po::value(&ensemble),
-       "standalone mode, continuous actions: score the mean action of the checkpoint and the "
-       "K - 1 checkpoints before it in its folder, an ensemble of K networks")  //
+      ("ensemble", rl::po::value(&config.ensemble)->default_value(config.ensemble),
+       "continuous actions: score the mean action of a checkpoint and the K - 1 checkpoints "
+       "before it in its folder, an ensemble of K networks (standalone mode: instead of the "
+       "checkpoint alone; service mode: after each checkpoint's own score, on the same "
+       "episodes, in eval.jsonl and the report beside it); 1: none")  //
+      ("ensemble-min-mean", rl::po::value(&config.ensemble_min_mean),
+       "service mode: score a checkpoint's ensemble only when its own mean is at least this "
+       "(default: every checkpoint's)")  //
       ("gamma", rl::po::value(&config.gamma)->default_value(config.gamma, "0.99"),
        "discount of the returns the network's value estimates are compared with: the actors' "
        "gamma (put gamma at the top of a preset so that both read it)")  //
@@ -215,31 +219,30 @@ int Main(int argc, char** argv) {
     rl::RefuseGiven(vm, {"epsilon"},
                     config.env_id + " has continuous actions, scored without exploration");
   } else {
-    rl::RefuseGiven(vm, {"noise", "ensemble"},
-                    config.env_id + " has discrete actions (see --epsilon)");
+    rl::RefuseGiven(vm, {"noise"}, config.env_id + " has discrete actions (see --epsilon)");
   }
+  const bool standalone_ensemble = !checkpoint.empty() && !vm["ensemble"].defaulted();
   if (checkpoint.empty()) {
     rl::RefuseGiven(vm, {"noise"}, "the service scores without noise, the standard metric");
-    rl::RefuseGiven(vm, {"ensemble"}, "the service scores one checkpoint at a time");
   }
-  if (vm.count("ensemble") > 0) {
+  if (standalone_ensemble) {
     rl::RefuseGiven(vm, {"noise", "frames", "tsne-map"},
                     "not with --ensemble, which scores the mean action of several networks");
-    if (ensemble < 1) throw std::invalid_argument("--ensemble must be at least 1");
   }
   if (!(noise_sigma >= 0 && std::isfinite(noise_sigma))) {
     throw std::invalid_argument("--noise must be finite and >= 0");
   }
 
   // Standalone mode: one file, one JSON object.
-  if (!checkpoint.empty() && vm.count("ensemble") > 0) {
+  if (standalone_ensemble) {
     config.Validate();
-    const std::vector<std::string> files = rl::evaluator::EnsembleFiles(checkpoint, ensemble);
+    const std::vector<std::string> files =
+        rl::evaluator::EnsembleFiles(checkpoint, config.ensemble);
     std::string names;
     for (const std::string& f : files) {
       names += (names.empty() ? "" : ", ") + std::filesystem::path(f).filename().string();
     }
-    std::fprintf(stderr, "evaluator: the mean action of %d checkpoints: %s\n", ensemble,
+    std::fprintf(stderr, "evaluator: the mean action of %d checkpoints: %s\n", config.ensemble,
                  names.c_str());
     rl::evaluator::EvalRecord record = rl::evaluator::ScoreEnsembleFiles(
         files, config.env_id, config.episodes, config.seed_base, config.gamma);

@@ -156,8 +156,13 @@ void Chart::DrawNote(Canvas* canvas, const std::string& text) const {
   canvas->Text({(x_.p0 + x_.p1) / 2, (y_.p0 + y_.p1) / 2}, text, font);
 }
 
+// A legend entry's key, the gap after it, and the gap after its label.
+constexpr double kLegendKey = 18;
+constexpr double kLegendKeyGap = 4;
+constexpr double kLegendEntryGap = 16;
+
 void DrawLegend(Canvas* canvas, Point at, std::span<const LegendEntry> entries) {
-  constexpr double kKey = 18;
+  constexpr double kKey = kLegendKey;
   double x = at.x;
   for (const LegendEntry& e : entries) {
     if (e.key == LegendEntry::Key::kLine) {
@@ -165,9 +170,17 @@ void DrawLegend(Canvas* canvas, Point at, std::span<const LegendEntry> entries) 
     } else {
       canvas->Rect({x, at.y - 6}, kKey, 12, e.paint);
     }
-    canvas->Text({x + kKey + 4, at.y + 4}, e.label, SmallFont(kTextColour));
-    x += kKey + 4 + canvas->TextWidth(e.label, kSmallSize) + 16;
+    canvas->Text({x + kKey + kLegendKeyGap, at.y + 4}, e.label, SmallFont(kTextColour));
+    x += kKey + kLegendKeyGap + canvas->TextWidth(e.label, kSmallSize) + kLegendEntryGap;
   }
+}
+
+double LegendWidth(const Canvas& canvas, std::span<const LegendEntry> entries) {
+  double width = 0;
+  for (const LegendEntry& e : entries) {
+    width += kLegendKey + kLegendKeyGap + canvas.TextWidth(e.label, kSmallSize) + kLegendEntryGap;
+  }
+  return entries.empty() ? 0 : width - kLegendEntryGap;
 }
 
 std::vector<Point> StepCorners(std::span<const Point> points) {

@@ -108,6 +108,8 @@ struct LegendEntry {
 /// The entries side by side from `at` (the left end of the first key, at the keys' middle
 /// height): an 18 px key, its label in 11 px, 16 px to the next entry.
 void DrawLegend(Canvas* canvas, Point at, std::span<const LegendEntry> entries);
+/// The width DrawLegend gives `entries` on `canvas`.
+double LegendWidth(const Canvas& canvas, std::span<const LegendEntry> entries);
 
 /// The corners of a step function through `points` (x ascending, each y holding until the next
 /// point's x): (x0, y0), (x1, y0), (x1, y1), (x2, y1), ...

@@ -70,6 +70,7 @@ struct Highlights {
   const EvalRecord* first_goal = nullptr;  // the first (lowest update) at the goal
   const EvalRecord* latest = nullptr;      // the highest update
   const EvalRecord* second = nullptr;      // the best with a second metric
+  const EvalRecord* ensemble = nullptr;    // the best ensemble (highest ensemble mean)
 };
 
 Highlights FindHighlights(const std::vector<EvalRecord>& records, double goal) {
@@ -83,28 +84,48 @@ Highlights FindHighlights(const std::vector<EvalRecord>& records, double goal) {
     if (h.latest == nullptr || r.update >= h.latest->update) h.latest = &r;
     // A tie with a later checkpoint leaves the later one without a second metric.
     if (r.second_episodes > 0 && (h.second == nullptr || r.mean > h.second->mean)) h.second = &r;
+    if (r.ensemble_size > 0 &&
+        (h.ensemble == nullptr || r.ensemble_mean > h.ensemble->ensemble_mean)) {
+      h.ensemble = &r;
+    }
   }
   return h;
 }
 
 // curve_env_steps.svg and curve_wall_time.svg.
+// "ensemble of 5" (the size of the last record with an ensemble), or "" when none has one.
+std::string EnsembleLabel(const std::vector<EvalRecord>& records) {
+  for (auto r = records.rbegin(); r != records.rend(); ++r) {
+    if (r->ensemble_size > 0) return "ensemble of " + std::to_string(r->ensemble_size);
+  }
+  return {};
+}
+
 void WriteLearningCurves(const std::string& dir, const std::vector<EvalRecord>& records,
                          double goal) {
   std::vector<CurvePoint> by_steps, by_time;
+  CurveOverlay ensembles_by_steps{EnsembleLabel(records), {}};
+  CurveOverlay ensembles_by_time = ensembles_by_steps;
   for (const EvalRecord& r : records) {
     by_steps.push_back({static_cast<double>(r.env_steps), r.mean, r.std, r.min, r.max});
     by_time.push_back({r.wall_seconds, r.mean, r.std, r.min, r.max});
+    if (r.ensemble_size > 0) {
+      ensembles_by_steps.points.push_back({static_cast<double>(r.env_steps), r.ensemble_mean});
+      ensembles_by_time.points.push_back({r.wall_seconds, r.ensemble_mean});
+    }
   }
   CurveStyle style;
   style.goal = std::isfinite(goal) ? goal : std::nan("");
   style.title = "Evaluation return vs. environment steps";
   style.x_label = "environment steps";
   style.x_kind = XAxisKind::kCount;
-  WriteFileAtomically(dir + "/" + kCurveEnvSteps, RenderLearningCurveSvg(by_steps, style));
+  WriteFileAtomically(dir + "/" + kCurveEnvSteps,
+                      RenderLearningCurveSvg(by_steps, style, std::move(ensembles_by_steps)));
   style.title = "Evaluation return vs. wall time";
   style.x_label = "wall time since the learner started";
   style.x_kind = XAxisKind::kSeconds;
-  WriteFileAtomically(dir + "/" + kCurveWallTime, RenderLearningCurveSvg(by_time, style));
+  WriteFileAtomically(dir + "/" + kCurveWallTime,
+                      RenderLearningCurveSvg(by_time, style, std::move(ensembles_by_time)));
 }
 
 // The training curves from the metrics the monitor keeps; returns what was drawn.
@@ -198,6 +219,15 @@ std::string SummarySection(const Highlights& hl, const ReportInfo& info) {
     h += "<div class=\"value\">\xE2\x80\x94</div><div class=\"detail\">no checkpoint scored "
          "yet</div>";
   }
+  if (hl.ensemble != nullptr) {
+    const EvalRecord& e = *hl.ensemble;
+    h += "</div>\n<div class=\"card\"><div class=\"label\">Best ensemble</div>";
+    h += "<div class=\"value\">" + Score(e.ensemble_mean) + " <small>\xC2\xB1 " +
+         Score(e.ensemble_std) + "</small></div><div class=\"detail\">the mean action of " +
+         std::to_string(e.ensemble_size) + " checkpoints, updates " + Thousands(e.ensemble_from) +
+         " to " + Thousands(e.update) + " (" + Thousands(e.env_steps) + " env steps, " +
+         Duration(e.wall_seconds) + ")</div>";
+  }
   h += "</div>\n<div class=\"card\"><div class=\"label\">Latest checkpoint</div>";
   if (hl.latest != nullptr) {
     h += MeanValue(*hl.latest) + "<div class=\"detail\">" + Where(*hl.latest) + "</div>";
@@ -276,7 +306,8 @@ double Quantile(std::vector<double> values, double q) {
 
 // One row of the checkpoint table.
 std::string CheckpointRow(const EvalRecord& r, const Highlights& hl, const ReportInfo& info,
-                          double bar_scale, bool has_values, bool has_returns, bool has_second) {
+                          double bar_scale, bool has_values, bool has_returns, bool has_second,
+                          bool has_ensemble) {
   std::string cls;
   if (&r == hl.best) cls += "best";
   if (std::isfinite(info.goal) && r.mean >= info.goal) cls += cls.empty() ? "goal" : " goal";
@@ -305,6 +336,13 @@ std::string CheckpointRow(const EvalRecord& r, const Highlights& hl, const Repor
          (r.second_episodes > 0 ? Score(r.second_mean) + " \xC2\xB1 " + Score(r.second_std) + " (" +
                                       std::to_string(r.second_episodes) + ")"
                                 : std::string()) +
+         "</td>";
+  }
+  if (has_ensemble) {
+    h += "<td>" +
+         (r.ensemble_size > 0 ? Score(r.ensemble_mean) + " \xC2\xB1 " + Score(r.ensemble_std) +
+                                    " (" + std::to_string(r.ensemble_size) + ")"
+                              : std::string()) +
          "</td>";
   }
   return h + "</tr>\n";
@@ -341,15 +379,22 @@ std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Hig
     h +=
         "<p>Second metric (new best checkpoints only): " + HtmlEscape(info.second_name) + ".</p>\n";
   }
+  const bool has_ensemble = hl.ensemble != nullptr;
+  if (has_ensemble) {
+    h += "<p>Ensemble: the mean action of the checkpoint and the ones before it (their count in "
+         "brackets), scored on the same episodes.</p>\n";
+  }
   h += "<div class=\"scroll\"><table>\n<thead><tr><th>checkpoint</th><th>update</th>"
        "<th>env steps</th><th>wall time</th><th>mean</th><th>std</th><th>min</th>";
   if (has_returns) h += "<th>10 %</th><th>median</th>";
   h += "<th>max</th><th>episodes</th><th>eval time</th>";
   if (has_values) h += "<th>Q</th><th>G</th><th>r</th>";
   if (has_second) h += "<th>second metric</th>";
+  if (has_ensemble) h += "<th>ensemble</th>";
   h += "</tr></thead>\n<tbody>\n";
-  for (const EvalRecord* r : rows)
-    h += CheckpointRow(*r, hl, info, bar_scale, has_values, has_returns, has_second);
+  for (const EvalRecord* r : rows) {
+    h += CheckpointRow(*r, hl, info, bar_scale, has_values, has_returns, has_second, has_ensemble);
+  }
   return h + "</tbody>\n</table></div>\n</section>\n";
 }
 

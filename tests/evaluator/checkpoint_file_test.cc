@@ -1,37 +1,21 @@
 // Scoring checkpoint files: an ensemble is a checkpoint and the ones before it in its folder.
 #include "evaluator/checkpoint_file.h"
 
-#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "constant_lander.h"
 #include "nn/checkpoint.h"
-#include "nn/sequential.h"
 #include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
 namespace {
 
-constexpr char kLander[] = "LunarLanderContinuous-v3";
-
-// A LunarLanderContinuous actor whose action is always (main, side), at update `update`.
-nn::Checkpoint ConstantLanderCheckpoint(int64_t update, float main, float side) {
-  std::mt19937 rng(1);
-  nn::Sequential actor = nn::MakeMlp(8, {4}, 2, &rng);
-  std::vector<float> flat(static_cast<size_t>(actor.NumParams()), 0.0f);
-  flat[flat.size() - 2] = main;
-  flat[flat.size() - 1] = side;
-  actor.SetFlat(flat.data(), flat.size());
-  nn::Checkpoint ckpt;
-  ckpt.architecture = actor.Architecture();
-  actor.GetFlat(&ckpt.params);
-  ckpt.meta.update = update;
-  ckpt.meta.env_steps = 2 * update;
-  return ckpt;
-}
+using testing::ConstantLanderCheckpoint;
+using testing::kLander;
 
 class EnsembleFilesTest : public TempDirTest {
  protected:

@@ -42,10 +42,21 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   // With the episodes' returns.
   d.returns = {-0.1, 912.5, 1.0 / 3.0};
   d.steps = {1, 200, 0};
-  for (const EvalRecord& r : {a, b, c, d}) AppendJsonLine(path, r);
+  // With an ensemble's score.
+  EvalRecord e = Record("e.bin", 5000, 800.5);
+  e.ensemble_size = 5;
+  e.ensemble_from = 4000;
+  e.ensemble_mean = 850.25;
+  e.ensemble_std = 12.5;
+  e.ensemble_min = 790;
+  e.ensemble_max = 931.5;
+  e.ensemble_returns = {790, 931.5, 829.25};
+  for (const EvalRecord& r : {a, b, c, d, e}) AppendJsonLine(path, r);
 
   const std::string text = ReadFile(path);
-  EXPECT_EQ(testing::CountOccurrences(text, "\n"), 4);
+  EXPECT_EQ(testing::CountOccurrences(text, "\n"), 5);
+  EXPECT_EQ(testing::CountOccurrences(text, "\"ensemble_size\": 5, \"ensemble_from\": 4000"), 1);
+  EXPECT_EQ(testing::CountOccurrences(text, "\"ensemble_"), 7);
   EXPECT_EQ(testing::CountOccurrences(text, "\"second_mean\": 642.125"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"value_correlation\": null"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"returns\": [-0.1,912.5,"), 1);
@@ -53,11 +64,12 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   int skipped = -1;
   const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
   EXPECT_EQ(skipped, 0);
-  ASSERT_EQ(back.size(), 4U);
+  ASSERT_EQ(back.size(), 5U);
   EXPECT_EQ(back[0], a);
   EXPECT_EQ(back[1], b);
   EXPECT_EQ(back[2], c);
   EXPECT_EQ(back[3], d);
+  EXPECT_EQ(back[4], e);
 }
 
 TEST(JsonLinesTest, ALineHasTheDocumentedFields) {
@@ -116,6 +128,9 @@ TEST(JsonLinesTest, ParseAcceptsOtherKeyOrderAndRejectsNonObjects) {
   }
   ASSERT_TRUE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1, "steps": [7, 0]})", &r));
   EXPECT_EQ(r.steps, (std::vector<int>{7, 0}));
+  // An ensemble size without its mean is no ensemble.
+  ASSERT_TRUE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1, "ensemble_size": 5})", &r));
+  EXPECT_EQ(r.ensemble_size, 0);
   EXPECT_FALSE(ParseJson("[1, 2]", &r));
   EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3})", &r));  // no mean
   EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1} trailing)", &r));

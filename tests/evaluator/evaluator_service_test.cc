@@ -2,11 +2,13 @@
 
 #include <sys/stat.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -15,6 +17,7 @@
 
 #include "common/channels.h"
 #include "common/lcm_bus.h"
+#include "constant_lander.h"
 #include "file_helpers.h"
 #include "nn/checkpoint.h"
 #include "nn/linear.h"
@@ -25,8 +28,10 @@
 namespace rl::evaluator {
 namespace {
 
+using testing::ConstantLanderCheckpoint;
 using testing::CountOccurrences;
 using testing::FifoUnblocker;
+using testing::kLander;
 
 BusConfig MemqConfig() { return InProcessBusConfig(77, "evaluator"); }
 
@@ -282,6 +287,74 @@ TEST_F(EvaluatorServiceTest, ANewBestBelowTheSecondMetricsMinimumIsNotScoredOnIt
   EXPECT_NE(ReportHtml(service).find("Second metric (new best checkpoints only): three episodes, "
                                      "3 episodes, for a standard mean of 1000 or more"),
             std::string::npos);
+}
+
+// Each checkpoint's ensemble with the one before it plays as one checkpoint of their mean action
+// does, on the same episodes; the first checkpoint has none before it, so no ensemble.
+TEST_F(EvaluatorServiceTest, ScoresEachCheckpointsEnsembleWithTheOnesBeforeIt) {
+  EvaluatorConfig c = Config();
+  c.env_id = kLander;
+  c.episodes = 2;
+  c.ensemble = 2;
+  std::FILE* progress = std::tmpfile();
+  ASSERT_NE(progress, nullptr);
+  EvaluatorService service(c, &bus_, progress);
+  ASSERT_TRUE(
+      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(10, 0.6f, -0.4f, 77)), 10, 1));
+  ASSERT_TRUE(
+      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(20, 0.2f, 0.0f, 77)), 20, 2));
+  ASSERT_EQ(service.records().size(), 2U);
+  const EvalRecord& first = service.records()[0];
+  const EvalRecord& second = service.records()[1];
+  EXPECT_EQ(first.ensemble_size, 0);
+  EXPECT_EQ(second.ensemble_size, 2);
+  EXPECT_EQ(second.ensemble_from, 10);
+  const EvalRecord mean_action = ScoreCheckpoint(ConstantLanderCheckpoint(7, 0.4f, -0.2f), "m.bin",
+                                                 kLander, 2, 0.0, c.seed_base, c.gamma);
+  EXPECT_EQ(second.ensemble_returns, mean_action.returns);
+  EXPECT_DOUBLE_EQ(second.ensemble_mean, mean_action.mean);
+  EXPECT_NE(second.ensemble_returns, second.returns);
+  // In eval.jsonl, the report and its curves.
+  const std::vector<std::string> lines = JsonLines(service);
+  ASSERT_EQ(lines.size(), 2U);
+  EXPECT_EQ(lines[0].find("ensemble_"), std::string::npos);
+  EvalRecord read;
+  ASSERT_TRUE(ParseJson(lines[1], &read));
+  EXPECT_EQ(read, second);
+  const std::string html = ReportHtml(service);
+  EXPECT_TRUE(Contains(html, "Best ensemble"));
+  EXPECT_TRUE(Contains(html, "the mean action of 2 checkpoints, updates 10 to 20"));
+  EXPECT_TRUE(Contains(html, "<th>ensemble</th>"));
+  EXPECT_TRUE(Contains(ReadFile(service.report_dir() + "/curve_env_steps.svg"), "ensemble of 2"));
+  const std::string log = ReadAndClose(progress);
+  EXPECT_TRUE(Contains(log, "update 10: no ensemble of 2: an ensemble of 2 needs 1 checkpoints"));
+  EXPECT_TRUE(Contains(log, "update 20: ensemble of 2 (updates 10 to 20): mean "));
+}
+
+TEST_F(EvaluatorServiceTest, NoEnsembleBelowItsMinimumOrOfAnotherRunsCheckpoint) {
+  EvaluatorConfig c = Config();
+  c.env_id = kLander;
+  c.episodes = 2;
+  c.ensemble = 2;
+  c.ensemble_min_mean = 1000;  // above any LunarLander score
+  {
+    EvaluatorService service(c, &bus_, nullptr);
+    Save(ConstantLanderCheckpoint(10, 0.6f, -0.4f, 77));
+    ASSERT_TRUE(
+        AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(20, 0.2f, 0.0f, 77)), 20, 1));
+    EXPECT_EQ(service.records().back().ensemble_size, 0);
+  }
+  c.ensemble_min_mean = -std::numeric_limits<double>::infinity();
+  c.out_dir = (dir_ / "run-b").string();
+  std::filesystem::create_directories(c.out_dir + "/checkpoints");
+  EvaluatorService service(c, &bus_, nullptr);
+  const std::string folder = c.out_dir + "/checkpoints/";
+  nn::SaveCheckpoint(folder + nn::CheckpointFileName(10), ConstantLanderCheckpoint(10, 0, 0, 78));
+  const std::string ours = folder + nn::CheckpointFileName(20);
+  nn::SaveCheckpoint(ours, ConstantLanderCheckpoint(20, 0.2f, 0.0f, 77));
+  ASSERT_TRUE(AnnounceUntilResults(&service, ours, 20, 2));
+  EXPECT_EQ(service.records().back().ensemble_size, 0);
+  EXPECT_EQ(service.records().back().update, 20);
 }
 
 TEST_F(EvaluatorServiceTest, RecordsAVideoOfEachNewBestCheckpointAndShowsItInTheReport) {
@@ -790,6 +863,15 @@ TEST(EvaluatorConfigTest, RejectsBadSettings) {
   c.second_env = "CartPole-v1";
   EXPECT_NO_THROW(c.Validate());
   c.second_episodes = 0;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c = EvaluatorConfig();
+  c.ensemble = 0;
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.ensemble = 2;  // CartPole-v1's actions are discrete: no mean action
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.env_id = kLander;
+  EXPECT_NO_THROW(c.Validate());
+  c.ensemble_min_mean = std::nan("");
   EXPECT_THROW(c.Validate(), std::invalid_argument);
 }
 

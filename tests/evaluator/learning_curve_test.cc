@@ -40,6 +40,25 @@ TEST(LearningCurveTest, DrawsLineBandGoalAndAxisTitles) {
   EXPECT_LT(xs[1], xs[2]);
 }
 
+TEST(LearningCurveTest, DrawsTheOverlaysLineWithItsLegendEntryAndRoomForIt) {
+  CurveStyle style;
+  style.goal = 475;
+  const std::vector<CurvePoint> points = {{1000, 10, 2}, {2000, 30, 5}};
+  const std::string plain = RenderLearningCurveSvg(points, style);
+  EXPECT_EQ(plain.find("class=\"overlay\""), std::string::npos);
+  EXPECT_EQ(plain.find("ensemble of 5"), std::string::npos);
+  // The overlay's points above the curve's band widen the y axis to them.
+  const std::string svg =
+      RenderLearningCurveSvg(points, style, {"ensemble of 5", {{2000, 900}, {1000, 5}}});
+  EXPECT_NE(svg.find("<polyline class=\"overlay\""), std::string::npos);
+  EXPECT_NE(svg.find("ensemble of 5"), std::string::npos);
+  EXPECT_NE(svg.find(">800<"), std::string::npos);  // a y tick label
+  EXPECT_EQ(plain.find(">800<"), std::string::npos);
+  // No curve: no overlay either.
+  const std::string empty = RenderLearningCurveSvg({}, style, {"ensemble of 5", {{1, 2}}});
+  EXPECT_EQ(empty.find("class=\"overlay\""), std::string::npos);
+}
+
 TEST(LearningCurveTest, PicksMinutesForLongDurations) {
   CurveStyle style;
   style.x_label = "wall time";

@@ -120,6 +120,27 @@ TEST_F(ReportTest, ShowsTheTenthPercentileAndMedianOfTheReturnsOnlyWhenKept) {
   EXPECT_NE(html.find("a few failed episodes"), std::string::npos);
 }
 
+TEST_F(ReportTest, ShowsTheBestEnsembleAndAnEnsembleColumnOnlyWhenScored) {
+  std::vector<EvalRecord> records = {Record("a.bin", 1000, 20.0), Record("b.bin", 2000, 180.0),
+                                     Record("c.bin", 3000, 90.0)};
+  const std::string without = WriteAndRead(dir_ / "without", records, Info(475));
+  EXPECT_EQ(without.find("Best ensemble"), std::string::npos);
+  EXPECT_EQ(without.find("<th>ensemble</th>"), std::string::npos);
+  for (auto [i, mean] : {std::pair{1, 250.5}, std::pair{2, 300.25}}) {
+    records[i].ensemble_size = 5;
+    records[i].ensemble_from = records[i].update - 400;
+    records[i].ensemble_mean = mean;
+    records[i].ensemble_std = 12;
+  }
+  const std::string html = WriteAndRead(dir_ / "with", records, Info(475));
+  EXPECT_NE(html.find("Best ensemble</div><div class=\"value\">300.2"), std::string::npos);
+  EXPECT_NE(html.find("the mean action of 5 checkpoints, updates 2,600 to 3,000"),
+            std::string::npos);
+  EXPECT_NE(html.find("<th>ensemble</th>"), std::string::npos);
+  EXPECT_NE(html.find("<td>250.5 \xC2\xB1 12.0 (5)</td>"), std::string::npos);
+  EXPECT_NE(ReadFile(dir_ / "with/curve_wall_time.svg").find("ensemble of 5"), std::string::npos);
+}
+
 TEST_F(ReportTest, SaysWhenAndWhereTheGoalWasFirstReached) {
   const std::vector<EvalRecord> records = {
       Record("a.bin", 1000, 100.0), Record("b.bin", 2000, 480.0), Record("c.bin", 3000, 500.0)};
