@@ -79,15 +79,14 @@ Learner::Learner(LearnerConfig config, Bus* bus)
       sender_(bus->config().sender) {
   nn::SetNumThreads(config_.threads);
   if (config_.policy_average > 0) average_.emplace(config_.policy_average);
-  std::filesystem::create_directories(std::filesystem::path(config_.out_dir) / "checkpoints");
+  const std::string checkpoints = (std::filesystem::path(config_.out_dir) / "checkpoints").string();
+  std::filesystem::create_directories(checkpoints);
   // An earlier life killed while it wrote a checkpoint or the state left its temporary file.
-  RemoveStaleTemporaries((std::filesystem::path(config_.out_dir) / "checkpoints").string());
-  // Earlier lives' checkpoints count towards keep_checkpoints, and go first.
-  // The checkpoints that earlier lives of the learner (a restart, a resumed run) left there.
-  for (std::string& path :
-       nn::CheckpointFilesIn((std::filesystem::path(config_.out_dir) / "checkpoints").string())) {
-    written_.push_back(std::move(path));
-  }
+  RemoveStaleTemporaries(checkpoints);
+  // The checkpoints that earlier lives of the learner (a restart, a resumed run) left there count
+  // towards keep_checkpoints, and go first.
+  const std::vector<std::string> earlier = nn::CheckpointFilesIn(checkpoints);
+  written_.assign(earlier.begin(), earlier.end());
   if (config_.resume && std::filesystem::exists(StatePath())) {
     LoadState(StateFile::Load(StatePath(), StateKind()));
     resumed_ = true;

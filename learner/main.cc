@@ -148,12 +148,12 @@ int Main(int argc, char** argv) {
   c.seed = seed;
   // The kernels the networks will run on (throws, naming the reason, when RL_KERNELS asks for a
   // path this CPU cannot run).
-  std::string kernels = "precision " + c.precision + ", " + rl::nn::KernelPath() + " kernels";
   const std::string& encoder_precision = c.Get<rl::learner::Td3Config>().encoder_precision;
+  std::string kernels = "precision " + c.precision;
   if (c.algorithm == rl::learner::Td3Config::kName && !encoder_precision.empty()) {
-    kernels = "precision " + c.precision + " (the shared encoder's: " + encoder_precision + "), " +
-              rl::nn::KernelPath() + " kernels";
+    kernels += " (the shared encoder's: " + encoder_precision + ")";
   }
+  kernels += ", " + rl::nn::KernelPath() + " kernels";
   if ((c.precision == "bf16" || encoder_precision == "bf16") && !rl::nn::NativeBf16()) {
     kernels += ", bf16 emulated: no AVX512_BF16";
     std::fprintf(stderr,

@@ -315,6 +315,15 @@ std::string ScoreStd(const EvalRecord& r) {
   return Score(r.mean) + " <small class=\"inline\">\xC2\xB1 " + Score(r.std) + "</small>";
 }
 
+// The ensemble of `r` (ensemble_size > 0): "812.5 ± 40.1" and below it "5, updates 200,000 to
+// 220,000".
+std::string EnsembleCell(const EvalRecord& r) {
+  return Score(r.ensemble_mean) + " <small class=\"inline\">\xC2\xB1 " + Score(r.ensemble_std) +
+         "</small><small>" + std::to_string(r.ensemble_size) + ", updates " +
+         Thousands(static_cast<double>(r.ensemble_from)) + " to " +
+         Thousands(static_cast<double>(r.update)) + "</small>";
+}
+
 std::string RunName(const CompareRun& run, const std::string& page_dir) {
   std::string name = HtmlEscape(run.label);
   if (page_dir.empty()) return name;
@@ -453,16 +462,27 @@ std::string PresetsSection(const std::vector<Group>& groups, const Summaries& su
 // The runs, by group.
 std::string RunsSection(const std::vector<Group>& groups, const Summaries& summaries,
                         const std::string& page_dir) {
+  bool ensembles = false;
+  for (const Group& g : groups) {
+    for (const CompareRun* run : g.runs)
+      ensembles |= summaries.of(run).best_ensemble.ensemble_size > 0;
+  }
   std::string h =
       "<section>\n<h2>Runs</h2>\n<p class=\"how\">Best: the first evaluation with the highest "
       "mean; final: the evaluation of the last checkpoint. A run's name links to its "
-      "report.</p>\n<div class=\"scroll\"><table>\n<thead><tr><th>run</th><th>seed</th>"
-      "<th>evaluations</th><th>best mean</th><th>env steps at best</th><th>wall time at best</th>"
-      "<th>final mean</th><th>last evaluation at</th><th>goal first reached at</th></tr>"
-      "</thead>\n";
+      "report.";
+  if (ensembles) {
+    h += " Best ensemble: the highest mean of the mean action of a checkpoint and those before it "
+         "(how many, and their updates, below it), on the same episodes.";
+  }
+  h += "</p>\n<div class=\"scroll\"><table>\n<thead><tr><th>run</th><th>seed</th>"
+       "<th>evaluations</th><th>best mean</th><th>env steps at best</th><th>wall time at best</th>"
+       "<th>final mean</th><th>last evaluation at</th><th>goal first reached at</th>";
+  if (ensembles) h += "<th>best ensemble</th>";
+  h += "</tr></thead>\n";
   for (const Group& g : groups) {
-    h += "<tbody>\n<tr class=\"sub\"><th colspan=\"9\">" + Swatch(g.color) + HtmlEscape(g.preset) +
-         "</th></tr>\n";
+    h += "<tbody>\n<tr class=\"sub\"><th colspan=\"" + std::to_string(ensembles ? 10 : 9) + "\">" +
+         Swatch(g.color) + HtmlEscape(g.preset) + "</th></tr>\n";
     for (const CompareRun* run : g.runs) {
       const RunSummary& s = summaries.of(run);
       h += "<tr><td>" + RunName(*run, page_dir) + "</td><td>" +
@@ -478,6 +498,12 @@ std::string RunsSection(const std::vector<Group>& groups, const Summaries& summa
              HtmlEscape(Format("%g", run->goal)) + ")</small></td>";
       } else {
         h += std::string("<td>") + kDash + "</td>";
+      }
+      if (ensembles) {
+        h += "<td>" +
+             (s.best_ensemble.ensemble_size > 0 ? EnsembleCell(s.best_ensemble)
+                                                : std::string(kDash)) +
+             "</td>";
       }
       h += "</tr>\n";
     }
@@ -589,6 +615,10 @@ RunSummary Summarize(const CompareRun& run) {
   const EvalRecord* goal = nullptr;
   for (const EvalRecord& r : run.records) {
     if (best == nullptr || r.mean > best->mean) best = &r;
+    if (r.ensemble_size > 0 &&
+        (s.best_ensemble.ensemble_size == 0 || r.ensemble_mean > s.best_ensemble.ensemble_mean)) {
+      s.best_ensemble = r;
+    }
     if (last == nullptr || r.update >= last->update) last = &r;
     if (std::isfinite(run.goal) && r.mean >= run.goal &&
         (goal == nullptr || r.update < goal->update)) {

@@ -48,6 +48,9 @@ struct RunSummary {
   evaluator::EvalRecord final;       // the evaluation of the highest update (the last, on ties)
   bool goal_reached = false;         // some evaluation's mean is at least the goal
   evaluator::EvalRecord first_goal;  // the first (lowest update) to reach it; unset if not
+  // The first evaluation with the highest ensemble mean (evaluator --ensemble); its
+  // ensemble_size is 0 when no evaluation has an ensemble.
+  evaluator::EvalRecord best_ensemble;
 };
 
 /// Summarizes `run` (whose records are not empty).

@@ -1,5 +1,6 @@
 #include "tools/compare_runs.h"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -47,6 +48,7 @@ class CompareRunsTest : public TempDirTest {
     double wall;
     double mean;
     double std = 10;
+    double ensemble = std::nan("");  // the mean of its ensemble of 5; NaN: none scored
   };
 
   // Appends `evals` to dir/eval.jsonl as the evaluator writes them (100 episodes each, min and
@@ -63,6 +65,12 @@ class CompareRunsTest : public TempDirTest {
       r.min = e.mean - e.std;
       r.max = e.mean + e.std;
       r.episodes = 100;
+      if (std::isfinite(e.ensemble)) {
+        r.ensemble_size = 5;
+        r.ensemble_from = e.update - 200;
+        r.ensemble_mean = e.ensemble;
+        r.ensemble_std = e.std;
+      }
       evaluator::AppendJsonLine(dir + "/eval.jsonl", r);
     }
   }
@@ -186,6 +194,30 @@ TEST_F(CompareRunsTest, SummarizesBestFinalAndTheFirstEvaluationAtTheGoal) {
   EXPECT_EQ(s.final.update, 2500);
   EXPECT_TRUE(s.goal_reached);
   EXPECT_EQ(s.first_goal.update, 1000);
+}
+
+TEST_F(CompareRunsTest, ShowsEachRunsBestEnsembleOnlyWhenSomeRunHasOne) {
+  const std::string one = MakeRun("one", "car", "CarRacing-v3", 1, 900);
+  AddEvals(one, {{500, 1000, 10, 700, 10, 720.5}, {1000, 2000, 20, 800, 10, 710}});
+  const std::string two = MakeRun("two", "car", "CarRacing-v3", 2, 900);
+  AddEvals(two, {{500, 1000, 10, 650}});
+  std::vector<CompareRun> runs = {LoadCompareRun(two)};
+  MakeLabelsUnique(&runs);
+  EXPECT_EQ(Summarize(runs[0]).best_ensemble.ensemble_size, 0);
+  EXPECT_EQ(RenderComparePage(runs, "").find("best ensemble"), std::string::npos);
+
+  runs.insert(runs.begin(), LoadCompareRun(one));
+  MakeLabelsUnique(&runs);
+  const RunSummary s = Summarize(runs[0]);
+  EXPECT_EQ(s.best.update, 1000);
+  EXPECT_EQ(s.best_ensemble.update, 500);  // the best ensemble is not the best checkpoint's
+  const std::string html = RenderComparePage(runs, "");
+  const size_t runs_table = html.find("<h2>Runs</h2>");
+  ASSERT_NE(runs_table, std::string::npos);
+  EXPECT_NE(html.find("<th>best ensemble</th>", runs_table), std::string::npos);
+  EXPECT_EQ(RowCells(html, runs_table, ">one<").back(),
+            "720.5 \xC2\xB1 10.0 5, updates 300 to 500");
+  EXPECT_EQ(RowCells(html, runs_table, ">two<").back(), "\xE2\x80\x94");
 }
 
 TEST_F(CompareRunsTest, LabelsRunsOfTheSameNameByTheirParentFolders) {
