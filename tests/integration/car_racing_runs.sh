@@ -14,10 +14,11 @@ status=0
 # Checkpoints every 50 updates and 3 evaluation episodes, so that the evaluator scores a few;
 # the learner on one thread, so that the run does not oversubscribe the two cores of CI; a t-SNE
 # map of 400 states (the preset's 2000 took the evaluator half a minute of a 90 s budget on a
-# loaded machine, and the embedding grows with the square of the states).
+# loaded machine, and the embedding grows with the square of the states); ensembles of two
+# checkpoints.
 launch car_racing_td3 --out "$dir/run" --seed 1 --goal 100000 --time-budget 90 \
   --learner-args "--checkpoint-every 50 --threads 1" \
-  --evaluator-args "--episodes 3 --second-episodes 2 --second-min-mean -1000 --videos 1 --tsne 400" \
+  --evaluator-args "--episodes 3 --second-episodes 2 --second-min-mean -1000 --videos 1 --tsne 400 --ensemble 2" \
   > "$dir/launch.log" 2>&1 || status=$?
 tail -6 "$dir/launch.log"
 [ "$status" -eq 1 ] || fail "launch exited with $status (expected 1: the budget ran out unsolved)"
@@ -34,6 +35,9 @@ if grep -q 'off-track=1' "$dir/run/logs/evaluator.log"; then fail "the evaluator
 grep -q '"second_episodes": 2' "$dir/run/eval.jsonl" || fail "no second metric in eval.jsonl"
 grep -q "the TD3 article&#39;s rules\|the TD3 article's rules" "$dir/run/report/index.html" ||
   fail "the report does not name the second metric"
+# Every checkpoint but the first also as an ensemble with the one before it, in the report too.
+grep -q '"ensemble_size": 2, "ensemble_from": ' "$dir/run/eval.jsonl" || fail "no ensemble in eval.jsonl"
+grep -q "Best ensemble" "$dir/run/report/index.html" || fail "the report shows no ensemble"
 # Progress over the second half of the run, from the metrics rows (t: seconds since the monitor
 # started): the replay's inserts and the learner's updates grew between the last row of the first
 # half and the last row, and the evaluator scored a checkpoint made in the second half (of an
