@@ -37,6 +37,9 @@ inline __m512i PairUp(__m512 even, __m512 odd) {
 // The 16 pairs of 32 consecutive floats, of which the first `valid` (<= 32) are read and the
 // rest taken as 0.
 inline __m512i PairsOfRun(const float* src, int valid) {
+  if (valid >= 32) {
+    return (__m512i)_mm512_cvtne2ps_pbh(_mm512_loadu_ps(src + 16), _mm512_loadu_ps(src));
+  }
   const auto lo_mask = static_cast<__mmask16>(valid >= 16 ? 0xFFFFU : (1U << valid) - 1U);
   const auto hi_mask = static_cast<__mmask16>(valid >= 32   ? 0xFFFFU
                                               : valid <= 16 ? 0U
@@ -87,11 +90,27 @@ inline void Transpose16(__m512i* r) {
 // of 16).
 void PairsFromColumns(const float* src, int64_t stride, int rows, int k, int q0, int pairs,
                       int width, int64_t dst_step, Pair* dst) {
+  // A stride of whole rows of a large matrix (a weight) crosses a page every pair or two, where
+  // the hardware does not prefetch: ask for the pair kAheadPairs on.
+  constexpr int kAheadPairs = 4;
+  const bool prefetch = stride >= 256;
   for (int q = q0; q < q0 + pairs; ++q) {
     const float* even = src + 2 * static_cast<int64_t>(q) * stride;
     const bool has_odd = 2 * q + 1 < k;
     Pair* out = dst + (q - q0) * dst_step;
+    if (prefetch && 2 * (q + kAheadPairs) + 1 < k) {
+      const float* ahead = even + 2 * kAheadPairs * stride;
+      for (int i = 0; i < rows; i += 16) {
+        __builtin_prefetch(ahead + i);
+        __builtin_prefetch(ahead + stride + i);
+      }
+    }
     for (int i = 0; i < width; i += 16) {
+      if (rows - i >= 16 && has_odd) {
+        _mm512_storeu_si512(out + i,
+                            PairUp(_mm512_loadu_ps(even + i), _mm512_loadu_ps(even + stride + i)));
+        continue;
+      }
       const __mmask16 mask = FirstLanes(rows - i);
       const __m512 e = _mm512_maskz_loadu_ps(mask, even + i);
       const __m512 o =
@@ -324,44 +343,93 @@ void GemmPairsOneBf16(const uint32_t* a_pairs, int m, int k, const ConstView& b,
   PanelGemmBf16({nullptr, m, k, 0, 0}, b, c, accumulate, epilogue, workspace, {nullptr, a_pairs});
 }
 
+// Taps gathered before they are paired: 32 rows of 48 floats (6 KB), with the planes' floats
+// they read, stay in L1 (nn/kernels.h sizes the scratch space of Im2colPairs() for it).
+constexpr int kGatherTaps = 32;
+static_assert(kGatherTaps % 2 == 0, "a block of taps holds whole pairs");
+
+// One copy of the unfolding's gather: up to 16 plane floats (for tap offset 0) into a run of a
+// panel row.
+struct GatherChunk {
+  int64_t src;
+  int lane;
+  __mmask16 mask;  // The floats it copies.
+};
+
 // The convolution's unfolding (conv_impl.h's Im2colPanels()) straight into bf16 pairs, a panel
-// at a time: its rows unfolded as floats into `panel` (taps x 48 floats, which stay in the L2
-// cache), then rounded and paired. (Pairing each two taps as they are gathered would read
-// vectors just written in pieces, which stalls on store forwarding.)
+// at a time and 32 taps at a time: those rows unfolded as floats into `panel` (32 x 48 floats),
+// then rounded and paired. (Pairing each two taps as they are gathered would read
+// vectors just written in pieces, which stalls on store forwarding.) The panel's pieces are cut
+// into chunks of 16 once per panel, and every tap copies the chunks with whole-vector loads and
+// stores where it can: a chunk's store may write past its run, because the next chunk of the row
+// overwrites those lanes (only the row's last chunk is a masked store), and its load may read
+// past its run while that stays inside the group's planes.
 void Im2colPairs(const ConvGeometry& g, const float* planes, int count, uint32_t* pairs,
                  float* panel) {
   const int64_t m = static_cast<int64_t>(count) * g.pixels;
   const int64_t panels = (m + kMrB - 1) / kMrB;
   const int steps = (g.taps + 1) / 2;
+  // A whole-vector load at chunk offset o reads [o + tap_offset, o + tap_offset + 16).
+  const int64_t readable = static_cast<int64_t>(count) * g.plane_stride;
+  const int64_t max_tap_offset = *std::max_element(g.tap_offset.begin(), g.tap_offset.end());
   std::array<PanelPiece, kMrB> pieces{};
-  // An odd number of taps pairs the last one with zeros.
-  std::fill(panel + static_cast<int64_t>(g.taps) * kMrB,
-            panel + static_cast<int64_t>(2 * steps) * kMrB, 0.0f);
+  std::array<GatherChunk, 2 * kMrB> chunks{};
   for (int64_t q = 0; q < panels; ++q) {
     const int n_pieces = PanelPieces(g, q, kMrB, m, pieces.data());
+    int n_chunks = 0;
+    for (int i = 0; i < n_pieces; ++i) {
+      const PanelPiece& piece = pieces[static_cast<size_t>(i)];
+      for (int x = 0; x < piece.n; x += 16) {
+        chunks[static_cast<size_t>(n_chunks++)] = {piece.src + x, piece.lane + x,
+                                                   FirstLanes(piece.n - x)};
+      }
+    }
+    // Chunks [0, whole_stores) end their row's 16 lanes inside it and have a chunk after them;
+    // the rest are masked stores. Lanes rise through the panel, so they are a prefix.
+    int whole_stores = 0;
+    while (whole_stores < n_chunks - 1 &&
+           chunks[static_cast<size_t>(whole_stores)].lane + 16 <= kMrB) {
+      ++whole_stores;
+    }
+    const bool whole_loads =
+        chunks[static_cast<size_t>(n_chunks - 1)].src + max_tap_offset + 16 <= readable;
     const int64_t r_end = std::min(m, (q + 1) * kMrB);
     const int filled = static_cast<int>(r_end - q * kMrB);
-    float* row = panel;
-    for (int tap = 0; tap < g.taps; ++tap, row += kMrB) {
-      const float* src = planes + g.tap_offset[static_cast<size_t>(tap)];
-      for (int i = 0; i < n_pieces; ++i) {
-        const PanelPiece& piece = pieces[static_cast<size_t>(i)];
-        for (int x = 0; x < piece.n; x += 16) {
-          const __mmask16 mask = FirstLanes(piece.n - x);
-          _mm512_mask_storeu_ps(row + piece.lane + x, mask,
-                                _mm512_maskz_loadu_ps(mask, src + piece.src + x));
-        }
-      }
-      // Rows past m (the last panel only) are zero.
-      std::fill(row + filled, row + kMrB, 0.0f);
-    }
+    // Taps a block at a time, each block gathered and then paired while it is still in L1.
     Pair* dst = pairs + q * kMrB * steps;
-    const float* even = panel;
-    for (int s = 0; s < steps; ++s, dst += kMrB, even += 2 * kMrB) {
+    for (int t0 = 0; t0 < g.taps; t0 += kGatherTaps) {
+      const int t1 = std::min(g.taps, t0 + kGatherTaps);
+      float* row = panel;
+      for (int tap = t0; tap < t1; ++tap, row += kMrB) {
+        const float* src = planes + g.tap_offset[static_cast<size_t>(tap)];
+        if (whole_loads) {
+          int i = 0;
+          for (; i < whole_stores; ++i) {
+            const GatherChunk& c = chunks[static_cast<size_t>(i)];
+            _mm512_storeu_ps(row + c.lane, _mm512_loadu_ps(src + c.src));
+          }
+          for (; i < n_chunks; ++i) {
+            const GatherChunk& c = chunks[static_cast<size_t>(i)];
+            _mm512_mask_storeu_ps(row + c.lane, c.mask, _mm512_loadu_ps(src + c.src));
+          }
+        } else {
+          for (int i = 0; i < n_chunks; ++i) {
+            const GatherChunk& c = chunks[static_cast<size_t>(i)];
+            _mm512_mask_storeu_ps(row + c.lane, c.mask, _mm512_maskz_loadu_ps(c.mask, src + c.src));
+          }
+        }
+        // Rows past m (the last panel only) are zero.
+        std::fill(row + filled, row + kMrB, 0.0f);
+      }
+      // An odd number of taps pairs the last one with zeros.
+      if ((t1 - t0) % 2 != 0) std::fill(row, row + kMrB, 0.0f);
+      const float* even = panel;
+      for (int tap = t0; tap < t1; tap += 2, dst += kMrB, even += 2 * kMrB) {
 #pragma GCC unroll 3
-      for (int v = 0; v < kMaxV; ++v) {
-        _mm512_storeu_si512(dst + v * kL, PairUp(_mm512_loadu_ps(even + v * kL),
-                                                 _mm512_loadu_ps(even + kMrB + v * kL)));
+        for (int v = 0; v < kMaxV; ++v) {
+          _mm512_storeu_si512(dst + v * kL, PairUp(_mm512_loadu_ps(even + v * kL),
+                                                   _mm512_loadu_ps(even + kMrB + v * kL)));
+        }
       }
     }
   }

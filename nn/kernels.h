@@ -130,8 +130,10 @@ struct KernelSet {
   void (*plane_gradient)(const ConvGeometry& g, const GradientRun* runs, int n_runs, float* out);
 };
 
-/// The scratch space of KernelSet::im2col_pairs: one panel of 48 rows, an even number of taps.
-inline int64_t Im2colPairsPanelFloats(const ConvGeometry& g) { return 48 * ((g.taps + 1) / 2 * 2); }
+/// The scratch space of KernelSet::im2col_pairs: 48 rows of up to 32 taps, an even number.
+inline int64_t Im2colPairsPanelFloats(const ConvGeometry& g) {
+  return 48 * std::min(32, (g.taps + 1) / 2 * 2);
+}
 
 /// The set in use (see KernelPath() in nn/precision.h). Throws std::runtime_error the first time
 /// when RL_KERNELS asks for a path that cannot run.
