@@ -1,5 +1,7 @@
 #include "common/options.h"
 
+#include <algorithm>
+
 #include <cstdio>
 #include <exception>
 #include <fstream>
@@ -126,6 +128,13 @@ bool ParseOptions(int argc, char** argv, const std::string& role, const std::str
   }
   po::notify(*vm);
   return true;
+}
+
+bool OnCommandLine(int argc, char** argv, const po::options_description& desc,
+                   const std::string& name) {
+  const po::parsed_options parsed = po::parse_command_line(argc, argv, desc);
+  return std::any_of(parsed.options.begin(), parsed.options.end(),
+                     [&](const po::option& opt) { return opt.string_key == name; });
 }
 
 void RefuseGiven(const po::variables_map& vm, const std::vector<std::string>& names,

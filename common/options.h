@@ -52,6 +52,11 @@ void AddCommonOptions(po::options_description* desc, CommonOptions* common);
 bool ParseOptions(int argc, char** argv, const std::string& role, const std::string& usage,
                   const po::options_description& desc, po::variables_map* vm);
 
+/// Whether option `name` of `desc` is on the command line itself, not only in the --config file
+/// (a preset's key may set what only a command line should switch on).
+bool OnCommandLine(int argc, char** argv, const po::options_description& desc,
+                   const std::string& name);
+
 /// Throws std::runtime_error("option --NAME does not apply: <why>") for the first of `names`
 /// that was given (on the command line or in the config file) rather than left at its default:
 /// options of the algorithm or exploration a run did not choose are refused, not ignored.

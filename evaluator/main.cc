@@ -45,7 +45,8 @@ constexpr char kUsage[] =
     "      that constant sigma (of the half-range) instead of its deterministic action, to\n"
     "      compare the two; the standard metric is without noise.\n"
     "      --ensemble K (continuous actions) scores the mean action of FILE and the K - 1\n"
-    "      checkpoints before it in its folder (the learner's ckpt-<update>.bin files).\n"
+    "      checkpoints before it in its folder (the learner's ckpt-<update>.bin files); only\n"
+    "      on the command line: a --config file's ensemble is the service's.\n"
     "      --frames also writes the grid of camera frames the report shows (pixel envs),\n"
     "      --tsne-map the t-SNE map of its last hidden layer (pixel envs; N states, 2000 by\n"
     "      default).\n"
@@ -221,7 +222,11 @@ int Main(int argc, char** argv) {
   } else {
     rl::RefuseGiven(vm, {"noise"}, config.env_id + " has discrete actions (see --epsilon)");
   }
-  const bool standalone_ensemble = !checkpoint.empty() && !vm["ensemble"].defaulted();
+  // Standalone, only a command line's --ensemble scores an ensemble: a preset's `ensemble` key
+  // is the service's.
+  const bool standalone_ensemble =
+      !checkpoint.empty() && rl::OnCommandLine(argc, argv, desc, "ensemble");
+  if (!checkpoint.empty() && !standalone_ensemble) config.ensemble = 1;
   if (checkpoint.empty()) {
     rl::RefuseGiven(vm, {"noise"}, "the service scores without noise, the standard metric");
   }

@@ -49,6 +49,34 @@ std::string ParseError(const std::string& ini) {
   return ErrorOf([&] { Parse(ini); });
 }
 
+TEST(OptionsTest, OnCommandLineTellsTheCommandLinesOptionsFromTheConfigFiles) {
+  const TempDir dir;
+  const fs::path path = dir / "options.ini";
+  std::ofstream(path) << "[evaluator]\nensemble = 5\n";
+  CommonOptions common;
+  int ensemble = 1;
+  int episodes = 100;
+  po::options_description desc("Options");
+  AddCommonOptions(&desc, &common);
+  desc.add_options()("ensemble", po::value(&ensemble)->default_value(1), "ensemble")  //
+      ("episodes", po::value(&episodes)->default_value(100), "episodes");
+  std::vector<std::string> args = {"evaluator", "--config", path.string(), "--episodes=3"};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  const int argc = static_cast<int>(argv.size());
+  po::variables_map vm;
+  ASSERT_TRUE(ParseOptions(argc, argv.data(), "evaluator", "usage", desc, &vm));
+  EXPECT_EQ(ensemble, 5);  // from the file
+  EXPECT_FALSE(vm["ensemble"].defaulted());
+  EXPECT_FALSE(OnCommandLine(argc, argv.data(), desc, "ensemble"));
+  EXPECT_TRUE(OnCommandLine(argc, argv.data(), desc, "episodes"));
+  args.emplace_back("--ensemble");
+  args.emplace_back("2");
+  argv.clear();
+  for (std::string& a : args) argv.push_back(a.data());
+  EXPECT_TRUE(OnCommandLine(static_cast<int>(argv.size()), argv.data(), desc, "ensemble"));
+}
+
 TEST(OptionsTest, TheSectionWinsOverTheTopLevelAndTheCommandLineOverBoth) {
   const std::string ini =
       "env = CarRacing-v3+pixels(skip=5,off-track=1)\nepisodes = 7\nunknown-top = 1\n"

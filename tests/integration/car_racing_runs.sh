@@ -38,6 +38,16 @@ grep -q "the TD3 article&#39;s rules\|the TD3 article's rules" "$dir/run/report/
 # Every checkpoint but the first also as an ensemble with the one before it, in the report too.
 grep -q '"ensemble_size": 2, "ensemble_from": ' "$dir/run/eval.jsonl" || fail "no ensemble in eval.jsonl"
 grep -q "Best ensemble" "$dir/run/report/index.html" || fail "the report shows no ensemble"
+# Standalone, the preset's config scores the one checkpoint (its `ensemble` is the service's);
+# --ensemble on the command line scores the mean action of it and the one before it.
+last=$(find "$dir/run/checkpoints" -name 'ckpt-*.bin' | sort -V | tail -1)
+"$bin/evaluator" --config "$dir/run/config.ini" --checkpoint "$last" --episodes 1 \
+  > "$dir/one.json" 2> "$dir/one.err" || fail "standalone scoring failed: $(cat "$dir/one.err")"
+grep -q '"episodes": 1' "$dir/one.json" || fail "standalone scoring printed no result"
+if grep -q "the mean action of" "$dir/one.err"; then fail "the preset's ensemble key made a standalone ensemble"; fi
+"$bin/evaluator" --config "$dir/run/config.ini" --checkpoint "$last" --episodes 1 --ensemble 2 \
+  > "$dir/two.json" 2> "$dir/two.err" || fail "standalone ensemble failed: $(cat "$dir/two.err")"
+grep -q "the mean action of 2 checkpoints" "$dir/two.err" || fail "--ensemble 2 scored no ensemble"
 # Progress over the second half of the run, from the metrics rows (t: seconds since the monitor
 # started): the replay's inserts and the learner's updates grew between the last row of the first
 # half and the last row, and the evaluator scored a checkpoint made in the second half (of an
