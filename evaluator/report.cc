@@ -92,28 +92,22 @@ Highlights FindHighlights(const std::vector<EvalRecord>& records, double goal) {
   return h;
 }
 
-// curve_env_steps.svg and curve_wall_time.svg.
-// "ensemble of 5" (the size of the last record with an ensemble), or "" when none has one.
-std::string EnsembleLabel(const std::vector<EvalRecord>& records) {
-  for (auto r = records.rbegin(); r != records.rend(); ++r) {
-    if (r->ensemble_size > 0) return "ensemble of " + std::to_string(r->ensemble_size);
-  }
-  return {};
-}
-
+// curve_env_steps.svg and curve_wall_time.svg, with the ensembles' means as a second line named
+// by the size of the last record's ensemble ("ensemble of 5") when some record has one.
 void WriteLearningCurves(const std::string& dir, const std::vector<EvalRecord>& records,
                          double goal) {
   std::vector<CurvePoint> by_steps, by_time;
-  CurveOverlay ensembles_by_steps{EnsembleLabel(records), {}};
-  CurveOverlay ensembles_by_time = ensembles_by_steps;
+  CurveOverlay ensembles_by_steps, ensembles_by_time;
   for (const EvalRecord& r : records) {
     by_steps.push_back({static_cast<double>(r.env_steps), r.mean, r.std, r.min, r.max});
     by_time.push_back({r.wall_seconds, r.mean, r.std, r.min, r.max});
     if (r.ensemble_size > 0) {
+      ensembles_by_steps.label = "ensemble of " + std::to_string(r.ensemble_size);
       ensembles_by_steps.points.push_back({static_cast<double>(r.env_steps), r.ensemble_mean});
       ensembles_by_time.points.push_back({r.wall_seconds, r.ensemble_mean});
     }
   }
+  ensembles_by_time.label = ensembles_by_steps.label;
   CurveStyle style;
   style.goal = std::isfinite(goal) ? goal : std::nan("");
   style.title = "Evaluation return vs. environment steps";
