@@ -4,6 +4,8 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace rl {
 
@@ -33,11 +35,24 @@ bool RunPortsInUse(int port) {
          0;
 }
 
+std::pair<int, int> EphemeralPorts() {
+  std::ifstream in("/proc/sys/net/ipv4/ip_local_port_range");
+  int low = 0, high = 0;
+  if (in >> low >> high && 0 < low && low <= high && high < 65536) return {low, high};
+  return {32768, 60999};  // Linux's default
+}
+
 int PickRunPorts(int tries) {
+  const auto [low, high] = EphemeralPorts();
+  std::vector<int> choices;
+  for (int port = 20000; port + 2 < 65536; port += 3) {
+    if (port + 2 < low || port > high) choices.push_back(port);
+  }
+  if (choices.empty()) return 0;
   std::random_device device;
-  std::uniform_int_distribution<int> pick(0, 13332);
+  std::uniform_int_distribution<size_t> pick(0, choices.size() - 1);
   for (int attempt = 0; attempt < tries; ++attempt) {
-    const int port = 20000 + 3 * pick(device);
+    const int port = choices[pick(device)];
     if (!RunPortsInUse(port)) return port;
   }
   return 0;

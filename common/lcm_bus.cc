@@ -110,16 +110,23 @@ void Bus::SubscribeRaw(const std::string& channel, Port port, int64_t fingerprin
   sub->counts_lost = std::none_of(subscriptions_.begin(), subscriptions_.end(),
                                   [&](const auto& s) { return s->channel == channel; });
   if (const auto it = restored_.find(channel); it != restored_.end()) sub->heard = it->second;
-  lcm::Subscription* s =
-      lcm(port).subscribeFunction<RawSubscription*>(channel, &Bus::OnRaw, sub.get());
-  if (s == nullptr) throw std::runtime_error("cannot subscribe to " + channel);
-  s->setQueueCapacity(config_.queue_capacity);
+  // Through LCM's C API: its C++ one hands back a subscription it never made when the port
+  // cannot be bound (another program's socket holds its UDP port: LCM prints "bind: ..."), and
+  // that subscription crashes at first use.
+  lcm_subscription_t* s =
+      lcm_subscribe(lcm(port).getUnderlyingLCM(), channel.c_str(), &Bus::OnRaw, sub.get());
+  if (s == nullptr) {
+    throw std::runtime_error("cannot subscribe to " + channel + " on the " +
+                             std::string(PortName(port)) + " port (" + PortUrl(port) +
+                             "): is its UDP port held by another program?");
+  }
+  lcm_subscription_set_queue_capacity(s, config_.queue_capacity);
   subscriptions_.push_back(std::move(sub));
   subscribed_[static_cast<int>(port)] = true;
 }
 
-void Bus::OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& /*channel*/,
-                RawSubscription* sub) {
+void Bus::OnRaw(const lcm_recv_buf_t* rbuf, const char* /*channel*/, void* user) {
+  auto* sub = static_cast<RawSubscription*>(user);
   try {
     sub->bus->Receive(sub, static_cast<const uint8_t*>(rbuf->data), rbuf->data_size,
                       rbuf->recv_utime);

@@ -254,11 +254,15 @@ class Bus {
   };
 
   lcm::LCM& lcm(Port port) { return *ports_[static_cast<int>(port)]; }
+  const std::string& PortUrl(Port port) const {
+    return port == Port::kMain   ? config_.url
+           : port == Port::kBulk ? config_.bulk_url
+                                 : config_.samples_url;
+  }
   void SubscribeRaw(const std::string& channel, Port port, int64_t fingerprint,
                     std::function<const char*(const uint8_t*, size_t)> decode,
                     std::function<void()> handle);
-  static void OnRaw(const lcm::ReceiveBuffer* rbuf, const std::string& channel,
-                    RawSubscription* sub);
+  static void OnRaw(const lcm_recv_buf_t* rbuf, const char* channel, void* sub);
   // Every check (see the top of this file), decoding, and the handler.
   void Receive(RawSubscription* sub, const uint8_t* data, size_t size, int64_t recv_utime);
   // Why a message is stale, or nullptr.

@@ -1,7 +1,6 @@
 #include "common/options.h"
 
 #include <algorithm>
-
 #include <cstdio>
 #include <exception>
 #include <fstream>

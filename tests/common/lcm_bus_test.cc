@@ -1,5 +1,9 @@
 #include "common/lcm_bus.h"
 
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -710,6 +714,47 @@ TEST(BusPortsTest, TheSamplesPortCanShareTheBulkPort) {
   for (int i = 0; i < 100 && (replies == 0 || weights == 0); ++i) bus->Handle(10);
   EXPECT_EQ(replies, 1);
   EXPECT_EQ(weights, 1);
+}
+
+// A udpm port another program holds (a UDP socket bound without SO_REUSEADDR, as a sending
+// socket given that ephemeral port is) cannot be bound by LCM: subscribing there is a clear
+// error, not a crash (LCM's C++ API hands back a subscription it never made).
+TEST(BusPortsTest, APortHeldByAnotherProgramIsAClearErrorAtSubscription) {
+  const int fd = socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  socklen_t size = sizeof(addr);
+  ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&addr), size), 0);
+  ASSERT_EQ(getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &size), 0);
+  const int held = ntohs(addr.sin_port);
+  BusConfig c = MemqConfig(5, "actor-0");
+  c.bulk_url = "udpm://239.255.76.67:" + std::to_string(held) + "?ttl=0";
+  std::unique_ptr<Bus> bus;
+  try {
+    bus = std::make_unique<Bus>(c);
+  } catch (const std::runtime_error& e) {
+    close(fd);
+    GTEST_SKIP() << "no multicast here: " << e.what();
+  }
+  try {
+    bus->Subscribe<rlmsg::weights_chunk_t>(
+        channels::kWeights, [](const rlmsg::weights_chunk_t&) {}, Port::kBulk);
+    ADD_FAILURE() << "subscribed on a port another socket holds";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("on the bulk port (" + c.bulk_url + ")"),
+              std::string::npos)
+        << e.what();
+  }
+  // The ports that could bind still work.
+  int stats = 0;
+  bus->Subscribe<rlmsg::stats_actor_t>(channels::kStatsActor,
+                                       [&stats](const rlmsg::stats_actor_t&) { ++stats; });
+  rlmsg::stats_actor_t s = examples::Example<rlmsg::stats_actor_t>();
+  ASSERT_TRUE(bus->Publish(channels::kStatsActor, &s));
+  for (int i = 0; i < 100 && stats == 0; ++i) bus->Handle(10);
+  EXPECT_EQ(stats, 1);
+  close(fd);
 }
 
 }  // namespace

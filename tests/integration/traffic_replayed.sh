@@ -20,7 +20,8 @@ scratch
 command -v lcm-logplayer >/dev/null || fail "lcm-logplayer is missing (liblcm-bin)"
 # The samples port is recorded from before the run starts, so that the recording holds the
 # replies to the learner's first requests (ids 0, 1, ...).
-port=$((20000 + 3 * (RANDOM % 13000)))
+# Below Linux's ephemeral ports (32768 on), where no sending socket can hold one of them.
+port=$((20000 + 3 * (RANDOM % 4255)))
 bulk_url="udpm://239.255.76.67:$((port + 1))?ttl=0&recv_buf_size=4194304"
 samples_url="udpm://239.255.76.67:$((port + 2))?ttl=0&recv_buf_size=4194304"
 lcm-logger --quiet --lcm-url="$samples_url" "$dir/samples.lcmlog" > "$dir/samples-logger.log" 2>&1 &
