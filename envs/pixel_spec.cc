@@ -64,11 +64,12 @@ EnvIdParts ParseEnvId(const std::string& id) {
       throw std::invalid_argument("env '" + id + "': expected key=value, got '" + item + "'");
     }
     const std::string value = item.substr(eq + 1);
-    if (key == "max-pool" || key == "off-track" || key == "lap-ends") {
+    if (key == "max-pool" || key == "off-track" || key == "lap-ends" || key == "pedals") {
       const int v = ParseInt(id, key, value);
       if (v != 0 && v != 1) throw std::invalid_argument("env '" + id + "': " + key + " is 0 or 1");
       (key == "max-pool"    ? c.max_pool
        : key == "off-track" ? parts.off_track
+       : key == "pedals"    ? parts.pedals
                             : parts.lap_ends) = v == 1;
     } else if (auto it = ints.find(key); it != ints.end()) {
       *it->second = ParseInt(id, key, value);
@@ -77,7 +78,7 @@ EnvIdParts ParseEnvId(const std::string& id) {
           "env '" + id + "': unknown pixels key '" + key +
           "' (known: width, height, stack, skip, max-pool, crop-top, crop-bottom, crop-left, "
           "crop-right, render-width, render-height, noop-start, off-track, off-track-grace, "
-          "time-limit, lap-ends)");
+          "time-limit, lap-ends, pedals)");
     }
   }
   try {
@@ -93,6 +94,10 @@ EnvIdParts ParseEnvId(const std::string& id) {
     throw std::invalid_argument("env '" + id +
                                 "': " + (parts.off_track ? "off-track" : "lap-ends") +
                                 " applies to CarRacing only");
+  }
+  if (parts.pedals && parts.base != "CarRacing-v3") {
+    throw std::invalid_argument("env '" + id +
+                                "': pedals applies to CarRacing-v3 only (continuous actions)");
   }
   return parts;
 }

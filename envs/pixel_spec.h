@@ -6,7 +6,8 @@
 // ImagePipelineConfig): width, height, stack, skip, max-pool, crop-top, crop-bottom, crop-left,
 // crop-right, render-width, render-height, noop-start, time-limit; and rules of CarRacing's own
 // (CarRacingConfig): off-track and lap-ends, which the TD3 CarRacing article's pipeline changes,
-// and off-track-grace. Reward clipping is not a key: it is a training choice (the actor's
+// off-track-grace, and pedals (gas and brake as one axis: an action form, not a rule). Reward
+// clipping is not a key: it is a training choice (the actor's
 // --clip-rewards), and evaluations score unclipped returns.
 #pragma once
 
@@ -24,12 +25,14 @@ struct EnvIdParts {
   bool off_track = false;
   int off_track_grace = 0;  // CarRacingConfig::off_track_grace, with off-track only
   bool lap_ends = true;
+  bool pedals = false;  // CarRacingConfig::pedals, CarRacing-v3 only
 };
 
 /// Splits and parses an env id. Throws std::invalid_argument naming the problem: an unknown key,
-/// a value that is not an integer (0/1 for max-pool, off-track and lap-ends), a missing ")" or
-/// text after it, settings that ImagePipelineConfig::Validate() refuses, off-track or lap-ends
-/// changed for an env other than CarRacing, or an off-track-grace below 0 or without off-track.
+/// a value that is not an integer (0/1 for max-pool, off-track, lap-ends and pedals), a missing
+/// ")" or text after it, settings that ImagePipelineConfig::Validate() refuses, off-track or
+/// lap-ends changed for an env other than CarRacing, pedals for one other than CarRacing-v3, or
+/// an off-track-grace below 0 or without off-track.
 EnvIdParts ParseEnvId(const std::string& id);
 
 }  // namespace rl::envs

@@ -40,8 +40,14 @@ EnvSpec LunarLanderSpec(bool continuous) {
   return LookupSpec(continuous ? "LunarLanderContinuous-v3" : "LunarLander-v3");
 }
 
-EnvSpec CarRacingSpec(bool continuous) {
-  return LookupSpec(continuous ? "CarRacing-v3" : "CarRacingDiscrete-v3");
+EnvSpec CarRacingSpec(bool continuous, bool pedals) {
+  EnvSpec spec = LookupSpec(continuous ? "CarRacing-v3" : "CarRacingDiscrete-v3");
+  if (pedals) {
+    spec.action_dim = 2;
+    spec.action_low = {-1, -1};
+    spec.action_high = {1, 1};
+  }
+  return spec;
 }
 
 EnvSpec KukaDiverseObjectSpec(bool is_test, int max_steps, int width, int height) {
@@ -78,7 +84,10 @@ EnvSpec PixelSpec(const EnvSpec& inner, const ImagePipelineConfig& config) {
 
 EnvSpec LookupSpec(const std::string& id) {
   const EnvIdParts parts = ParseEnvId(id);
-  if (parts.pixels) return PixelSpec(LookupSpec(parts.base), parts.image);
+  if (parts.pixels) {
+    return PixelSpec(parts.pedals ? CarRacingSpec(true, true) : LookupSpec(parts.base),
+                     parts.image);
+  }
   for (const EnvSpec& spec : ListedSpecs()) {
     if (spec.id == id) return spec;
   }

@@ -22,7 +22,8 @@ EnvSpec PendulumSpec();
 EnvSpec LunarLanderSpec(bool continuous);
 /// CarRacing-v3 (continuous: steer [-1, 1], gas [0, 1], brake [0, 1]) or its discrete variant
 /// "CarRacingDiscrete-v3" (5 actions); observation 96 x 96 x 3 RGB / 255; native render 96 x 96.
-EnvSpec CarRacingSpec(bool continuous);
+/// With `pedals` (continuous only, CarRacingConfig::pedals): steer and pedal, both in [-1, 1].
+EnvSpec CarRacingSpec(bool continuous, bool pedals = false);
 /// The KUKA grasping envs: training objects or held-out test objects, with `max_steps` as the
 /// time limit and a native render size of width x height (the registered ids: 15 and 20 steps,
 /// 48 x 48).

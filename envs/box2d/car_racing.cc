@@ -178,6 +178,9 @@ void CarRacingConfig::Validate() const {
     throw std::invalid_argument("CarRacingConfig: off_track_after must be >= 0, got " +
                                 std::to_string(off_track_after));
   }
+  if (pedals && !continuous) {
+    throw std::invalid_argument("CarRacingConfig: pedals needs continuous actions");
+  }
   if (off_track_grace < 0) {
     throw std::invalid_argument("CarRacingConfig: off_track_grace must be >= 0, got " +
                                 std::to_string(off_track_grace));
@@ -187,7 +190,8 @@ void CarRacingConfig::Validate() const {
 double CarRacingCar::speed() const { return std::hypot(velocity.x, velocity.y); }
 
 CarRacing::CarRacing(const CarRacingConfig& config)
-    : SeededEnv(CarRacingSpec(config.continuous)), config_(config) {
+    : SeededEnv(CarRacingSpec(config.continuous, config.pedals && config.continuous)),
+      config_(config) {
   config_.Validate();
 }
 
@@ -389,8 +393,13 @@ StepResult CarRacing::Finish() {
 StepResult CarRacing::OnStep(std::span<const float> action) {
   if (config_.continuous) {
     const double steer = std::clamp(double{action[0]}, -1.0, 1.0);
-    const double brake = std::clamp(double{action[2]}, 0.0, 1.0);
-    Control(-steer, action[1], brake);
+    if (config_.pedals) {
+      const double pedal = std::clamp(double{action[1]}, -1.0, 1.0);
+      Control(-steer, std::max(pedal, 0.0), std::max(-pedal, 0.0));
+    } else {
+      const double brake = std::clamp(double{action[2]}, 0.0, 1.0);
+      Control(-steer, action[1], brake);
+    }
   } else {
     const int a = ActionIndex(action);
     Control(-0.6 * (a == 1) + 0.6 * (a == 2), 0.2 * (a == 3), 0.8 * (a == 4));
@@ -579,7 +588,8 @@ std::unique_ptr<Env> MakeCarRacing(const EnvIdParts& id, bool continuous) {
                                                      .lap_ends = id.lap_ends,
                                                      .off_track = id.off_track,
                                                      .off_track_after = id.image.noop_start,
-                                                     .off_track_grace = id.off_track_grace});
+                                                     .off_track_grace = id.off_track_grace,
+                                                     .pedals = id.pedals});
 }
 
 }  // namespace

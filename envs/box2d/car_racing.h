@@ -45,12 +45,16 @@ struct CarRacingConfig {
   // article's rule, at the first). Within them the step's reward is the usual one, so a policy
   // can learn to steer back onto the track, which the article's rule never shows it.
   int off_track_grace = 0;
+  // Gas and brake as one pedal (continuous only): actions [steer, pedal] in [-1, 1]^2, a pedal
+  // above 0 the gas and below it the brake, so that a policy cannot press both at once. The car,
+  // the rewards and the rules are the same; only the action's form changes.
+  bool pedals = false;
   // Point samples per pixel side of the 96 x 96 observation (4: 16 samples per pixel, see
   // car_racing_render.h). Larger renders use fewer, never more than one per surface pixel.
   int supersample = 4;
 
   /// Throws std::invalid_argument unless lap_complete_percent is in [0, 1], supersample in
-  /// [1, 8], and off_track_after and off_track_grace >= 0.
+  /// [1, 8], off_track_after and off_track_grace >= 0, and pedals with continuous actions.
   void Validate() const;
 };
 
@@ -82,6 +86,8 @@ struct CarRacingCar {
 /// Actions: continuous [steer in [-1, 1] (positive turns right), gas in [0, 1], brake in [0, 1]],
 /// clipped to those bounds (the reference clips only gas; the clip changes nothing the car does:
 /// the steering joint stops at +-0.4 rad, and a brake of 0.9 or more already locks the wheels).
+/// With config.pedals: [steer, pedal], both in [-1, 1]; a pedal p gives gas max(p, 0) and brake
+/// max(-p, 0).
 /// Discrete: 0 nothing, 1 steer right (-0.6 on the joint's target), 2 steer left (+0.6), 3 gas
 /// 0.2, 4 brake 0.8; each sets all three controls.
 ///

@@ -45,6 +45,8 @@ TEST(PixelSpecTest, ReadsEveryKey) {
   const EnvIdParts car = ParseEnvId("CarRacing-v3+pixels(off-track=1,lap-ends=0)");
   EXPECT_TRUE(car.off_track);
   EXPECT_FALSE(car.lap_ends);
+  EXPECT_FALSE(car.pedals);
+  EXPECT_TRUE(ParseEnvId("CarRacing-v3+pixels(pedals=1)").pedals);
 }
 
 TEST(PixelSpecTest, KeepsTheDefaultsOfKeysNotGiven) {
@@ -83,6 +85,11 @@ TEST(PixelSpecTest, RefusesBadSpecsWithTheReason) {
   EXPECT_NE(message("CarRacing-v3+pixels(off-track-grace=20)").find("with off-track=1"),
             std::string::npos);
   EXPECT_NE(message("CarRacing-v3+pixels(off-track=1,off-track-grace=-1)").find("frames >= 0"),
+            std::string::npos);
+  EXPECT_NE(message("CarRacing-v3+pixels(pedals=2)").find("pedals is 0 or 1"), std::string::npos);
+  EXPECT_NE(message("CarRacingDiscrete-v3+pixels(pedals=1)").find("pedals applies to CarRacing-v3"),
+            std::string::npos);
+  EXPECT_NE(message("Catch-v0+pixels(pedals=1)").find("pedals applies to CarRacing-v3"),
             std::string::npos);
 }
 

@@ -16,6 +16,7 @@
 #include "envs/image/image_source.h"
 #include "envs/pixel_spec.h"
 #include "envs/registry.h"
+#include "envs/specs.h"
 #include "envs/wrapper.h"
 #include "tests/envs/image_testing.h"
 
@@ -116,6 +117,37 @@ TEST(CarRacingTest, LockedBrakeStopsTheWheelsAndTheTyresSlipAtTheLimit) {
   }
   // Four tyres at the limit decelerate the car by about 4 * 400 / 7.3 * 0.02 = 4.4 m/s a step.
   EXPECT_NEAR(before - car.speed(), 4 * 400 / 7.3 * kDt, 0.6);
+}
+
+// With pedals, [steer, p] drives as [steer, max(p, 0), max(-p, 0)] does: the same car, state for
+// state, through gas, coasting and the brake.
+TEST(CarRacingTest, PedalsDriveAsGasAndBrakeOfTheSameSign) {
+  CarRacing three;
+  CarRacing pedals(CarRacingConfig{.pedals = true});
+  EXPECT_EQ(pedals.spec().action_dim, 2);
+  EXPECT_EQ(pedals.spec().action_low, (std::vector<float>{-1, -1}));
+  EXPECT_EQ(pedals.spec().action_high, (std::vector<float>{1, 1}));
+  three.Reset(6);
+  pedals.Reset(6);
+  const std::vector<std::array<float, 2>> plan = {{0, 1},    {0.3f, 0.6f}, {-0.5f, 0}, {0, -0.4f},
+                                                  {0.2f, 1}, {0, -1},      {-1, 0.8f}, {0, 2}};
+  for (int k = 0; k < 80; ++k) {
+    const auto [steer, pedal] = plan[k / 10];
+    const StepResult a = Drive(three, steer, std::max(pedal, 0.0f), std::max(-pedal, 0.0f));
+    const std::array<float, 2> pressed = {steer, pedal};
+    const StepResult b = pedals.Step(pressed);
+    ASSERT_EQ(a.reward, b.reward) << "step " << k;
+    ASSERT_EQ(a.terminated, b.terminated);
+    ASSERT_EQ(three.car().position.x, pedals.car().position.x) << "step " << k;
+    ASSERT_EQ(three.car().position.y, pedals.car().position.y);
+    ASSERT_EQ(three.car().speed(), pedals.car().speed());
+  }
+  EXPECT_GT(pedals.car().wheels[2].gas, 0.9);  // the last pedal, 2, clipped to full gas
+  EXPECT_EQ(pedals.car().wheels[2].brake, 0);
+  const std::array<float, 3> three_wide = {0, 0, 0};
+  EXPECT_THROW(pedals.Step(three_wide), std::invalid_argument);
+  EXPECT_THROW(CarRacing(CarRacingConfig{.continuous = false, .pedals = true}),
+               std::invalid_argument);
 }
 
 TEST(CarRacingTest, SteeringTurnsTheFrontWheelsToTheirStopsAndTheCarRight) {
@@ -302,6 +334,11 @@ TEST(CarRacingTest, EnvIdKeysSetTheRulesOfTheEnvUnderThePipeline) {
   EXPECT_EQ(car->config().off_track_grace, 0);
   EXPECT_FALSE(ParseEnvId("CarRacing-v3+pixels(skip=5)").off_track);
   EXPECT_EQ(ParseEnvId("CarRacing-v3+pixels(off-track=1,off-track-grace=50)").off_track_grace, 50);
+  EXPECT_FALSE(car->config().pedals);
+  const auto pedals = MakeEnv("CarRacing-v3+pixels(skip=5,pedals=1)");
+  EXPECT_EQ(pedals->spec().action_dim, 2);
+  EXPECT_TRUE(SameShape(pedals->spec(), LookupSpec("CarRacing-v3+pixels(skip=5,pedals=1)")));
+  EXPECT_FALSE(SameShape(pedals->spec(), LookupSpec("CarRacing-v3+pixels(skip=5)")));
 }
 
 TEST(CarRacingTest, ScriptedPilotCompletesLapsWithAHighScore) {
