@@ -64,6 +64,7 @@ EvalRecord Record(const std::string& path, const nn::CheckpointMeta& meta, const
   r.episodes = score.episodes;
   r.returns = score.returns;
   r.steps = score.steps;
+  r.action_mean = score.action_mean;
   r.eval_seconds = seconds;
   if (score.values) {
     r.value_steps = score.values->steps;

@@ -50,6 +50,7 @@ std::string ToJson(const EvalRecord& r) {
   }
   if (!r.returns.empty()) j["returns"] = r.returns;
   if (!r.steps.empty()) j["steps"] = r.steps;
+  if (!r.action_mean.empty()) j["action_mean"] = r.action_mean;
   return JsonLine(j);
 }
 
@@ -107,6 +108,7 @@ bool ParseJson(const std::string& line, EvalRecord* record) {
     }
     r.steps.push_back(static_cast<int>(steps));
   }
+  r.action_mean = JsonNumbersAt(*j, "action_mean").value_or(std::vector<double>{});
   *record = std::move(r);
   return true;
 }

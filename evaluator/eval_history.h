@@ -49,6 +49,10 @@ struct EvalRecord {
   // Each evaluation episode's env steps, in episode order: with the env's time limit, which
   // episodes ended early (a lap finished, a crash) and which ran out of time. Empty as above.
   std::vector<int> steps;
+  // Continuous actions: each component's mean over every step of the episodes, as the policy
+  // gave it (e.g. CarRacing's steer, gas and brake): what the policy does. Empty for discrete
+  // actions and in lines written before it was kept.
+  std::vector<double> action_mean;
 
   bool operator==(const EvalRecord&) const = default;
 };

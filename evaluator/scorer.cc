@@ -174,6 +174,9 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
 
   std::vector<double> returns;
   std::vector<int> steps;
+  const bool continuous = env->spec().continuous();
+  std::vector<double> action_sum(continuous ? action.size() : 0, 0.0);
+  int64_t total_steps = 0;
   returns.reserve(static_cast<size_t>(episodes));
   steps.reserve(static_cast<size_t>(episodes));
   for (int i = 0; i < episodes; ++i) {
@@ -188,6 +191,7 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
       const envs::StepResult step = env->Step(action);
       episode_return += step.reward;
       ++episode_steps;
+      for (size_t d = 0; d < action_sum.size(); ++d) action_sum[d] += action[d];
       if (value) {
         has_values = true;
         calibration.Step(*value, step.reward);
@@ -200,9 +204,13 @@ EvalScore Score(actor::Policy* policy, const std::string& env_id, int episodes, 
     }
     returns.push_back(episode_return);
     steps.push_back(episode_steps);
+    total_steps += episode_steps;
   }
   EvalScore score = Summarize(std::move(returns));
   score.steps = std::move(steps);
+  for (double sum : action_sum) {
+    score.action_mean.push_back(total_steps > 0 ? sum / static_cast<double>(total_steps) : 0.0);
+  }
   if (has_values) score.values = calibration.Result();
   return score;
 }

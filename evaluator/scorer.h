@@ -55,6 +55,9 @@ struct EvalScore {
   double max = 0;
   std::vector<double> returns;  // one per episode, in episode order
   std::vector<int> steps;       // each episode's env steps (Score() only), in episode order
+  // Continuous actions (Score() only): each component's mean over every step, as the policy gave
+  // it.
+  std::vector<double> action_mean;
   /// Set when the policy gave value estimates (a Q network's, see Policy::last_value) and some
   /// steps could be compared.
   std::optional<ValueCalibration> values;

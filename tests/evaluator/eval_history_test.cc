@@ -42,6 +42,7 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   // With the episodes' returns.
   d.returns = {-0.1, 912.5, 1.0 / 3.0};
   d.steps = {1, 200, 0};
+  d.action_mean = {0.25, -0.5, 0.125};
   // With an ensemble's score.
   EvalRecord e = Record("e.bin", 5000, 800.5);
   e.ensemble_size = 5;
@@ -61,6 +62,7 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   EXPECT_EQ(testing::CountOccurrences(text, "\"value_correlation\": null"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"returns\": [-0.1,912.5,"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"steps\": [1,200,0]"), 1);
+  EXPECT_EQ(testing::CountOccurrences(text, "\"action_mean\": [0.25,-0.5,0.125]"), 1);
   int skipped = -1;
   const std::vector<EvalRecord> back = LoadJsonLines(path, &skipped);
   EXPECT_EQ(skipped, 0);

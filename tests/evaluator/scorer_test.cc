@@ -89,6 +89,7 @@ TEST(ScorerTest, AConstantActionNetworkScoresAsTheSameEpisodesPlayedByHand) {
   EXPECT_LT(score.mean, 20.0);
   EXPECT_GT(score.mean, 5.0);
   EXPECT_LE(score.max, 20.0);
+  EXPECT_TRUE(score.action_mean.empty()) << "a discrete env's actions have no mean";
 }
 
 TEST(ScorerTest, TheSameSeedsGiveTheSameScore) {
@@ -279,6 +280,9 @@ TEST(ScorerTest, ScoresAContinuousActorWithItsDeterministicAction) {
   const float action[] = {0.6f, -0.4f};
   EXPECT_EQ(score.returns, ConstantActionReturns(action, 3, 40));
   EXPECT_FALSE(score.values.has_value());
+  ASSERT_EQ(score.action_mean.size(), 2U);
+  EXPECT_NEAR(score.action_mean[0], 0.6, 1e-6);
+  EXPECT_NEAR(score.action_mean[1], -0.4, 1e-6);
   // A Q-network's output size (4 actions) does not fit the 2 action dimensions.
   nn::Sequential q = nn::MakeMlp(8, {4}, 4, &rng);
   EXPECT_THROW(ScorePolicy(&q, kLander, 1, 0.05, 1), std::invalid_argument);
