@@ -215,7 +215,17 @@ int Main(int argc, char** argv) {
     if (vm.count("nice") > 0) scheduling.nice = rl::evaluator::CheckNice(nice);
     rl::evaluator::ApplyScheduling(scheduling);
   }
-  if (!eval_env.empty()) config.env_id = eval_env;
+  if (!eval_env.empty()) {
+    // A run's networks take its env's observations and actions: an eval-env of another shape
+    // (e.g. without CarRacing's pedals=1) could score none of its checkpoints.
+    if (!vm["env"].defaulted() &&
+        !rl::envs::SameShape(rl::envs::LookupSpec(config.env_id), rl::envs::LookupSpec(eval_env))) {
+      throw std::invalid_argument("eval-env " + eval_env +
+                                  " does not take the observations and actions of the run's env " +
+                                  config.env_id);
+    }
+    config.env_id = eval_env;
+  }
   if (rl::envs::LookupSpec(config.env_id).continuous()) {
     rl::RefuseGiven(vm, {"epsilon"},
                     config.env_id + " has continuous actions, scored without exploration");

@@ -78,6 +78,19 @@ learner_refuses "^learner: error: option --learning-rate does not apply: algorit
   --algorithm td3 --learning-rate 0.01
 learner_refuses "^learner: error: option --policy-delay does not apply: algorithm is dqn, and it is an option of td3$" \
   --policy-delay 3
+# The evaluator refuses an eval-env whose observations or actions are not the run's env's (one
+# line, exit 2, no folder): its networks could score none of the run's checkpoints.
+car="CarRacing-v3+pixels(skip=5,stack=2,off-track=1"
+set +e
+timeout 20 "$build_dir/bin/evaluator" --env "$car,pedals=1)" --eval-env "CarRacing-v3+pixels(skip=5,stack=2)" \
+  --out "$dir/eval" > "$dir/evaluator.log" 2>&1
+status=$?
+set -e
+[ "$status" -eq 2 ] || fail "the evaluator took an eval-env without the run's pedals ($status)"
+grep -q "^evaluator: error: eval-env CarRacing-v3+pixels(skip=5,stack=2) does not take the observations and actions of the run's env $car,pedals=1)$" \
+  "$dir/evaluator.log" || fail "the evaluator did not say why: $(cat "$dir/evaluator.log")"
+[ "$(wc -l < "$dir/evaluator.log")" -eq 1 ] || fail "the evaluator said more than one line"
+[ ! -e "$dir/eval" ] || fail "the refused evaluator made its folder"
 "$build_dir/bin/learner" --help > "$dir/learner-help.log"
 for section in "Options of dqn" "Options of td3"; do
   grep -q "^$section" "$dir/learner-help.log" || fail "the learner's help has no '$section'"
