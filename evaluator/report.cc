@@ -300,8 +300,8 @@ double Quantile(std::vector<double> values, double q) {
 
 // One row of the checkpoint table.
 std::string CheckpointRow(const EvalRecord& r, const Highlights& hl, const ReportInfo& info,
-                          double bar_scale, bool has_values, bool has_returns, bool has_second,
-                          bool has_ensemble) {
+                          double bar_scale, bool has_values, bool has_returns, bool has_actions,
+                          bool has_second, bool has_ensemble) {
   std::string cls;
   if (&r == hl.best) cls += "best";
   if (std::isfinite(info.goal) && r.mean >= info.goal) cls += cls.empty() ? "goal" : " goal";
@@ -324,6 +324,12 @@ std::string CheckpointRow(const EvalRecord& r, const Highlights& hl, const Repor
          (r.value_correlation ? Format("%.2f", *r.value_correlation) : "\xE2\x80\x94") + "</td>";
   } else if (has_values) {
     h += "<td></td><td></td><td></td>";
+  }
+  if (has_actions) {
+    std::string mean_action;
+    for (double a : r.action_mean)
+      mean_action += (mean_action.empty() ? "" : ", ") + Format("%.2f", a);
+    h += "<td>" + mean_action + "</td>";
   }
   if (has_second) {
     h += "<td>" +
@@ -368,6 +374,13 @@ std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Hig
          "below. A mean well under its median comes from a few failed episodes, a low median "
          "from a shortfall in most of them.</p>\n";
   }
+  const bool has_actions = std::any_of(records.begin(), records.end(),
+                                       [](const EvalRecord& r) { return !r.action_mean.empty(); });
+  if (has_actions) {
+    h += "<p>Mean action: each component of the action, in the env's order, averaged over every "
+         "step of the evaluation episodes (CarRacing: steer, gas and brake); what the policy "
+         "does.</p>\n";
+  }
   const bool has_second = !info.second_name.empty();
   if (has_second) {
     h +=
@@ -383,11 +396,13 @@ std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Hig
   if (has_returns) h += "<th>10 %</th><th>median</th>";
   h += "<th>max</th><th>episodes</th><th>eval time</th>";
   if (has_values) h += "<th>Q</th><th>G</th><th>r</th>";
+  if (has_actions) h += "<th>mean action</th>";
   if (has_second) h += "<th>second metric</th>";
   if (has_ensemble) h += "<th>ensemble</th>";
   h += "</tr></thead>\n<tbody>\n";
   for (const EvalRecord* r : rows) {
-    h += CheckpointRow(*r, hl, info, bar_scale, has_values, has_returns, has_second, has_ensemble);
+    h += CheckpointRow(*r, hl, info, bar_scale, has_values, has_returns, has_actions, has_second,
+                       has_ensemble);
   }
   return h + "</tbody>\n</table></div>\n</section>\n";
 }

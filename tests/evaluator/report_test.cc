@@ -120,6 +120,18 @@ TEST_F(ReportTest, ShowsTheTenthPercentileAndMedianOfTheReturnsOnlyWhenKept) {
   EXPECT_NE(html.find("a few failed episodes"), std::string::npos);
 }
 
+TEST_F(ReportTest, ShowsTheMeanActionOnlyWhenKept) {
+  const std::string report = dir_ / "report";
+  std::string html = WriteAndRead(report, {Record("a.bin", 1000, 450)}, Info(900));
+  EXPECT_EQ(html.find("<th>mean action</th>"), std::string::npos);
+  EvalRecord r = Record("b.bin", 2000, 715);
+  r.action_mean = {-0.051, 1.0, 0.1585};
+  html = WriteAndRead(report, {Record("a.bin", 1000, 450), r}, Info(900));
+  EXPECT_NE(html.find("<th>mean action</th>"), std::string::npos);
+  EXPECT_NE(html.find("<td>-0.05, 1.00, 0.16</td>"), std::string::npos) << html;
+  EXPECT_NE(html.find("steer, gas and brake"), std::string::npos);
+}
+
 TEST_F(ReportTest, ShowsTheBestEnsembleAndAnEnsembleColumnOnlyWhenScored) {
   std::vector<EvalRecord> records = {Record("a.bin", 1000, 20.0), Record("b.bin", 2000, 180.0),
                                      Record("c.bin", 3000, 90.0)};
