@@ -63,15 +63,16 @@ struct EvalRecord {
 /// "value_return" and "value_correlation" (null when unset), and when second_episodes > 0
 /// "second_mean", "second_std" and "second_episodes", when ensemble_size > 0 "ensemble_size",
 /// "ensemble_from", "ensemble_mean", "ensemble_std", "ensemble_min", "ensemble_max" and
-/// "ensemble_returns", and last, when there are any, "returns"
-/// and "steps" (arrays) (json_line.h: numbers in their shortest form that reads back exactly; a
-/// non-finite number is written as null).
+/// "ensemble_returns", and last, when there are any, "returns", "steps" and "action_mean"
+/// (arrays) (json_line.h: numbers in their shortest form that reads back exactly; a non-finite
+/// number is written as null).
 std::string ToJson(const EvalRecord& record);
 
 /// Parses one line written by ToJson (keys in any order, unknown keys ignored, whitespace
 /// allowed). Returns false, leaving *record unchanged, when the line is not such an object or
 /// lacks "checkpoint", "update" or "mean". "returns" that is not an array of numbers, or
-/// "steps" that is not one of whole numbers from 0, is read as none.
+/// "steps" that is not one of whole numbers from 0, or "action_mean" that is not an array of
+/// numbers, is read as none.
 bool ParseJson(const std::string& line, EvalRecord* record);
 
 /// Appends ToJson(record) and a newline to the file at `path` (created if missing), then
