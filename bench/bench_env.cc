@@ -2,10 +2,13 @@
 // CartPole-v1 (the same measurement as the PyTorch peer's "env_steps") and LunarLander-v3; for
 // CarRacing-v3: with every frame drawn at 96 x 96, without drawing, and through the TD3 preset's
 // image pipeline (action repeat 5, only the frame an agent sees drawn), in env frames per
-// second; and the scripted centre-line pilot's mean score over 100 tracks (the env is solvable).
+// second; and the scripted centre-line pilot's mean score over 100 tracks (the env is solvable),
+// also on the discrete variant, deciding every frame and every fifth.
 #include <array>
 #include <random>
+#include <span>
 #include <utility>
+#include <vector>
 
 #include "bench/bench_util.h"
 #include "envs/box2d/car_racing.h"
@@ -31,6 +34,43 @@ double CarRacingRate(rl::envs::Env& env, int frames_per_step, bool draw, double 
       double{chunk} * frames_per_step, seconds);
 }
 
+// The scripted pilot's mean return over 100 tracks (seeds 5000-5099), 1,000 frames at most: with
+// the continuous actions, or with the discrete variant's five (gas 0.2, and no action steers and
+// accelerates at once), deciding every `repeat` frames (the pixel presets' action repeat is 5).
+void PilotScore(bool discrete, int repeat, const char* name) {
+  std::vector<double> returns;
+  int laps = 0;
+  for (uint64_t seed = 5000; seed < 5100; ++seed) {
+    rl::envs::CarRacing car(rl::envs::CarRacingConfig{.continuous = !discrete});
+    rl::envs::CarRacingPilot pilot;
+    car.Reset(seed);
+    double total = 0;
+    std::array<float, 3> action{};  // [steer, gas, brake], or the discrete index in action[0]
+    const std::span<const float> taken = std::span<const float>(action).first(discrete ? 1 : 3);
+    for (int frame = 0; frame < 1000; ++frame) {
+      if (frame % repeat == 0) {
+        if (discrete) {
+          action[0] = static_cast<float>(pilot.ActDiscrete(car));
+        } else {
+          action = pilot.Act(car);
+        }
+      }
+      const auto r = car.Step(taken);
+      total += r.reward;
+      if (r.terminated) break;
+    }
+    laps += car.lap_finished();
+    returns.push_back(total);
+  }
+  double mean = 0;
+  for (double r : returns) mean += r / returns.size();
+  const rl::bench::Summary s = rl::bench::Summarize(returns);
+  std::printf(
+      "{\"bench\": \"%s\", \"value\": %.1f, \"unit\": \"return\", \"min\": %.1f, "
+      "\"median\": %.1f, \"max\": %.1f, \"episodes\": 100, \"laps\": %d, \"repeat\": %d}\n",
+      name, mean, s.min, s.median, s.max, laps, repeat);
+}
+
 void BenchCarRacing(int repeats, double seconds) {
   std::mt19937_64 rng(0);
   auto env = rl::envs::MakeEnv("CarRacing-v3");
@@ -52,29 +92,9 @@ void BenchCarRacing(int repeats, double seconds) {
       rl::bench::Repeat(repeats, [&] { return CarRacingRate(*pixels, 5, true, seconds, rng); }),
       repeats, "\"frames_drawn\": \"1 in 5\", \"observation\": \"4x84x84\"");
 
-  // The scripted pilot: mean return over 100 tracks (seeds 5000-5099), 1,000 frames at most.
-  std::vector<double> returns;
-  int laps = 0;
-  for (uint64_t seed = 5000; seed < 5100; ++seed) {
-    rl::envs::CarRacing car;
-    rl::envs::CarRacingPilot pilot;
-    car.Reset(seed);
-    double total = 0;
-    for (int frame = 0; frame < 1000; ++frame) {
-      const auto r = car.Step(pilot.Act(car));
-      total += r.reward;
-      if (r.terminated) break;
-    }
-    laps += car.lap_finished();
-    returns.push_back(total);
-  }
-  double mean = 0;
-  for (double r : returns) mean += r / returns.size();
-  const rl::bench::Summary s = rl::bench::Summarize(returns);
-  std::printf(
-      "{\"bench\": \"car_racing_pilot_score\", \"value\": %.1f, \"unit\": \"return\", "
-      "\"min\": %.1f, \"median\": %.1f, \"max\": %.1f, \"episodes\": 100, \"laps\": %d}\n",
-      mean, s.min, s.median, s.max, laps);
+  PilotScore(/*discrete=*/false, 1, "car_racing_pilot_score");
+  PilotScore(/*discrete=*/true, 1, "car_racing_discrete_pilot_score");
+  PilotScore(/*discrete=*/true, 5, "car_racing_discrete_pilot_score");
 }
 
 }  // namespace

