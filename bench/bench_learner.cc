@@ -186,7 +186,8 @@ int main(int argc, char** argv) {
       {"td3_car", car_spec, "car", 128, 2.5e-4f, 1e-3f, 0.05f, true},
       // The car_racing_td3 preset: the article's encoder shared, DrQ-v2 heads of 256.
       {"td3_car_drq", car_spec, "drq", 128, 2.5e-4f, 1e-3f, 0.05f, true},
-      // As configs/car_racing_td3.ini trains it: batch 64, rates 3e-4, tau 0.01, 2 threads.
+      // As configs/car_racing_td3.ini trains it: batch 64, rates 3e-4, tau 0.01, 2 threads
+      // (with 3 actions: the preset's pedals=1 drives 2, one output of the heads fewer).
       {"td3_car_preset", car_spec, "drq", 64, 3e-4f, 3e-4f, 0.01f, true, 1},
       {"td3_car_preset", car_spec, "drq", 64, 3e-4f, 3e-4f, 0.01f, true, 2},
   };

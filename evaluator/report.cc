@@ -378,8 +378,8 @@ std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Hig
                                        [](const EvalRecord& r) { return !r.action_mean.empty(); });
   if (has_actions) {
     h += "<p>Mean action: each component of the action, in the env's order, averaged over every "
-         "step of the evaluation episodes (CarRacing: steer, gas and brake); what the policy "
-         "does.</p>\n";
+         "step of the evaluation episodes (CarRacing: steer, gas and brake; with pedals=1 steer "
+         "and the pedal, gas above 0, brake below); what the policy does.</p>\n";
   }
   const bool has_second = !info.second_name.empty();
   if (has_second) {

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The whole pipeline on CarRacing from pixels with TD3 (the car_racing_td3 preset: the TD3
-# article's image pipeline with its off-track rule in training, its CNNs, float actions of three
-# dimensions over LCM) for a bounded time: frames stored, nothing lost or dropped, and the
-# evaluator scoring checkpoints on the unmodified environment (no no-op start, no off-track rule,
-# every frame's reward) and new best ones on the article's rules as well. Learning CarRacing takes
+# article's image pipeline with its off-track rule in training, its CNNs, float actions of two
+# dimensions, steer and pedal, over LCM) for a bounded time: frames stored, nothing lost or
+# dropped, and the evaluator scoring checkpoints on the unmodified environment (no no-op start,
+# no off-track rule, every frame's reward; the one pedal is the preset's action form) and new
+# best ones on the article's rules as well. Learning CarRacing takes
 # hours; this test checks the plumbing, and that it kept working to the end of the budget: a run
 # that stalled and sat out its time fails, since the replay's inserts and the learner's updates
 # must grow over the second half of the run, and the evaluator must score a checkpoint made then.
@@ -26,7 +27,7 @@ grep -q "TD3" "$dir/run/logs/learner.log" || fail "the learner did not run TD3"
 expect_clean_pixel_replay "$dir/run"
 # The evaluator scored checkpoints, on the env without the training pipeline's changes.
 [ -s "$dir/run/eval.jsonl" ] || fail "the evaluator scored no checkpoint"
-grep -q 'CarRacing-v3+pixels(skip=5,max-pool=0,crop-bottom=12,crop-left=6,crop-right=6,width=0,height=0,stack=4)' \
+grep -q 'CarRacing-v3+pixels(skip=5,max-pool=0,crop-bottom=12,crop-left=6,crop-right=6,width=0,height=0,stack=4,pedals=1)' \
   "$dir/run/logs/evaluator.log" "$dir/run/report/index.html" ||
   fail "the evaluator did not name the unmodified env"
 if grep -q 'off-track=1' "$dir/run/logs/evaluator.log"; then fail "the evaluator used the off-track rule"; fi
