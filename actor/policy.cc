@@ -106,6 +106,12 @@ std::string Policy::CheckNetwork(const nn::Sequential& net) const {
     if (!why.empty()) why += "; ";
     why += "network output size " + std::to_string(net.OutputSize()) + " does not match " +
            spec_.id + "'s " + std::to_string(outputs) + " " + what;
+    // CarRacing's two action forms differ by the env string alone: name the option.
+    if (spec_.id == "CarRacing-v3" && net.OutputSize() == 3) {
+      why += " (a network for gas and brake as two actions: drop pedals=1 from the env)";
+    } else if (spec_.id == "CarRacing-v3" && net.OutputSize() == 2) {
+      why += " (a network for steer and one pedal: add pedals=1 to the env)";
+    }
   }
   return why;
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -121,6 +122,21 @@ TEST(PolicyTest, RefusesMismatchedExplorationAndNetworks) {
   EXPECT_TRUE(policy->CheckNetwork(ConstantNet(3, {0.0f})).empty());
   EXPECT_THROW(policy->SetNetwork(ConstantNet(4, {0.0f})), std::invalid_argument);
   EXPECT_FALSE(policy->has_network());
+}
+
+TEST(PolicyTest, CarRacingMismatchNamesThePedalsOption) {
+  // A checkpoint of one action form scored with the other's env string: the error says which.
+  const envs::EnvSpec two_pedals = envs::CarRacingSpec(true);
+  const envs::EnvSpec one_pedal = envs::CarRacingSpec(true, /*pedals=*/true);
+  const int in = two_pedals.observation_size;
+  const std::string old_net =
+      MakePolicy(one_pedal, Gaussian(0.1), 0, 1, 1)->CheckNetwork(ConstantNet(in, {0, 0, 0}));
+  EXPECT_NE(old_net.find("drop pedals=1"), std::string::npos) << old_net;
+  const std::string new_net =
+      MakePolicy(two_pedals, Gaussian(0.1), 0, 1, 1)->CheckNetwork(ConstantNet(in, {0, 0}));
+  EXPECT_NE(new_net.find("add pedals=1"), std::string::npos) << new_net;
+  EXPECT_TRUE(
+      MakePolicy(one_pedal, Gaussian(0.1), 0, 1, 1)->CheckNetwork(ConstantNet(in, {0, 0})).empty());
 }
 
 }  // namespace
