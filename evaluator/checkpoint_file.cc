@@ -125,6 +125,45 @@ EvalRecord ScoreEnsemble(const std::vector<nn::Checkpoint>& ckpts,
   return Record(paths.front(), ckpts.front().meta, score, MonoSeconds() - start);
 }
 
+nn::Checkpoint AverageCheckpoints(const std::vector<nn::Checkpoint>& ckpts,
+                                  const std::vector<std::string>& paths) {
+  if (ckpts.empty()) throw std::invalid_argument("an average needs at least one checkpoint");
+  if (paths.size() != ckpts.size()) {
+    throw std::invalid_argument("an average needs a path for each checkpoint");
+  }
+  const nn::Checkpoint& newest = ckpts.front();
+  std::vector<double> sum(newest.params.begin(), newest.params.end());
+  for (size_t k = 1; k < ckpts.size(); ++k) {
+    const nn::Checkpoint& c = ckpts[k];
+    if (c.architecture != newest.architecture || c.params.size() != newest.params.size()) {
+      throw std::runtime_error(paths[k] + " is another network than " + paths[0] +
+                               " (architecture '" + c.architecture + "', " +
+                               std::to_string(c.params.size()) + " parameters): no average");
+    }
+    if (c.meta.run_id != newest.meta.run_id) {
+      throw std::runtime_error(paths[k] + " is of run " + std::to_string(c.meta.run_id) + ", not " +
+                               std::to_string(newest.meta.run_id) + ": no average");
+    }
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += c.params[i];
+  }
+  nn::Checkpoint average = newest;
+  const double n = static_cast<double>(ckpts.size());
+  for (size_t i = 0; i < sum.size(); ++i) average.params[i] = static_cast<float>(sum[i] / n);
+  average.meta.note = "The mean weights of " + std::to_string(ckpts.size()) +
+                      " checkpoints, updates " + std::to_string(ckpts.back().meta.update) + " to " +
+                      std::to_string(newest.meta.update) + ".\n" + newest.meta.note;
+  return average;
+}
+
+EvalRecord ScoreAverage(const std::vector<nn::Checkpoint>& ckpts,
+                        const std::vector<std::string>& paths, const std::string& env_id,
+                        int episodes, double epsilon, uint64_t first_seed, double gamma,
+                        const Tick& tick) {
+  const nn::Checkpoint average = AverageCheckpoints(ckpts, paths);  // throws before front()
+  return ScoreCheckpoint(average, paths.front(), env_id, episodes, epsilon, first_seed, gamma,
+                         tick);
+}
+
 EvalRecord ScoreEnsembleFiles(const std::vector<std::string>& paths, const std::string& env_id,
                               int episodes, uint64_t first_seed, double gamma) {
   std::vector<nn::Checkpoint> ckpts;

@@ -58,6 +58,23 @@ EvalRecord ScoreEnsemble(const std::vector<nn::Checkpoint>& ckpts,
                          int episodes, uint64_t first_seed, double gamma = kDefaultGamma,
                          const Tick& tick = {});
 
+/// The checkpoint whose parameters are the mean of the loaded checkpoints' `ckpts`, read from
+/// `paths` (their weights averaged, as stochastic weight averaging averages the weights along
+/// one run): the architecture and metadata of ckpts[0] (EnsembleFiles' newest), its note after
+/// a line naming the members' updates. Throws std::invalid_argument for no checkpoint or as many
+/// paths as checkpoints, and std::runtime_error naming the path of a member of another
+/// architecture or run, or with another parameter count.
+nn::Checkpoint AverageCheckpoints(const std::vector<nn::Checkpoint>& ckpts,
+                                  const std::vector<std::string>& paths);
+
+/// Scores the network of AverageCheckpoints(ckpts, paths) as ScoreCheckpoint scores one (any
+/// env: discrete ones with `epsilon`): the record names paths[0] and has its metadata. Throws
+/// as AverageCheckpoints and PolicyNetwork. `tick` as in ScorePolicy.
+EvalRecord ScoreAverage(const std::vector<nn::Checkpoint>& ckpts,
+                        const std::vector<std::string>& paths, const std::string& env_id,
+                        int episodes, double epsilon, uint64_t first_seed,
+                        double gamma = kDefaultGamma, const Tick& tick = {});
+
 /// Loads the checkpoint files `paths` and scores their mean action (ScoreEnsemble). Throws
 /// std::runtime_error as ScoreCheckpointFile for any of the files, std::invalid_argument as
 /// ScoreEnsemble.

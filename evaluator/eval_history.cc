@@ -41,6 +41,7 @@ std::string ToJson(const EvalRecord& r) {
   }
   if (r.ensemble_size > 0) {
     j["ensemble_size"] = r.ensemble_size;
+    j["ensemble_by"] = r.ensemble_by;
     j["ensemble_from"] = r.ensemble_from;
     j["ensemble_mean"] = r.ensemble_mean;
     j["ensemble_std"] = r.ensemble_std;
@@ -91,6 +92,9 @@ bool ParseJson(const std::string& line, EvalRecord* record) {
   r.ensemble_size = static_cast<int>(integer("ensemble_size"));
   const std::optional<double> ensemble_mean = JsonNumberAt(*j, "ensemble_mean");
   if (r.ensemble_size > 0 && ensemble_mean) {
+    // Lines from before averages of weights were scored are ensembles of actions.
+    r.ensemble_by = JsonStringAt(*j, "ensemble_by").value_or("actions");
+    if (r.ensemble_by != "weights") r.ensemble_by = "actions";
     r.ensemble_from = integer("ensemble_from");
     r.ensemble_mean = *ensemble_mean;
     r.ensemble_std = number("ensemble_std", 0);

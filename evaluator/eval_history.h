@@ -10,6 +10,10 @@
 
 namespace rl::evaluator {
 
+/// The file of the run's folder that keeps the network of the best average of weights
+/// (EvaluatorConfig::ensemble_by "weights"): a checkpoint file like the learner's.
+inline constexpr char kBestAverageFile[] = "best-average.bin";
+
 /// The score of one checkpoint.
 struct EvalRecord {
   std::string checkpoint;   // file name of the checkpoint (no directory)
@@ -36,7 +40,9 @@ struct EvalRecord {
   // The mean action of this checkpoint and the ensemble_size - 1 checkpoints before it in the
   // run's folder (EvaluatorConfig::ensemble), the oldest at update ensemble_from, scored on the
   // same episodes as the checkpoint; ensemble_size 0: not scored.
+  // ensemble_by "weights": instead the network of their mean weights (AverageCheckpoints).
   int ensemble_size = 0;
+  std::string ensemble_by;  // "actions" or "weights" when ensemble_size > 0
   int64_t ensemble_from = 0;
   double ensemble_mean = 0;
   double ensemble_std = 0;
@@ -62,6 +68,7 @@ struct EvalRecord {
 /// "eval_seconds": ...}, and when value_steps > 0 also "value_steps", "value_estimate",
 /// "value_return" and "value_correlation" (null when unset), and when second_episodes > 0
 /// "second_mean", "second_std" and "second_episodes", when ensemble_size > 0 "ensemble_size",
+/// "ensemble_by",
 /// "ensemble_from", "ensemble_mean", "ensemble_std", "ensemble_min", "ensemble_max" and
 /// "ensemble_returns", and last, when there are any, "returns", "steps" and "action_mean"
 /// (arrays) (json_line.h: numbers in their shortest form that reads back exactly; a non-finite

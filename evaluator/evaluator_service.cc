@@ -65,10 +65,12 @@ ReportInfo RunReportInfo(const EvaluatorConfig& c, int64_t run_id) {
                                           : " with epsilon " + FormatDouble("%g", c.epsilon)) +
                        "; returns G are discounted with gamma " + FormatDouble("%g", c.gamma) + ".";
   if (c.ensemble > 1) {
+    const bool weights = c.ensemble_by == "weights";
     info.eval_settings +=
-        " An ensemble of " + std::to_string(c.ensemble) +
-        " is the mean action of a checkpoint and the " + std::to_string(c.ensemble - 1) +
-        " before it, scored on the same episodes" +
+        std::string(weights ? " An average of " : " An ensemble of ") + std::to_string(c.ensemble) +
+        (weights ? " is the network whose weights are the mean of a checkpoint's and the "
+                 : " is the mean action of a checkpoint and the ") +
+        std::to_string(c.ensemble - 1) + " before it, scored on the same episodes" +
         (std::isfinite(c.ensemble_min_mean) ? " for checkpoints whose own mean is at least " +
                                                   FormatDouble("%g", c.ensemble_min_mean)
                                             : std::string()) +
@@ -149,9 +151,16 @@ void EvaluatorConfig::Validate() const {
     throw std::invalid_argument("ensemble must be at least 1 (1: no ensembles), got " +
                                 std::to_string(ensemble));
   }
-  if (ensemble > 1 && !envs::LookupSpec(env_id).continuous()) {
-    throw std::invalid_argument("ensemble needs continuous actions (the members' mean action); " +
-                                env_id + " has discrete ones");
+  if (ensemble_by != "actions" && ensemble_by != "weights") {
+    throw std::invalid_argument(
+        "ensemble-by must be 'actions' (the mean action) or 'weights' "
+        "(the mean weights), got '" +
+        ensemble_by + "'");
+  }
+  if (ensemble > 1 && ensemble_by == "actions" && !envs::LookupSpec(env_id).continuous()) {
+    throw std::invalid_argument(
+        "ensemble by actions needs continuous actions (the members' mean action); " + env_id +
+        " has discrete ones (ensemble-by = weights averages the networks instead)");
   }
   if (std::isnan(ensemble_min_mean)) throw std::invalid_argument("ensemble-min-mean is NaN");
   if (backlog < 0) {
@@ -335,8 +344,15 @@ void EvaluatorService::ScoreEnsembleIfDue(const nn::Checkpoint& ckpt, const std:
                                  std::to_string(ckpt.meta.run_id));
       }
     }
-    ensemble = ScoreEnsemble(members, paths, config_.env_id, config_.episodes, config_.seed_base,
-                             config_.gamma, [this] { Tick(); });
+    if (config_.ensemble_by == "weights") {
+      const nn::Checkpoint average = AverageCheckpoints(members, paths);
+      ensemble = ScoreCheckpoint(average, path, config_.env_id, config_.episodes, config_.epsilon,
+                                 config_.seed_base, config_.gamma, [this] { Tick(); });
+      KeepAverageIfBest(average, ensemble.mean);
+    } else {
+      ensemble = ScoreEnsemble(members, paths, config_.env_id, config_.episodes, config_.seed_base,
+                               config_.gamma, [this] { Tick(); });
+    }
     oldest = members.back().meta.update;
   } catch (const Interrupted&) {
     return;
@@ -346,6 +362,7 @@ void EvaluatorService::ScoreEnsembleIfDue(const nn::Checkpoint& ckpt, const std:
     return;
   }
   record->ensemble_size = config_.ensemble;
+  record->ensemble_by = config_.ensemble_by;
   record->ensemble_from = oldest;
   record->ensemble_mean = ensemble.mean;
   record->ensemble_std = ensemble.std;
@@ -353,11 +370,25 @@ void EvaluatorService::ScoreEnsembleIfDue(const nn::Checkpoint& ckpt, const std:
   record->ensemble_max = ensemble.max;
   record->ensemble_returns = ensemble.returns;
   log_(
-      "evaluator: update %lld: ensemble of %d (updates %lld to %lld): mean %.2f \xC2\xB1 %.1f "
+      "evaluator: update %lld: %s of %d (updates %lld to %lld): mean %.2f \xC2\xB1 %.1f "
       "(min %g, max %g, %.2f s)\n",
-      static_cast<long long>(record->update), config_.ensemble,
+      static_cast<long long>(record->update),
+      config_.ensemble_by == "weights" ? "average" : "ensemble", config_.ensemble,
       static_cast<long long>(record->ensemble_from), static_cast<long long>(record->update),
       ensemble.mean, ensemble.std, ensemble.min, ensemble.max, ensemble.eval_seconds);
+}
+
+void EvaluatorService::KeepAverageIfBest(const nn::Checkpoint& average, double mean) {
+  if (config_.out_dir.empty()) return;
+  for (const EvalRecord& r : history_.records()) {
+    if (r.ensemble_size > 0 && r.ensemble_by == "weights" && r.ensemble_mean >= mean) return;
+  }
+  const std::string file = (std::filesystem::path(config_.out_dir) / kBestAverageFile).string();
+  try {
+    nn::SaveCheckpoint(file, average);
+  } catch (const std::exception& e) {
+    LogError(e.what());
+  }
 }
 
 bool EvaluatorService::PassesScreen(const nn::Checkpoint& ckpt,

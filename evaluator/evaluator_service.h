@@ -80,11 +80,16 @@ struct EvaluatorConfig {
   int screen_episodes = 0;
   double screen_margin = 0;
   int screen_max_rejects = 3;
-  // Continuous envs: after its own score, a checkpoint is also scored as an ensemble, the mean
-  // action of it and the ensemble - 1 checkpoints before it in the run's checkpoint folder, on
+  // After its own score, a checkpoint is also scored as an ensemble of it and the ensemble - 1
+  // checkpoints before it in the run's checkpoint folder: by default (ensemble_by "actions",
+  // continuous envs) their mean action, on
   // the same episodes (eval.jsonl's ensemble_* fields, a second curve in the report); only when
   // its own mean is at least ensemble_min_mean and those checkpoints are there. 1: no ensembles.
+  // "weights" (any env): the ensemble is instead the one network whose weights are the mean of
+  // those checkpoints' (AverageCheckpoints), scored as a checkpoint is; the best such network
+  // is kept as <out_dir>/best-average.bin, a checkpoint file like the learner's.
   int ensemble = 1;
+  std::string ensemble_by = "actions";
   double ensemble_min_mean = -std::numeric_limits<double>::infinity();
   // Checkpoints superseded by a newer one before their turn (scoring is slower than the
   // learner, or busy with a second metric, a video or a map) wait, up to this many, and are
@@ -177,10 +182,14 @@ class EvaluatorService {
   bool ScoreAnnounced(const rlmsg::checkpoint_t& announced);
   // With config.ensemble > 1 and the record's mean at ensemble_min_mean or more, scores the
   // ensemble of the checkpoint `ckpt` (read from `path`) and the ones before it into the
-  // record's ensemble_* fields and prints a progress line. Too few checkpoints before it, a file
+  // record's ensemble_* fields (an average of weights: and keeps it when it is the best average
+  // so far) and prints a progress line. Too few checkpoints before it, a file
   // that does not load or is of another run, and a stop request leave the record as it is; the
   // first two are logged. Throws Interrupted only through `tick` (caught here).
   void ScoreEnsembleIfDue(const nn::Checkpoint& ckpt, const std::string& path, EvalRecord* record);
+  // Writes `average` (scored `mean`) to <out_dir>/kBestAverageFile, atomically, when no average
+  // of the history scored as much; a failure to write is logged, nothing else.
+  void KeepAverageIfBest(const nn::Checkpoint& average, double mean);
   // Whether the checkpoint earns its full evaluation: true without a screen (screen_episodes 0,
   // no best yet, or screen_max_rejects failures in a row), else whether the mean of its first
   // screen_episodes episodes reaches the best full mean less screen_margin. A failure is counted

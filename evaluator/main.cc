@@ -34,7 +34,8 @@ constexpr char kUsage[] =
     "      SIGTERM, or with --stop-at-goal once a checkpoint reaches the goal, and then prints\n"
     "      'evaluator: goal reached' or 'evaluator: goal not reached (best X)'; exit status 0.\n"
     "  evaluator --checkpoint FILE [--env ID] [--episodes N] [--epsilon E] [--noise S]\n"
-    "            [--ensemble K] [--seed-base S] [--gamma G] [--frames PNG]\n"
+    "            [--ensemble K [--ensemble-by weights [--save-average OUT]]]\n"
+    "            [--seed-base S] [--gamma G] [--frames PNG]\n"
     "            [--tsne-map PNG [--tsne N]]\n"
     "      Standalone mode: scores one checkpoint file and prints one JSON object (checkpoint,\n"
     "      update, env_steps, wall_seconds, mean, std, min, max, episodes, eval_seconds,\n"
@@ -46,7 +47,10 @@ constexpr char kUsage[] =
     "      compare the two; the standard metric is without noise.\n"
     "      --ensemble K (continuous actions) scores the mean action of FILE and the K - 1\n"
     "      checkpoints before it in its folder (the learner's ckpt-<update>.bin files); only\n"
-    "      on the command line: a --config file's ensemble is the service's.\n"
+    "      on the command line: a --config file's ensemble is the service's. With\n"
+    "      --ensemble-by weights (any env) it scores instead the one network whose weights are\n"
+    "      the mean of those checkpoints', and --save-average writes that network to OUT, a\n"
+    "      checkpoint file like the learner's.\n"
     "      --frames also writes the grid of camera frames the report shows (pixel envs),\n"
     "      --tsne-map the t-SNE map of its last hidden layer (pixel envs; N states, 2000 by\n"
     "      default).\n"
@@ -103,6 +107,7 @@ int Main(int argc, char** argv) {
   std::string eval_env;
   std::string frames_file;
   std::string tsne_file;
+  std::string average_file;
   double noise_sigma = 0;
   std::string sched_policy;
   int nice = 0;
@@ -131,6 +136,13 @@ int Main(int argc, char** argv) {
        "before it in its folder, an ensemble of K networks (standalone mode: instead of the "
        "checkpoint alone; service mode: after each checkpoint's own score, on the same "
        "episodes, in eval.jsonl and the report beside it); 1: none")  //
+      ("ensemble-by", rl::po::value(&config.ensemble_by)->default_value(config.ensemble_by),
+       "what an ensemble averages: 'actions' (continuous actions: the members' mean action, "
+       "each network run every step) or 'weights' (any env: one network, the mean of the "
+       "members' weights; service mode keeps the best as DIR/best-average.bin)")  //
+      ("save-average", rl::po::value(&average_file),
+       "standalone mode, with --ensemble K --ensemble-by weights: also write the averaged "
+       "network to this checkpoint file")  //
       ("ensemble-min-mean", rl::po::value(&config.ensemble_min_mean),
        "service mode: score a checkpoint's ensemble only when its own mean is at least this "
        "(default: every checkpoint's)")  //
@@ -242,7 +254,11 @@ int Main(int argc, char** argv) {
   }
   if (standalone_ensemble) {
     rl::RefuseGiven(vm, {"noise", "frames", "tsne-map"},
-                    "not with --ensemble, which scores the mean action of several networks");
+                    "not with --ensemble, which scores several networks as one");
+  }
+  if (!average_file.empty() && (!standalone_ensemble || config.ensemble_by != "weights")) {
+    throw std::invalid_argument(
+        "--save-average needs --checkpoint, --ensemble K and --ensemble-by weights");
   }
   if (!(noise_sigma >= 0 && std::isfinite(noise_sigma))) {
     throw std::invalid_argument("--noise must be finite and >= 0");
@@ -257,10 +273,24 @@ int Main(int argc, char** argv) {
     for (const std::string& f : files) {
       names += (names.empty() ? "" : ", ") + std::filesystem::path(f).filename().string();
     }
-    std::fprintf(stderr, "evaluator: the mean action of %d checkpoints: %s\n", config.ensemble,
-                 names.c_str());
-    rl::evaluator::EvalRecord record = rl::evaluator::ScoreEnsembleFiles(
-        files, config.env_id, config.episodes, config.seed_base, config.gamma);
+    const bool weights = config.ensemble_by == "weights";
+    std::fprintf(stderr, "evaluator: the mean %s of %d checkpoints: %s\n",
+                 weights ? "weights" : "action", config.ensemble, names.c_str());
+    rl::evaluator::EvalRecord record;
+    if (weights) {
+      std::vector<rl::nn::Checkpoint> members;
+      for (const std::string& f : files) members.push_back(rl::nn::LoadCheckpoint(f));
+      const rl::nn::Checkpoint average = rl::evaluator::AverageCheckpoints(members, files);
+      record = rl::evaluator::ScoreCheckpoint(average, checkpoint, config.env_id, config.episodes,
+                                              config.epsilon, config.seed_base, config.gamma);
+      if (!average_file.empty()) {
+        rl::nn::SaveCheckpoint(average_file, average);
+        std::fprintf(stderr, "evaluator: wrote the averaged network to %s\n", average_file.c_str());
+      }
+    } else {
+      record = rl::evaluator::ScoreEnsembleFiles(files, config.env_id, config.episodes,
+                                                 config.seed_base, config.gamma);
+    }
     record.checkpoint = checkpoint;
     std::cout << rl::evaluator::ToJson(record) << std::endl;
     return 0;

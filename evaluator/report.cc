@@ -92,8 +92,14 @@ Highlights FindHighlights(const std::vector<EvalRecord>& records, double goal) {
   return h;
 }
 
+// "ensemble" or, for an average of weights (EvaluatorConfig::ensemble_by), "average".
+std::string EnsembleWord(const EvalRecord& r) {
+  return r.ensemble_by == "weights" ? "average" : "ensemble";
+}
+
 // curve_env_steps.svg and curve_wall_time.svg, with the ensembles' means as a second line named
-// by the size of the last record's ensemble ("ensemble of 5") when some record has one.
+// by the kind and size of the last record's ensemble ("ensemble of 5", "average of 5") when some
+// record has one.
 void WriteLearningCurves(const std::string& dir, const std::vector<EvalRecord>& records,
                          double goal) {
   std::vector<CurvePoint> by_steps, by_time;
@@ -102,7 +108,7 @@ void WriteLearningCurves(const std::string& dir, const std::vector<EvalRecord>& 
     by_steps.push_back({static_cast<double>(r.env_steps), r.mean, r.std, r.min, r.max});
     by_time.push_back({r.wall_seconds, r.mean, r.std, r.min, r.max});
     if (r.ensemble_size > 0) {
-      ensembles_by_steps.label = "ensemble of " + std::to_string(r.ensemble_size);
+      ensembles_by_steps.label = EnsembleWord(r) + " of " + std::to_string(r.ensemble_size);
       ensembles_by_steps.points.push_back({static_cast<double>(r.env_steps), r.ensemble_mean});
       ensembles_by_time.points.push_back({r.wall_seconds, r.ensemble_mean});
     }
@@ -215,12 +221,15 @@ std::string SummarySection(const Highlights& hl, const ReportInfo& info) {
   }
   if (hl.ensemble != nullptr) {
     const EvalRecord& e = *hl.ensemble;
-    h += "</div>\n<div class=\"card\"><div class=\"label\">Best ensemble</div>";
+    const bool weights = e.ensemble_by == "weights";
+    h += "</div>\n<div class=\"card\"><div class=\"label\">Best " + EnsembleWord(e) + "</div>";
     h += "<div class=\"value\">" + Score(e.ensemble_mean) + " <small>\xC2\xB1 " +
-         Score(e.ensemble_std) + "</small></div><div class=\"detail\">the mean action of " +
+         Score(e.ensemble_std) + "</small></div><div class=\"detail\">" +
+         (weights ? "the mean weights of " : "the mean action of ") +
          std::to_string(e.ensemble_size) + " checkpoints, updates " + Thousands(e.ensemble_from) +
          " to " + Thousands(e.update) + " (" + Thousands(e.env_steps) + " env steps, " +
-         Duration(e.wall_seconds) + ")</div>";
+         Duration(e.wall_seconds) + ")" +
+         (weights ? std::string("; kept as ") + kBestAverageFile : std::string()) + "</div>";
   }
   h += "</div>\n<div class=\"card\"><div class=\"label\">Latest checkpoint</div>";
   if (hl.latest != nullptr) {
@@ -387,7 +396,10 @@ std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Hig
         "<p>Second metric (new best checkpoints only): " + HtmlEscape(info.second_name) + ".</p>\n";
   }
   const bool has_ensemble = hl.ensemble != nullptr;
-  if (has_ensemble) {
+  if (has_ensemble && hl.ensemble->ensemble_by == "weights") {
+    h += "<p>Average: the network whose weights are the mean of the checkpoint's and the ones' "
+         "before it (their count in brackets), scored on the same episodes.</p>\n";
+  } else if (has_ensemble) {
     h += "<p>Ensemble: the mean action of the checkpoint and the ones before it (their count in "
          "brackets), scored on the same episodes.</p>\n";
   }
@@ -398,7 +410,7 @@ std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Hig
   if (has_values) h += "<th>Q</th><th>G</th><th>r</th>";
   if (has_actions) h += "<th>mean action</th>";
   if (has_second) h += "<th>second metric</th>";
-  if (has_ensemble) h += "<th>ensemble</th>";
+  if (has_ensemble) h += "<th>" + EnsembleWord(*hl.ensemble) + "</th>";
   h += "</tr></thead>\n<tbody>\n";
   for (const EvalRecord* r : rows) {
     h += CheckpointRow(*r, hl, info, bar_scale, has_values, has_returns, has_actions, has_second,

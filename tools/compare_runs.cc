@@ -316,10 +316,11 @@ std::string ScoreStd(const EvalRecord& r) {
 }
 
 // The ensemble of `r` (ensemble_size > 0): "812.5 ± 40.1" and below it "5, updates 200,000 to
-// 220,000".
+// 220,000" ("5 averaged, ..." for an average of weights).
 std::string EnsembleCell(const EvalRecord& r) {
   return Score(r.ensemble_mean) + " <small class=\"inline\">\xC2\xB1 " + Score(r.ensemble_std) +
-         "</small><small>" + std::to_string(r.ensemble_size) + ", updates " +
+         "</small><small>" + std::to_string(r.ensemble_size) +
+         (r.ensemble_by == "weights" ? " averaged" : "") + ", updates " +
          Thousands(static_cast<double>(r.ensemble_from)) + " to " +
          Thousands(static_cast<double>(r.update)) + "</small>";
 }
@@ -472,8 +473,9 @@ std::string RunsSection(const std::vector<Group>& groups, const Summaries& summa
       "mean; final: the evaluation of the last checkpoint. A run's name links to its "
       "report.";
   if (ensembles) {
-    h += " Best ensemble: the highest mean of the mean action of a checkpoint and those before it "
-         "(how many, and their updates, below it), on the same episodes.";
+    h += " Best ensemble: the highest mean of a checkpoint and those before it played as one, by "
+         "their mean action or (averaged) as the network of their mean weights (how many, and "
+         "their updates, below it), on the same episodes.";
   }
   h += "</p>\n<div class=\"scroll\"><table>\n<thead><tr><th>run</th><th>seed</th>"
        "<th>evaluations</th><th>best mean</th><th>env steps at best</th><th>wall time at best</th>"

@@ -1,6 +1,9 @@
-// Scoring checkpoint files: an ensemble is a checkpoint and the ones before it in its folder.
+// Scoring checkpoint files: an ensemble is a checkpoint and the ones before it in its folder,
+// played by their mean action or averaged into one network.
 #include "evaluator/checkpoint_file.h"
 
+#include <filesystem>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -9,6 +12,7 @@
 
 #include "constant_lander.h"
 #include "nn/checkpoint.h"
+#include "nn/sequential.h"
 #include "tests/common/temp_dir.h"
 
 namespace rl::evaluator {
@@ -53,6 +57,62 @@ TEST_F(EnsembleFilesTest, ScoresTheMeanActionUnderTheNewestCheckpointsName) {
   EXPECT_NE(ensemble.returns, ScoreCheckpointFile(Path(50), kLander, 2, 0.0, 40).returns);
   EXPECT_THROW(ScoreEnsembleFiles({}, kLander, 2, 40), std::invalid_argument);
   EXPECT_THROW(ScoreEnsembleFiles({Path(50)}, "CartPole-v1", 2, 40), std::runtime_error);
+}
+
+// The mean of the members' parameters, under the newest one's architecture and metadata.
+TEST(AverageCheckpointsTest, AveragesTheWeightsOfOneRunsNetworks) {
+  nn::Checkpoint a = ConstantLanderCheckpoint(20, 0.6f, -0.4f, 9);
+  nn::Checkpoint b = ConstantLanderCheckpoint(10, 0.2f, 0.0f, 9);
+  b.params[3] = 1.0f;  // a weight, not only the biases
+  a.meta.note = "run notes";
+  const nn::Checkpoint average = AverageCheckpoints({a, b}, {"a.bin", "b.bin"});
+  EXPECT_EQ(average.architecture, a.architecture);
+  EXPECT_EQ(average.meta.update, 20);
+  EXPECT_EQ(average.meta.env_steps, 40);
+  EXPECT_EQ(average.meta.run_id, 9U);
+  EXPECT_EQ(average.meta.note, "The mean weights of 2 checkpoints, updates 10 to 20.\nrun notes");
+  ASSERT_EQ(average.params.size(), a.params.size());
+  for (size_t i = 0; i < a.params.size(); ++i) {
+    EXPECT_FLOAT_EQ(average.params[i], (a.params[i] + b.params[i]) / 2) << i;
+  }
+  EXPECT_FLOAT_EQ(average.params[3], 0.5f);
+  EXPECT_EQ(AverageCheckpoints({a}, {"a.bin"}).params, a.params);
+}
+
+TEST(AverageCheckpointsTest, RefusesAnotherRunOrNetwork) {
+  const nn::Checkpoint a = ConstantLanderCheckpoint(20, 0.6f, -0.4f, 9);
+  EXPECT_THROW(AverageCheckpoints({}, {}), std::invalid_argument);
+  EXPECT_THROW(AverageCheckpoints({a, a}, {"a.bin"}), std::invalid_argument);
+  try {
+    AverageCheckpoints({a, ConstantLanderCheckpoint(10, 0, 0, 8)}, {"a.bin", "other-run.bin"});
+    ADD_FAILURE() << "another run's checkpoint was averaged";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("other-run.bin is of run 8, not 9"), std::string::npos)
+        << e.what();
+  }
+  std::mt19937 rng(1);
+  const nn::Sequential wider = nn::MakeMlp(8, {5}, 2, &rng);
+  nn::Checkpoint other = a;
+  other.architecture = wider.Architecture();
+  wider.GetFlat(&other.params);
+  EXPECT_THROW(AverageCheckpoints({a, other}, {"a.bin", "wider.bin"}), std::runtime_error);
+}
+
+// An average of weights is scored as the one checkpoint it is; for these constant actors that
+// is also their mean action, and epsilon plays no part with continuous actions.
+TEST_F(EnsembleFilesTest, ScoresTheAverageAsTheCheckpointOfTheMeanWeights) {
+  nn::SaveCheckpoint(Path(50), ConstantLanderCheckpoint(50, 0.2f, 0.0f));
+  const std::vector<std::string> files = EnsembleFiles(Path(50), 2);
+  const std::vector<nn::Checkpoint> members = {nn::LoadCheckpoint(files[0]),
+                                               nn::LoadCheckpoint(files[1])};
+  const EvalRecord average = ScoreAverage(members, files, kLander, 2, 0.0, 40);
+  EXPECT_EQ(average.checkpoint, nn::CheckpointFileName(50));
+  EXPECT_EQ(average.update, 50);
+  EXPECT_EQ(average.returns, ScoreEnsembleFiles(files, kLander, 2, 40).returns);
+  EXPECT_EQ(average.returns,
+            ScoreCheckpoint(ConstantLanderCheckpoint(7, 0.4f, -0.2f), "m.bin", kLander, 2, 0.0, 40)
+                .returns);
+  EXPECT_THROW(ScoreAverage({}, {}, kLander, 2, 0.0, 40), std::invalid_argument);
 }
 
 }  // namespace

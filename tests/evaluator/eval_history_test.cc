@@ -46,6 +46,7 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
   // With an ensemble's score.
   EvalRecord e = Record("e.bin", 5000, 800.5);
   e.ensemble_size = 5;
+  e.ensemble_by = "weights";
   e.ensemble_from = 4000;
   e.ensemble_mean = 850.25;
   e.ensemble_std = 12.5;
@@ -56,8 +57,11 @@ TEST(JsonLinesTest, TwoAppendedRecordsReadBackEqual) {
 
   const std::string text = ReadFile(path);
   EXPECT_EQ(testing::CountOccurrences(text, "\n"), 5);
-  EXPECT_EQ(testing::CountOccurrences(text, "\"ensemble_size\": 5, \"ensemble_from\": 4000"), 1);
-  EXPECT_EQ(testing::CountOccurrences(text, "\"ensemble_"), 7);
+  EXPECT_EQ(
+      testing::CountOccurrences(
+          text, "\"ensemble_size\": 5, \"ensemble_by\": \"weights\", \"ensemble_from\": 4000"),
+      1);
+  EXPECT_EQ(testing::CountOccurrences(text, "\"ensemble_"), 8);
   EXPECT_EQ(testing::CountOccurrences(text, "\"second_mean\": 642.125"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"value_correlation\": null"), 1);
   EXPECT_EQ(testing::CountOccurrences(text, "\"returns\": [-0.1,912.5,"), 1);
@@ -133,6 +137,12 @@ TEST(JsonLinesTest, ParseAcceptsOtherKeyOrderAndRejectsNonObjects) {
   // An ensemble size without its mean is no ensemble.
   ASSERT_TRUE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1, "ensemble_size": 5})", &r));
   EXPECT_EQ(r.ensemble_size, 0);
+  // Lines from before averages of weights were scored hold ensembles of actions.
+  ASSERT_TRUE(ParseJson(
+      R"({"checkpoint": "x", "update": 3, "mean": 1, "ensemble_size": 5, "ensemble_mean": 2})",
+      &r));
+  EXPECT_EQ(r.ensemble_size, 5);
+  EXPECT_EQ(r.ensemble_by, "actions");
   EXPECT_FALSE(ParseJson("[1, 2]", &r));
   EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3})", &r));  // no mean
   EXPECT_FALSE(ParseJson(R"({"checkpoint": "x", "update": 3, "mean": 1} trailing)", &r));

@@ -331,6 +331,55 @@ TEST_F(EvaluatorServiceTest, ScoresEachCheckpointsEnsembleWithTheOnesBeforeIt) {
   EXPECT_TRUE(Contains(log, "update 20: ensemble of 2 (updates 10 to 20): mean "));
 }
 
+// By weights, the ensemble is the network of the members' mean weights (here also their mean
+// action), on a discrete env too; the best one is kept in the run's folder as a checkpoint.
+TEST_F(EvaluatorServiceTest, ScoresAndKeepsTheAverageOfEachCheckpointsWeights) {
+  EvaluatorConfig c = Config();
+  c.env_id = kLander;
+  c.episodes = 2;
+  c.ensemble = 2;
+  c.ensemble_by = "weights";
+  std::FILE* progress = std::tmpfile();
+  ASSERT_NE(progress, nullptr);
+  EvaluatorService service(c, &bus_, progress);
+  ASSERT_TRUE(
+      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(10, 0.6f, -0.4f, 77)), 10, 1));
+  ASSERT_TRUE(
+      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(20, 0.2f, 0.0f, 77)), 20, 2));
+  const EvalRecord second = service.records().back();
+  EXPECT_EQ(second.ensemble_size, 2);
+  EXPECT_EQ(second.ensemble_by, "weights");
+  EXPECT_EQ(second.ensemble_from, 10);
+  const EvalRecord mean_weights = ScoreCheckpoint(ConstantLanderCheckpoint(7, 0.4f, -0.2f), "m.bin",
+                                                  kLander, 2, 0.0, c.seed_base, c.gamma);
+  EXPECT_EQ(second.ensemble_returns, mean_weights.returns);
+  const nn::Checkpoint kept = nn::LoadCheckpoint(c.out_dir + "/" + kBestAverageFile);
+  EXPECT_EQ(kept.meta.update, 20);
+  EXPECT_EQ(kept.params, AverageCheckpoints({ConstantLanderCheckpoint(20, 0.2f, 0.0f, 77),
+                                             ConstantLanderCheckpoint(10, 0.6f, -0.4f, 77)},
+                                            {"b", "a"})
+                             .params);
+  EvalRecord read;
+  ASSERT_TRUE(ParseJson(JsonLines(service).back(), &read));
+  EXPECT_EQ(read, second);
+  const std::string html = ReportHtml(service);
+  EXPECT_TRUE(Contains(html, "Best average"));
+  EXPECT_TRUE(Contains(html, "the mean weights of 2 checkpoints, updates 10 to 20"));
+  EXPECT_TRUE(Contains(html, "<th>average</th>"));
+  EXPECT_TRUE(Contains(ReadFile(service.report_dir() + "/curve_env_steps.svg"), "average of 2"));
+  // A better average replaces it (mean action (-0.4, 0.5)); an equal one later does not.
+  ASSERT_TRUE(
+      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(30, -1.0f, 1.0f, 77)), 30, 3));
+  ASSERT_GT(service.records().back().ensemble_mean, second.ensemble_mean);
+  EXPECT_EQ(nn::LoadCheckpoint(c.out_dir + "/" + kBestAverageFile).meta.update, 30);
+  ASSERT_TRUE(
+      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(40, 0.2f, 0.0f, 77)), 40, 4));
+  ASSERT_EQ(service.records().back().ensemble_mean, service.records()[2].ensemble_mean);
+  EXPECT_EQ(nn::LoadCheckpoint(c.out_dir + "/" + kBestAverageFile).meta.update, 30);
+  EXPECT_TRUE(
+      Contains(ReadAndClose(progress), "update 20: average of 2 (updates 10 to 20): mean "));
+}
+
 TEST_F(EvaluatorServiceTest, NoEnsembleBelowItsMinimumOrOfAnotherRunsCheckpoint) {
   EvaluatorConfig c = Config();
   c.env_id = kLander;
@@ -869,6 +918,11 @@ TEST(EvaluatorConfigTest, RejectsBadSettings) {
   EXPECT_THROW(c.Validate(), std::invalid_argument);
   c.ensemble = 2;  // CartPole-v1's actions are discrete: no mean action
   EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.ensemble_by = "weights";  // but a mean of weights
+  EXPECT_NO_THROW(c.Validate());
+  c.ensemble_by = "votes";
+  EXPECT_THROW(c.Validate(), std::invalid_argument);
+  c.ensemble_by = "actions";
   c.env_id = kLander;
   EXPECT_NO_THROW(c.Validate());
   c.ensemble_min_mean = std::nan("");

@@ -49,6 +49,7 @@ class CompareRunsTest : public TempDirTest {
     double mean;
     double std = 10;
     double ensemble = std::nan("");  // the mean of its ensemble of 5; NaN: none scored
+    bool averaged = false;           // the ensemble is an average of weights
   };
 
   // Appends `evals` to dir/eval.jsonl as the evaluator writes them (100 episodes each, min and
@@ -67,6 +68,7 @@ class CompareRunsTest : public TempDirTest {
       r.episodes = 100;
       if (std::isfinite(e.ensemble)) {
         r.ensemble_size = 5;
+        r.ensemble_by = e.averaged ? "weights" : "actions";
         r.ensemble_from = e.update - 200;
         r.ensemble_mean = e.ensemble;
         r.ensemble_std = e.std;
@@ -218,6 +220,14 @@ TEST_F(CompareRunsTest, ShowsEachRunsBestEnsembleOnlyWhenSomeRunHasOne) {
   EXPECT_EQ(RowCells(html, runs_table, ">one<").back(),
             "720.5 \xC2\xB1 10.0 5, updates 300 to 500");
   EXPECT_EQ(RowCells(html, runs_table, ">two<").back(), "\xE2\x80\x94");
+  // An average of weights says so.
+  const std::string three = MakeRun("three", "car", "CarRacing-v3", 3, 900);
+  AddEvals(three, {{500, 1000, 10, 700, 10, 730.5, true}});
+  runs.push_back(LoadCompareRun(three));
+  MakeLabelsUnique(&runs);
+  const std::string with_average = RenderComparePage(runs, "");
+  EXPECT_EQ(RowCells(with_average, with_average.find("<h2>Runs</h2>"), ">three<").back(),
+            "730.5 \xC2\xB1 10.0 5 averaged, updates 300 to 500");
 }
 
 TEST_F(CompareRunsTest, LabelsRunsOfTheSameNameByTheirParentFolders) {
