@@ -15,8 +15,8 @@ status=0
 # Checkpoints every 50 updates and 3 evaluation episodes, so that the evaluator scores a few;
 # the learner on one thread, so that the run does not oversubscribe the two cores of CI; a t-SNE
 # map of 400 states (the preset's 2000 took the evaluator half a minute of a 90 s budget on a
-# loaded machine, and the embedding grows with the square of the states); ensembles of two
-# checkpoints from any mean (the preset scores them from 750).
+# loaded machine, and the embedding grows with the square of the states); averages of two
+# checkpoints' weights from any mean (the preset scores them from 750).
 launch car_racing_td3 --out "$dir/run" --seed 1 --goal 100000 --time-budget 90 \
   --learner-args "--checkpoint-every 50 --threads 1" \
   --evaluator-args "--episodes 3 --second-episodes 2 --second-min-mean -1000 --videos 1 --tsne 400 --ensemble 2 --ensemble-min-mean -1000" \
@@ -36,19 +36,33 @@ if grep -q 'off-track=1' "$dir/run/logs/evaluator.log"; then fail "the evaluator
 grep -q '"second_episodes": 2' "$dir/run/eval.jsonl" || fail "no second metric in eval.jsonl"
 grep -q "the TD3 article&#39;s rules\|the TD3 article's rules" "$dir/run/report/index.html" ||
   fail "the report does not name the second metric"
-# Every checkpoint but the first also as an ensemble with the one before it, in the report too.
-grep -q '"ensemble_size": 2, "ensemble_from": ' "$dir/run/eval.jsonl" || fail "no ensemble in eval.jsonl"
-grep -q "Best ensemble" "$dir/run/report/index.html" || fail "the report shows no ensemble"
+# Every checkpoint but the first also as the average of its weights with the one before it's, in
+# the report too, the best kept as a checkpoint file that scores as one.
+grep -q '"ensemble_size": 2, "ensemble_by": "weights", "ensemble_from": ' "$dir/run/eval.jsonl" ||
+  fail "no average in eval.jsonl"
+grep -q "Best average" "$dir/run/report/index.html" || fail "the report shows no average"
+"$bin/evaluator" --config "$dir/run/config.ini" --checkpoint "$dir/run/best-average.bin" \
+  --episodes 1 > "$dir/avg.json" 2> "$dir/avg.err" ||
+  fail "the kept best average does not score: $(cat "$dir/avg.err")"
 # Standalone, the preset's config scores the one checkpoint (its `ensemble` is the service's);
-# --ensemble on the command line scores the mean action of it and the one before it.
+# --ensemble on the command line scores the average of it and the one before it, and the mean
+# action with --ensemble-by actions.
 last=$(find "$dir/run/checkpoints" -name 'ckpt-*.bin' | sort -V | tail -1)
 "$bin/evaluator" --config "$dir/run/config.ini" --checkpoint "$last" --episodes 1 \
   > "$dir/one.json" 2> "$dir/one.err" || fail "standalone scoring failed: $(cat "$dir/one.err")"
 grep -q '"episodes": 1' "$dir/one.json" || fail "standalone scoring printed no result"
-if grep -q "the mean action of" "$dir/one.err"; then fail "the preset's ensemble key made a standalone ensemble"; fi
+if grep -q "the mean" "$dir/one.err"; then fail "the preset's ensemble key made a standalone ensemble"; fi
 "$bin/evaluator" --config "$dir/run/config.ini" --checkpoint "$last" --episodes 1 --ensemble 2 \
-  > "$dir/two.json" 2> "$dir/two.err" || fail "standalone ensemble failed: $(cat "$dir/two.err")"
-grep -q "the mean action of 2 checkpoints" "$dir/two.err" || fail "--ensemble 2 scored no ensemble"
+  --save-average "$dir/two.bin" > "$dir/two.json" 2> "$dir/two.err" ||
+  fail "standalone average failed: $(cat "$dir/two.err")"
+grep -q "the mean weights of 2 checkpoints" "$dir/two.err" || fail "--ensemble 2 scored no average"
+"$bin/evaluator" --config "$dir/run/config.ini" --checkpoint "$dir/two.bin" --episodes 1 \
+  > "$dir/two-again.json" 2>&1 || fail "the saved average does not score: $(cat "$dir/two-again.json")"
+[ "$(grep -o '"mean": [^,]*' "$dir/two.json")" = "$(grep -o '"mean": [^,]*' "$dir/two-again.json")" ] ||
+  fail "the saved average scores otherwise than the average did"
+"$bin/evaluator" --config "$dir/run/config.ini" --checkpoint "$last" --episodes 1 --ensemble 2 \
+  --ensemble-by actions > /dev/null 2> "$dir/act.err" || fail "standalone ensemble failed: $(cat "$dir/act.err")"
+grep -q "the mean action of 2 checkpoints" "$dir/act.err" || fail "--ensemble-by actions scored no ensemble"
 # Progress over the second half of the run, from the metrics rows (t: seconds since the monitor
 # started): the replay's inserts and the learner's updates grew between the last row of the first
 # half and the last row, and the evaluator scored a checkpoint made in the second half (of an
