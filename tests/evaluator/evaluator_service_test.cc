@@ -147,6 +147,24 @@ class EvaluatorServiceTest : public ::testing::Test {
     return c;
   }
 
+  // Config() on LunarLanderContinuous, 2 episodes, ensembles of 2 by `by` (actions or weights).
+  EvaluatorConfig EnsembleConfig(const std::string& by) const {
+    EvaluatorConfig c = Config();
+    c.env_id = kLander;
+    c.episodes = 2;
+    c.ensemble = 2;
+    c.ensemble_by = by;
+    return c;
+  }
+  // Scores two checkpoints of run 77 that always act (0.6, -0.4) and (0.2, 0), at updates 10 and
+  // 20: the second has an ensemble, of the mean action (0.4, -0.2) either way.
+  void ScoreTwoConstantLanders(EvaluatorService* service) {
+    ASSERT_TRUE(
+        AnnounceUntilResults(service, Save(ConstantLanderCheckpoint(10, 0.6f, -0.4f, 77)), 10, 1));
+    ASSERT_TRUE(
+        AnnounceUntilResults(service, Save(ConstantLanderCheckpoint(20, 0.2f, 0.0f, 77)), 20, 2));
+  }
+
   // Saves `ckpt` in the run's checkpoint folder under the learner's name for it; returns its path.
   std::string Save(const nn::Checkpoint& ckpt) {
     std::string path = checkpoints_ + "/" + nn::CheckpointFileName(ckpt.meta.update);
@@ -292,17 +310,11 @@ TEST_F(EvaluatorServiceTest, ANewBestBelowTheSecondMetricsMinimumIsNotScoredOnIt
 // Each checkpoint's ensemble with the one before it plays as one checkpoint of their mean action
 // does, on the same episodes; the first checkpoint has none before it, so no ensemble.
 TEST_F(EvaluatorServiceTest, ScoresEachCheckpointsEnsembleWithTheOnesBeforeIt) {
-  EvaluatorConfig c = Config();
-  c.env_id = kLander;
-  c.episodes = 2;
-  c.ensemble = 2;
+  const EvaluatorConfig c = EnsembleConfig("actions");
   std::FILE* progress = std::tmpfile();
   ASSERT_NE(progress, nullptr);
   EvaluatorService service(c, &bus_, progress);
-  ASSERT_TRUE(
-      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(10, 0.6f, -0.4f, 77)), 10, 1));
-  ASSERT_TRUE(
-      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(20, 0.2f, 0.0f, 77)), 20, 2));
+  ASSERT_NO_FATAL_FAILURE(ScoreTwoConstantLanders(&service));
   ASSERT_EQ(service.records().size(), 2U);
   const EvalRecord& first = service.records()[0];
   const EvalRecord& second = service.records()[1];
@@ -331,21 +343,14 @@ TEST_F(EvaluatorServiceTest, ScoresEachCheckpointsEnsembleWithTheOnesBeforeIt) {
   EXPECT_TRUE(Contains(log, "update 20: ensemble of 2 (updates 10 to 20): mean "));
 }
 
-// By weights, the ensemble is the network of the members' mean weights (here also their mean
-// action), on a discrete env too; the best one is kept in the run's folder as a checkpoint.
+// By weights, the ensemble is the network of the members' mean weights (for these actors also
+// their mean action); the best one is kept in the run's folder as a checkpoint file.
 TEST_F(EvaluatorServiceTest, ScoresAndKeepsTheAverageOfEachCheckpointsWeights) {
-  EvaluatorConfig c = Config();
-  c.env_id = kLander;
-  c.episodes = 2;
-  c.ensemble = 2;
-  c.ensemble_by = "weights";
+  const EvaluatorConfig c = EnsembleConfig("weights");
   std::FILE* progress = std::tmpfile();
   ASSERT_NE(progress, nullptr);
   EvaluatorService service(c, &bus_, progress);
-  ASSERT_TRUE(
-      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(10, 0.6f, -0.4f, 77)), 10, 1));
-  ASSERT_TRUE(
-      AnnounceUntilResults(&service, Save(ConstantLanderCheckpoint(20, 0.2f, 0.0f, 77)), 20, 2));
+  ASSERT_NO_FATAL_FAILURE(ScoreTwoConstantLanders(&service));
   const EvalRecord second = service.records().back();
   EXPECT_EQ(second.ensemble_size, 2);
   EXPECT_EQ(second.ensemble_by, "weights");
@@ -381,10 +386,7 @@ TEST_F(EvaluatorServiceTest, ScoresAndKeepsTheAverageOfEachCheckpointsWeights) {
 }
 
 TEST_F(EvaluatorServiceTest, NoEnsembleBelowItsMinimumOrOfAnotherRunsCheckpoint) {
-  EvaluatorConfig c = Config();
-  c.env_id = kLander;
-  c.episodes = 2;
-  c.ensemble = 2;
+  EvaluatorConfig c = EnsembleConfig("actions");
   c.ensemble_min_mean = 1000;  // above any LunarLander score
   {
     EvaluatorService service(c, &bus_, nullptr);
