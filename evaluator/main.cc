@@ -132,8 +132,9 @@ int Main(int argc, char** argv) {
        "standalone mode, continuous actions: score with the actors' Gaussian noise at this "
        "constant sigma (a fraction of each action's half-range), not the deterministic action")  //
       ("ensemble", rl::po::value(&config.ensemble)->default_value(config.ensemble),
-       "continuous actions: score the mean action of a checkpoint and the K - 1 checkpoints "
-       "before it in its folder, an ensemble of K networks (standalone mode: instead of the "
+       "score a checkpoint and the K - 1 checkpoints before it in its folder as one, an "
+       "ensemble of K networks, by their mean action or their mean weights (--ensemble-by) "
+       "(standalone mode: instead of the "
        "checkpoint alone; service mode: after each checkpoint's own score, on the same "
        "episodes, in eval.jsonl and the report beside it); 1: none")  //
       ("ensemble-by", rl::po::value(&config.ensemble_by)->default_value(config.ensemble_by),
