@@ -68,11 +68,10 @@ struct EvalRecord {
 /// "eval_seconds": ...}, and when value_steps > 0 also "value_steps", "value_estimate",
 /// "value_return" and "value_correlation" (null when unset), and when second_episodes > 0
 /// "second_mean", "second_std" and "second_episodes", when ensemble_size > 0 "ensemble_size",
-/// "ensemble_by",
-/// "ensemble_from", "ensemble_mean", "ensemble_std", "ensemble_min", "ensemble_max" and
-/// "ensemble_returns", and last, when there are any, "returns", "steps" and "action_mean"
-/// (arrays) (json_line.h: numbers in their shortest form that reads back exactly; a non-finite
-/// number is written as null).
+/// "ensemble_by", "ensemble_from", "ensemble_mean", "ensemble_std", "ensemble_min",
+/// "ensemble_max" and "ensemble_returns", and last, when there are any, "returns", "steps" and
+/// "action_mean" (arrays) (json_line.h: numbers in their shortest form that reads back exactly; a
+/// non-finite number is written as null).
 std::string ToJson(const EvalRecord& record);
 
 /// Parses one line written by ToJson (keys in any order, unknown keys ignored, whitespace

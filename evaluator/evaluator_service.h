@@ -81,13 +81,12 @@ struct EvaluatorConfig {
   double screen_margin = 0;
   int screen_max_rejects = 3;
   // After its own score, a checkpoint is also scored as an ensemble of it and the ensemble - 1
-  // checkpoints before it in the run's checkpoint folder: by default (ensemble_by "actions",
-  // continuous envs) their mean action, on
-  // the same episodes (eval.jsonl's ensemble_* fields, a second curve in the report); only when
-  // its own mean is at least ensemble_min_mean and those checkpoints are there. 1: no ensembles.
-  // "weights" (any env): the ensemble is instead the one network whose weights are the mean of
-  // those checkpoints' (AverageCheckpoints), scored as a checkpoint is; the best such network
-  // is kept as <out_dir>/best-average.bin, a checkpoint file like the learner's.
+  // checkpoints before it in the run's checkpoint folder, on the same episodes (eval.jsonl's
+  // ensemble_* fields, a second curve in the report); only when its own mean is at least
+  // ensemble_min_mean and those checkpoints are there. 1: no ensembles. ensemble_by "actions"
+  // (continuous envs): their mean action; "weights" (any env): the one network whose weights
+  // are the mean of theirs (AverageCheckpoints), scored as a checkpoint is, the best such
+  // network kept as <out_dir>/kBestAverageFile, a checkpoint file like the learner's.
   int ensemble = 1;
   std::string ensemble_by = "actions";
   double ensemble_min_mean = -std::numeric_limits<double>::infinity();
