@@ -155,15 +155,6 @@ nn::Checkpoint AverageCheckpoints(const std::vector<nn::Checkpoint>& ckpts,
   return average;
 }
 
-EvalRecord ScoreAverage(const std::vector<nn::Checkpoint>& ckpts,
-                        const std::vector<std::string>& paths, const std::string& env_id,
-                        int episodes, double epsilon, uint64_t first_seed, double gamma,
-                        const Tick& tick) {
-  const nn::Checkpoint average = AverageCheckpoints(ckpts, paths);  // throws before front()
-  return ScoreCheckpoint(average, paths.front(), env_id, episodes, epsilon, first_seed, gamma,
-                         tick);
-}
-
 EvalRecord ScoreEnsembleFiles(const std::vector<std::string>& paths, const std::string& env_id,
                               int episodes, uint64_t first_seed, double gamma) {
   std::vector<nn::Checkpoint> ckpts;

@@ -52,7 +52,8 @@ std::vector<std::string> EnsembleFiles(const std::string& path, int count);
 /// Scores the mean action of the loaded checkpoints `ckpts`, read from `paths` (EnsemblePolicy;
 /// continuous envs), as ScoreCheckpoint scores one: the record names paths[0] and has its
 /// metadata. Throws std::runtime_error as PolicyNetwork for any of them, std::invalid_argument
-/// for a discrete env, no checkpoint, or as many paths as checkpoints. `tick` as in ScorePolicy.
+/// for a discrete env, no checkpoint, or not as many paths as checkpoints. `tick` as in
+/// ScorePolicy.
 EvalRecord ScoreEnsemble(const std::vector<nn::Checkpoint>& ckpts,
                          const std::vector<std::string>& paths, const std::string& env_id,
                          int episodes, uint64_t first_seed, double gamma = kDefaultGamma,
@@ -61,19 +62,12 @@ EvalRecord ScoreEnsemble(const std::vector<nn::Checkpoint>& ckpts,
 /// The checkpoint whose parameters are the mean of the loaded checkpoints' `ckpts`, read from
 /// `paths` (their weights averaged, as stochastic weight averaging averages the weights along
 /// one run): the architecture and metadata of ckpts[0] (EnsembleFiles' newest), its note after
-/// a line naming the members' updates. Throws std::invalid_argument for no checkpoint or as many
-/// paths as checkpoints, and std::runtime_error naming the path of a member of another
-/// architecture or run, or with another parameter count.
+/// a line naming the members' updates. Throws std::invalid_argument for no checkpoint or not as
+/// many paths as checkpoints, and std::runtime_error naming the path of a member of another
+/// architecture or run, or with another parameter count. Scored with ScoreCheckpoint under
+/// paths[0], as one checkpoint.
 nn::Checkpoint AverageCheckpoints(const std::vector<nn::Checkpoint>& ckpts,
                                   const std::vector<std::string>& paths);
-
-/// Scores the network of AverageCheckpoints(ckpts, paths) as ScoreCheckpoint scores one (any
-/// env: discrete ones with `epsilon`): the record names paths[0] and has its metadata. Throws
-/// as AverageCheckpoints and PolicyNetwork. `tick` as in ScorePolicy.
-EvalRecord ScoreAverage(const std::vector<nn::Checkpoint>& ckpts,
-                        const std::vector<std::string>& paths, const std::string& env_id,
-                        int episodes, double epsilon, uint64_t first_seed,
-                        double gamma = kDefaultGamma, const Tick& tick = {});
 
 /// Loads the checkpoint files `paths` and scores their mean action (ScoreEnsemble). Throws
 /// std::runtime_error as ScoreCheckpointFile for any of the files, std::invalid_argument as

@@ -98,21 +98,21 @@ TEST(AverageCheckpointsTest, RefusesAnotherRunOrNetwork) {
   EXPECT_THROW(AverageCheckpoints({a, other}, {"a.bin", "wider.bin"}), std::runtime_error);
 }
 
-// An average of weights is scored as the one checkpoint it is; for these constant actors that
-// is also their mean action, and epsilon plays no part with continuous actions.
+// An average of weights is scored as the one checkpoint it is (as the service and the
+// standalone mode score it); for these constant actors that is also their mean action.
 TEST_F(EnsembleFilesTest, ScoresTheAverageAsTheCheckpointOfTheMeanWeights) {
   nn::SaveCheckpoint(Path(50), ConstantLanderCheckpoint(50, 0.2f, 0.0f));
   const std::vector<std::string> files = EnsembleFiles(Path(50), 2);
   const std::vector<nn::Checkpoint> members = {nn::LoadCheckpoint(files[0]),
                                                nn::LoadCheckpoint(files[1])};
-  const EvalRecord average = ScoreAverage(members, files, kLander, 2, 0.0, 40);
+  const EvalRecord average =
+      ScoreCheckpoint(AverageCheckpoints(members, files), files[0], kLander, 2, 0.0, 40);
   EXPECT_EQ(average.checkpoint, nn::CheckpointFileName(50));
   EXPECT_EQ(average.update, 50);
   EXPECT_EQ(average.returns, ScoreEnsembleFiles(files, kLander, 2, 40).returns);
   EXPECT_EQ(average.returns,
             ScoreCheckpoint(ConstantLanderCheckpoint(7, 0.4f, -0.2f), "m.bin", kLander, 2, 0.0, 40)
                 .returns);
-  EXPECT_THROW(ScoreAverage({}, {}, kLander, 2, 0.0, 40), std::invalid_argument);
 }
 
 }  // namespace
