@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
@@ -180,9 +181,12 @@ std::string Header(const ReportInfo& info, size_t records) {
   return h;
 }
 
-// "update 1,200, 4,800 env steps, 12 s".
-std::string Where(const EvalRecord& r) {
+// "update 1,200, 4,800 env steps, 12 s", with ", 310 training episodes" before the time when
+// the run's metrics tell them.
+std::string Where(const EvalRecord& r, const std::vector<EpisodesAtUpdate>& episodes) {
+  const std::optional<int64_t> trained = EpisodesAt(episodes, r.update);
   return "update " + Thousands(r.update) + ", " + Thousands(r.env_steps) + " env steps, " +
+         (trained ? Thousands(*trained) + " training episodes, " : std::string()) +
          Duration(r.wall_seconds);
 }
 
@@ -193,7 +197,8 @@ std::string MeanValue(const EvalRecord& r) {
 }
 
 // The summary cards: the goal, the best mean, the latest checkpoint.
-std::string SummarySection(const Highlights& hl, const ReportInfo& info) {
+std::string SummarySection(const Highlights& hl, const ReportInfo& info,
+                           const std::vector<EpisodesAtUpdate>& episodes) {
   std::string h = "<section class=\"summary\">\n<h2>Summary</h2>\n<div class=\"cards\">\n";
   h += "<div class=\"card\"><div class=\"label\">Goal</div><div class=\"value\">";
   const std::string goal = HtmlEscape(Format("%g", info.goal));
@@ -201,7 +206,7 @@ std::string SummarySection(const Highlights& hl, const ReportInfo& info) {
     h += "<span class=\"badge no\">none set</span>";
   } else if (hl.first_goal != nullptr) {
     h += "<span class=\"badge yes\">reached</span></div><div class=\"detail\">mean \xE2\x89\xA5 " +
-         goal + " first at " + Where(*hl.first_goal);
+         goal + " first at " + Where(*hl.first_goal, episodes);
   } else {
     h += "<span class=\"badge no\">not reached</span></div><div class=\"detail\">goal: mean "
          "\xE2\x89\xA5 " +
@@ -209,7 +214,7 @@ std::string SummarySection(const Highlights& hl, const ReportInfo& info) {
   }
   h += "</div></div>\n<div class=\"card\"><div class=\"label\">Best mean return</div>";
   if (hl.best != nullptr) {
-    h += MeanValue(*hl.best) + "<div class=\"detail\">" + Where(*hl.best) + "</div>";
+    h += MeanValue(*hl.best) + "<div class=\"detail\">" + Where(*hl.best, episodes) + "</div>";
     if (hl.second != nullptr) {
       h += "<div class=\"detail\">second metric (update " + Thousands(hl.second->update) +
            "): " + Score(hl.second->second_mean) + " \xC2\xB1 " + Score(hl.second->second_std) +
@@ -233,7 +238,7 @@ std::string SummarySection(const Highlights& hl, const ReportInfo& info) {
   }
   h += "</div>\n<div class=\"card\"><div class=\"label\">Latest checkpoint</div>";
   if (hl.latest != nullptr) {
-    h += MeanValue(*hl.latest) + "<div class=\"detail\">" + Where(*hl.latest) + "</div>";
+    h += MeanValue(*hl.latest) + "<div class=\"detail\">" + Where(*hl.latest, episodes) + "</div>";
   } else {
     h += "<div class=\"value\">\xE2\x80\x94</div>";
   }
@@ -309,15 +314,21 @@ double Quantile(std::vector<double> values, double q) {
 
 // One row of the checkpoint table.
 std::string CheckpointRow(const EvalRecord& r, const Highlights& hl, const ReportInfo& info,
-                          double bar_scale, bool has_values, bool has_returns, bool has_actions,
-                          bool has_second, bool has_ensemble) {
+                          const std::vector<EpisodesAtUpdate>& episodes, double bar_scale,
+                          bool has_values, bool has_returns, bool has_actions, bool has_second,
+                          bool has_ensemble) {
   std::string cls;
   if (&r == hl.best) cls += "best";
   if (std::isfinite(info.goal) && r.mean >= info.goal) cls += cls.empty() ? "goal" : " goal";
   const double bar = bar_scale > 0 ? std::clamp(r.mean / bar_scale, 0.0, 1.0) * 100.0 : 0.0;
   std::string h = cls.empty() ? "<tr>" : "<tr class=\"" + cls + "\">";
   h += "<td>" + HtmlEscape(r.checkpoint) + "</td><td>" + Thousands(r.update) + "</td><td>" +
-       Thousands(r.env_steps) + "</td><td>" + Duration(r.wall_seconds) + "</td>";
+       Thousands(r.env_steps) + "</td>";
+  if (!episodes.empty()) {
+    const std::optional<int64_t> trained = EpisodesAt(episodes, r.update);
+    h += "<td>" + (trained ? Thousands(*trained) : std::string()) + "</td>";
+  }
+  h += "<td>" + Duration(r.wall_seconds) + "</td>";
   h += "<td class=\"mean\"><span class=\"bar\" style=\"width:" + Format("%.1f", bar) +
        "%\"></span>" + Score(r.mean) + "</td>";
   h += "<td>" + Score(r.std) + "</td><td>" + Format("%g", r.min) + "</td>";
@@ -359,7 +370,8 @@ std::string CheckpointRow(const EvalRecord& r, const Highlights& hl, const Repor
 
 // The table of every checkpoint, newest first.
 std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Highlights& hl,
-                               const ReportInfo& info) {
+                               const ReportInfo& info,
+                               const std::vector<EpisodesAtUpdate>& episodes) {
   std::string h = "<section>\n<h2>Checkpoints</h2>\n";
   if (records.empty()) return h + "<p class=\"empty\">No checkpoint scored yet.</p>\n</section>\n";
   std::vector<const EvalRecord*> rows;
@@ -368,6 +380,10 @@ std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Hig
                    [](const EvalRecord* a, const EvalRecord* b) { return a->update > b->update; });
   double bar_scale = std::isfinite(info.goal) ? info.goal : 0;
   for (const EvalRecord* r : rows) bar_scale = std::max(bar_scale, r->mean);
+  if (!episodes.empty()) {
+    h += "<p>Training episodes: the episodes the actors had finished when the learner reached the "
+         "checkpoint's update (from metrics.jsonl, to within its rows' spacing).</p>\n";
+  }
   const bool has_values = std::any_of(records.begin(), records.end(),
                                       [](const EvalRecord& r) { return r.value_steps > 0; });
   if (has_values) {
@@ -404,17 +420,19 @@ std::string CheckpointsSection(const std::vector<EvalRecord>& records, const Hig
          "brackets), scored on the same episodes.</p>\n";
   }
   h += "<div class=\"scroll\"><table>\n<thead><tr><th>checkpoint</th><th>update</th>"
-       "<th>env steps</th><th>wall time</th><th>mean</th><th>std</th><th>min</th>";
+       "<th>env steps</th>";
+  if (!episodes.empty()) h += "<th>training episodes</th>";
+  h += "<th>wall time</th><th>mean</th><th>std</th><th>min</th>";
   if (has_returns) h += "<th>10 %</th><th>median</th>";
-  h += "<th>max</th><th>episodes</th><th>eval time</th>";
+  h += "<th>max</th><th>eval episodes</th><th>eval time</th>";
   if (has_values) h += "<th>Q</th><th>G</th><th>r</th>";
   if (has_actions) h += "<th>mean action</th>";
   if (has_second) h += "<th>second metric</th>";
   if (has_ensemble) h += "<th>" + EnsembleWord(*hl.ensemble) + "</th>";
   h += "</tr></thead>\n<tbody>\n";
   for (const EvalRecord* r : rows) {
-    h += CheckpointRow(*r, hl, info, bar_scale, has_values, has_returns, has_actions, has_second,
-                       has_ensemble);
+    h += CheckpointRow(*r, hl, info, episodes, bar_scale, has_values, has_returns, has_actions,
+                       has_second, has_ensemble);
   }
   return h + "</tbody>\n</table></div>\n</section>\n";
 }
@@ -491,11 +509,12 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
   const std::vector<TrainingSeries> training = WriteTrainingCurves(dir, info.metrics_file);
 
   const Highlights highlights = FindHighlights(records, info.goal);
+  const std::vector<EpisodesAtUpdate> episodes = LoadEpisodesByUpdate(info.metrics_file);
   std::string h = Header(info, records.size());
-  h += SummarySection(highlights, info);
+  h += SummarySection(highlights, info, episodes);
   h += CurvesSections(training);
   h += MediaSections(info);
-  h += CheckpointsSection(records, highlights, info);
+  h += CheckpointsSection(records, highlights, info, episodes);
   h += RestartsSection(info.restarts_file);
   h += "<section>\n<h2>Run config</h2>\n<pre>" +
        HtmlEscape(info.run_config.empty() ? "(none given)" : info.run_config) +

@@ -1,5 +1,6 @@
 #include "evaluator/training_curves.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -79,6 +80,50 @@ std::vector<TrainingSeries> LoadTrainingSeries(const std::string& path) {
     if (!s.points.empty()) kept.push_back(std::move(s));
   }
   return kept;
+}
+
+void ActorEpisodeCounter::Add(const std::string& role, int64_t episodes) {
+  auto& [earlier, current] = by_role_[role];
+  if (episodes < current) earlier += current;
+  current = episodes;
+}
+
+int64_t ActorEpisodeCounter::total() const {
+  int64_t total = 0;
+  for (const auto& [role, counts] : by_role_) total += counts.first + counts.second;
+  return total;
+}
+
+std::vector<EpisodesAtUpdate> LoadEpisodesByUpdate(const std::string& path) {
+  std::ifstream in(path);
+  ActorEpisodeCounter counter;
+  bool any_actor = false;
+  std::vector<EpisodesAtUpdate> points;
+  for (std::string line; std::getline(in, line);) {
+    const std::optional<nlohmann::json> obj = ParseJsonLine(line);
+    if (!obj) continue;
+    const std::optional<std::string> role = JsonStringAt(*obj, "role");
+    if (!role) continue;
+    if (role->rfind("actor-", 0) == 0) {
+      if (const auto episodes = JsonIntegerAt(*obj, "episodes")) {
+        counter.Add(*role, *episodes);
+        any_actor = true;
+      }
+    } else if (*role == "learner") {
+      if (const auto updates = JsonIntegerAt(*obj, "updates"); updates && any_actor) {
+        points.push_back({*updates, counter.total()});
+      }
+    }
+  }
+  return points;
+}
+
+std::optional<int64_t> EpisodesAt(const std::vector<EpisodesAtUpdate>& points, int64_t update) {
+  // Updates only grow within a run (a resumed learner continues its count).
+  const auto it = std::find_if(points.begin(), points.end(),
+                               [update](const EpisodesAtUpdate& p) { return p.updates >= update; });
+  if (it == points.end()) return std::nullopt;
+  return it->episodes;
 }
 
 }  // namespace rl::evaluator

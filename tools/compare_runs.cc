@@ -306,6 +306,13 @@ std::string StepsAndTime(const EvalRecord& r) {
          "</small>";
 }
 
+// "<small>1,234 episodes</small>": the training episodes by `r`'s update, when the run's
+// metrics tell them; else "".
+std::string TrainingEpisodes(const CompareRun& run, const EvalRecord& r) {
+  const std::optional<int64_t> episodes = evaluator::EpisodesAt(run.episodes, r.update);
+  return episodes ? "<small>" + Thousands(*episodes) + " episodes</small>" : std::string();
+}
+
 // The line styles of the plots, for the legend (drawn by the CSS of .k).
 constexpr char kLegendKeys[] =
     "<i class=\"k run\"></i>a run <i class=\"k mean\"></i>mean of a preset's runs "
@@ -490,9 +497,9 @@ std::string RunsSection(const std::vector<Group>& groups, const Summaries& summa
       h += "<tr><td>" + RunName(*run, page_dir) + "</td><td>" +
            (run->seed >= 0 ? std::to_string(run->seed) : std::string(kDash)) + "</td><td>" +
            std::to_string(s.evaluations) + "</td><td>" + ScoreStd(s.best) + "</td><td>" +
-           Thousands(static_cast<double>(s.best.env_steps)) + "</td><td>" +
-           Duration(s.best.wall_seconds) + "</td><td>" + ScoreStd(s.final) + "</td><td>" +
-           StepsAndTime(s.final) + "</td>";
+           Thousands(static_cast<double>(s.best.env_steps)) + TrainingEpisodes(*run, s.best) +
+           "</td><td>" + Duration(s.best.wall_seconds) + "</td><td>" + ScoreStd(s.final) +
+           "</td><td>" + StepsAndTime(s.final) + "</td>";
       if (s.goal_reached) {
         h += "<td class=\"yes\">" + StepsAndTime(s.first_goal) + "</td>";
       } else if (std::isfinite(run->goal)) {
@@ -566,6 +573,7 @@ CompareRun LoadCompareRun(const std::string& dir) {
   if (run.records.empty()) {
     throw std::runtime_error(dir + ": eval.jsonl has no evaluation yet");
   }
+  run.episodes = evaluator::LoadEpisodesByUpdate((fs::path(dir) / "metrics.jsonl").string());
   return run;
 }
 

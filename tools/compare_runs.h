@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "evaluator/report.h"
+#include "evaluator/training_curves.h"
 
 namespace rl::tools {
 
@@ -28,9 +29,12 @@ struct CompareRun {
   int64_t seed = -1;   // the run seed; -1 when config.ini names none
   std::vector<evaluator::EvalRecord> records;  // eval.jsonl, in file order; never empty
   int skipped_lines = 0;                       // eval.jsonl lines that did not parse
+  // The actors' episodes by learner update (metrics.jsonl); empty when the folder has none.
+  std::vector<evaluator::EpisodesAtUpdate> episodes;
 };
 
-/// Reads `dir`/config.ini (preset, env, goal, seed) and `dir`/eval.jsonl. Throws
+/// Reads `dir`/config.ini (preset, env, goal, seed), `dir`/eval.jsonl and, when there is one,
+/// `dir`/metrics.jsonl (the training episodes). Throws
 /// std::runtime_error with a one-line message that names `dir` when it is not a folder, has no
 /// config.ini or no eval.jsonl, when config.ini has no "# Run of preset" line, or when eval.jsonl
 /// has no evaluation that parses.

@@ -10,13 +10,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <map>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
 
 #include "common/messages.h"
 #include "evaluator/json_line.h"
+#include "evaluator/training_curves.h"
 
 namespace rl::tools {
 namespace {
@@ -136,7 +136,7 @@ double LastT(const std::string& path) {
 
 int64_t ActorEpisodes(const std::string& path) {
   std::ifstream in(path);
-  std::map<std::string, std::pair<int64_t, int64_t>> by_role;  // {earlier lives, this life}
+  evaluator::ActorEpisodeCounter counter;
   std::string line;
   while (std::getline(in, line)) {
     const auto object = ParseJsonLine(line);
@@ -144,13 +144,9 @@ int64_t ActorEpisodes(const std::string& path) {
     const auto role = JsonStringAt(*object, "role");
     const auto episodes = JsonIntegerAt(*object, "episodes");
     if (!role || role->rfind("actor-", 0) != 0 || !episodes) continue;
-    auto& [earlier, current] = by_role[*role];
-    if (*episodes < current) earlier += current;
-    current = *episodes;
+    counter.Add(*role, *episodes);
   }
-  int64_t total = 0;
-  for (const auto& [role, counts] : by_role) total += counts.first + counts.second;
-  return total;
+  return counter.total();
 }
 
 MetricsLog::MetricsLog(const std::string& path, double dense_seconds, double dense_period,

@@ -88,5 +88,75 @@ TEST(TrainingCurvesTest, TheReportShowsATrainingSectionOnlyWithMetrics) {
   EXPECT_NE(svg.find("Learner loss"), std::string::npos);
 }
 
+TEST(TrainingCurvesTest, EpisodesByUpdateCountEveryLifeOfTheActors) {
+  TempDir dir;
+  const std::string path = dir / "metrics.jsonl";
+  {
+    std::ofstream out(path);
+    out << R"({"t": 1, "role": "learner", "updates": 0})"
+        << "\n"  // before any actor line
+        << R"({"t": 2, "role": "actor-0", "episodes": 5})"
+        << "\n"
+        << R"({"t": 2, "role": "actor-1", "episodes": 3})"
+        << "\n"
+        << R"({"t": 2, "role": "learner", "updates": 100})"
+        << "\n"
+        << R"({"t": 3, "role": "actor-0", "episodes": 2})"
+        << "\n"  // restarted after 5
+        << R"({"t": 3, "role": "evaluator", "episodes": 100})"
+        << "\n"  // not an actor's
+        << "not json\n"
+        << R"({"t": 3, "role": "learner", "updates": 250})"
+        << "\n"
+        << R"({"t": 4, "role": "learner", "upd)";  // cut short
+  }
+  const std::vector<EpisodesAtUpdate> points = LoadEpisodesByUpdate(path);
+  ASSERT_EQ(points.size(), 2u);
+  EXPECT_EQ(points[0].updates, 100);
+  EXPECT_EQ(points[0].episodes, 5 + 3);
+  EXPECT_EQ(points[1].updates, 250);
+  EXPECT_EQ(points[1].episodes, 5 + 2 + 3);
+  EXPECT_EQ(EpisodesAt(points, 0), 8);
+  EXPECT_EQ(EpisodesAt(points, 100), 8);
+  EXPECT_EQ(EpisodesAt(points, 101), 10);  // the first point at or past the update
+  EXPECT_EQ(EpisodesAt(points, 251), std::nullopt);
+  EXPECT_TRUE(LoadEpisodesByUpdate(dir / "missing.jsonl").empty());
+}
+
+TEST(TrainingCurvesTest, TheReportSaysTheTrainingEpisodesOfEachCheckpoint) {
+  TempDir dir;
+  ReportInfo info;
+  info.env_id = "KukaDiverseObjectGrasping-v0";
+  info.goal = 0.25;  // the goal card names the early checkpoint, the best card the late one
+  EvalRecord early;
+  early.checkpoint = "ckpt-000000100.bin";
+  early.update = 100;
+  early.mean = 0.3;
+  EvalRecord late = early;
+  late.checkpoint = "ckpt-000000300.bin";
+  late.update = 300;  // past the metrics' last point
+  late.mean = 0.7;
+  WriteReport(dir / "plain", {early, late}, info);
+  const std::string plain = ReadFile(dir / "plain/index.html");
+  EXPECT_EQ(plain.find("training episodes"), std::string::npos) << "no metrics, no column";
+
+  info.metrics_file = dir / "metrics.jsonl";
+  {
+    std::ofstream out(info.metrics_file);
+    out << R"({"t": 1, "role": "actor-0", "episodes": 1234})"
+        << "\n"
+        << R"({"t": 1, "role": "learner", "updates": 150})"
+        << "\n";
+  }
+  WriteReport(dir / "report", {early, late}, info);
+  const std::string html = ReadFile(dir / "report/index.html");
+  EXPECT_NE(html.find("<th>training episodes</th>"), std::string::npos);
+  EXPECT_NE(html.find("<td>1,234</td>"), std::string::npos) << "the early checkpoint's";
+  EXPECT_NE(html.find("update 100, 0 env steps, 1,234 training episodes"), std::string::npos)
+      << "the goal card";
+  EXPECT_NE(html.find("update 300, 0 env steps, 0.0 s"), std::string::npos)
+      << "the best card, past the metrics: no episodes said";
+}
+
 }  // namespace
 }  // namespace rl::evaluator

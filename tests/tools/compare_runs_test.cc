@@ -230,6 +230,25 @@ TEST_F(CompareRunsTest, ShowsEachRunsBestEnsembleOnlyWhenSomeRunHasOne) {
             "730.5 \xC2\xB1 10.0 5 averaged, updates 300 to 500");
 }
 
+TEST_F(CompareRunsTest, ARunWithMetricsSaysItsTrainingEpisodesAtItsBest) {
+  const std::string dir = MakeRun("kuka-1", "kuka_grasp", "KukaDiverseObjectGrasping-v0", 1, 0.6);
+  AddEvals(dir, {{100, 700, 60, 0.4, 0.05}, {200, 1400, 120, 0.55, 0.05}});
+  std::vector<CompareRun> runs = {LoadCompareRun(dir)};
+  EXPECT_TRUE(runs[0].episodes.empty()) << "no metrics.jsonl";
+  const std::string plain = RenderComparePage(runs, "");
+  EXPECT_EQ(RowCells(plain, plain.find("<h2>Runs</h2>"), ">kuka-1<")[4], "1,400");
+
+  std::ofstream(dir + "/metrics.jsonl")
+      << "{\"t\": 50, \"role\": \"actor-0\", \"episodes\": 90}\n"
+      << "{\"t\": 50, \"role\": \"learner\", \"updates\": 110}\n"
+      << "{\"t\": 110, \"role\": \"actor-0\", \"episodes\": 180}\n"
+      << "{\"t\": 110, \"role\": \"learner\", \"updates\": 205}\n";
+  runs = {LoadCompareRun(dir)};
+  EXPECT_EQ(runs[0].episodes.size(), 2u);
+  const std::string html = RenderComparePage(runs, "");
+  EXPECT_EQ(RowCells(html, html.find("<h2>Runs</h2>"), ">kuka-1<")[4], "1,400 180 episodes");
+}
+
 TEST_F(CompareRunsTest, LabelsRunsOfTheSameNameByTheirParentFolders) {
   std::vector<CompareRun> runs(3);
   fs::create_directories(dir_ / "x" / "run");
