@@ -1,7 +1,10 @@
 // kuka_probe: measures KukaDiverseObjectEnv: physics steps/s, rendered frames/s, env steps/s
 // with rendering, and the grasp success rates of the scripted oracle and of a random policy.
 // Rates are given per second of this process's CPU time (what one actor gets from one free core)
-// and per wall-clock second (lower on a busy machine).
+// and per wall-clock second (lower on a busy machine). Where an episode's CPU time goes is split
+// into the reset (building the world and settling the dropped objects), the moving steps, the
+// grasp (the step that closes the gripper and lifts) and the rendering, each with its physics
+// steps.
 //
 //   kuka_probe [--episodes N] [--test] [--seed S] [--iterations I] [--reference-physics]
 //              [--no-render] [--frames F] [--json]
@@ -11,6 +14,7 @@
 //
 // --test draws held-out objects with 20 steps an episode (evaluation); --reference-physics uses
 // the reference's 150 solver iterations and compliant fingertips.
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -19,6 +23,7 @@
 #include <ctime>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "envs/kuka/kuka_diverse_object_env.h"
@@ -40,6 +45,12 @@ double CpuSeconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
+// CPU seconds and physics steps of one part of the episodes.
+struct Part {
+  double cpu_seconds = 0;
+  int64_t physics_steps = 0;
+};
+
 struct Rates {
   int episodes = 0;
   int successes = 0;
@@ -47,7 +58,11 @@ struct Rates {
   int64_t physics_steps = 0;
   double seconds = 0;
   double cpu_seconds = 0;
+  Part reset, moves, grasp, render;
 };
+
+// Physics steps of a step that grasps: the closing and the lifting (500 each) and more.
+constexpr int64_t kGraspPhysicsSteps = 1000;
 
 // Runs `episodes` episodes with the oracle (or uniformly random actions), rendering every
 // observation at the native size when `render` is set.
@@ -59,16 +74,33 @@ Rates Run(rl::envs::KukaDiverseObjectEnv& env, int episodes, uint64_t seed, bool
   int w = 0, h = 0;
   const auto start = Clock::now();
   const double cpu_start = CpuSeconds();
+  // Adds the CPU time since `*cpu` and the physics steps since `*physics` to `part`, and moves
+  // both marks on.
+  const auto charge = [&env](Part* part, double* cpu, int64_t* physics) {
+    const double now = CpuSeconds();
+    part->cpu_seconds += now - *cpu;
+    part->physics_steps += env.physics_steps() - *physics;
+    *cpu = now;
+    *physics = env.physics_steps();
+  };
   for (int e = 0; e < episodes; ++e) {
+    double cpu = CpuSeconds();
+    int64_t physics = 0;  // physics_steps() counts from the reset
     env.Reset(seed + e);
+    charge(&r.reset, &cpu, &physics);
     if (render) env.Render(&rgb, &w, &h);
+    charge(&r.render, &cpu, &physics);
     bool done = false;
     double reward = 0;
     while (!done) {
       const int action = oracle ? rl::envs::kuka::OracleAction(env)
                                 : static_cast<int>(rl::envs::UniformInt(rng, 0, 7));
+      const int64_t before = env.physics_steps();
       const rl::envs::StepResult s = env.Step(rl::envs::DiscreteAction(action));
+      const bool grasped = env.physics_steps() - before >= kGraspPhysicsSteps;
+      charge(grasped ? &r.grasp : &r.moves, &cpu, &physics);
       if (render) env.Render(&rgb, &w, &h);
+      charge(&r.render, &cpu, &physics);
       reward += s.reward;
       done = s.terminated || s.truncated;
       ++r.env_steps;
@@ -82,6 +114,11 @@ Rates Run(rl::envs::KukaDiverseObjectEnv& env, int episodes, uint64_t seed, bool
   return r;
 }
 
+// The parts of an episode, named.
+std::array<std::pair<const char*, const Part*>, 4> Parts(const Rates& r) {
+  return {{{"reset", &r.reset}, {"moves", &r.moves}, {"grasp", &r.grasp}, {"render", &r.render}}};
+}
+
 void Print(const char* name, const Rates& r) {
   std::printf(
       "%-7s episodes %d  success %.3f  steps/episode %.2f  physics steps/episode %.0f\n"
@@ -90,6 +127,12 @@ void Print(const char* name, const Rates& r) {
       static_cast<double>(r.env_steps) / r.episodes,
       static_cast<double>(r.physics_steps) / r.episodes, r.env_steps / r.cpu_seconds,
       r.physics_steps / r.cpu_seconds, r.env_steps / r.seconds, r.physics_steps / r.seconds);
+  std::printf("        CPU ms per episode (physics steps):");
+  for (const auto& [part_name, part] : Parts(r)) {
+    std::printf("  %s %.1f (%.0f)", part_name, 1e3 * part->cpu_seconds / r.episodes,
+                static_cast<double>(part->physics_steps) / r.episodes);
+  }
+  std::printf("\n");
 }
 
 // The Rates of one policy as JSON lines: env steps/s, physics steps/s and episodes per hour per
@@ -115,6 +158,13 @@ void PrintJson(const char* policy, const Rates& r, bool test) {
       "{\"bench\": \"kuka_grasp_success\", \"value\": %.3f, \"unit\": \"fraction\", \"policy\": "
       "\"%s\", \"objects\": \"%s\", \"episodes\": %d}\n",
       static_cast<double>(r.successes) / r.episodes, policy, objects, r.episodes);
+  for (const auto& [part_name, part] : Parts(r)) {
+    std::printf(
+        "{\"bench\": \"kuka_episode_cpu_ms\", \"value\": %.2f, \"unit\": \"ms\", \"policy\": "
+        "\"%s\", \"part\": \"%s\", \"physics_steps\": %.0f}\n",
+        1e3 * part->cpu_seconds / r.episodes, policy, part_name,
+        static_cast<double>(part->physics_steps) / r.episodes);
+  }
 }
 
 }  // namespace
