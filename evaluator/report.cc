@@ -509,7 +509,7 @@ void WriteReport(const std::string& dir, const std::vector<EvalRecord>& records,
   const std::vector<TrainingSeries> training = WriteTrainingCurves(dir, info.metrics_file);
 
   const Highlights highlights = FindHighlights(records, info.goal);
-  const std::vector<EpisodesAtUpdate> episodes = LoadEpisodesByUpdate(info.metrics_file);
+  const std::vector<EpisodesAtUpdate> episodes = LoadActorEpisodes(info.metrics_file).by_update;
   std::string h = Header(info, records.size());
   h += SummarySection(highlights, info, episodes);
   h += CurvesSections(training);

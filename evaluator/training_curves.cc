@@ -82,40 +82,33 @@ std::vector<TrainingSeries> LoadTrainingSeries(const std::string& path) {
   return kept;
 }
 
-void ActorEpisodeCounter::Add(const std::string& role, int64_t episodes) {
-  auto& [earlier, current] = by_role_[role];
-  if (episodes < current) earlier += current;
-  current = episodes;
-}
-
-int64_t ActorEpisodeCounter::total() const {
-  int64_t total = 0;
-  for (const auto& [role, counts] : by_role_) total += counts.first + counts.second;
-  return total;
-}
-
-std::vector<EpisodesAtUpdate> LoadEpisodesByUpdate(const std::string& path) {
+ActorEpisodes LoadActorEpisodes(const std::string& path) {
   std::ifstream in(path);
-  ActorEpisodeCounter counter;
-  bool any_actor = false;
-  std::vector<EpisodesAtUpdate> points;
+  std::map<std::string, std::pair<int64_t, int64_t>> by_role;  // {earlier lives, this life}
+  const auto total = [&by_role] {
+    int64_t sum = 0;
+    for (const auto& [role, counts] : by_role) sum += counts.first + counts.second;
+    return sum;
+  };
+  ActorEpisodes result;
   for (std::string line; std::getline(in, line);) {
     const std::optional<nlohmann::json> obj = ParseJsonLine(line);
     if (!obj) continue;
     const std::optional<std::string> role = JsonStringAt(*obj, "role");
     if (!role) continue;
     if (role->rfind("actor-", 0) == 0) {
-      if (const auto episodes = JsonIntegerAt(*obj, "episodes")) {
-        counter.Add(*role, *episodes);
-        any_actor = true;
-      }
+      const std::optional<int64_t> episodes = JsonIntegerAt(*obj, "episodes");
+      if (!episodes) continue;
+      auto& [earlier, current] = by_role[*role];
+      if (*episodes < current) earlier += current;
+      current = *episodes;
     } else if (*role == "learner") {
-      if (const auto updates = JsonIntegerAt(*obj, "updates"); updates && any_actor) {
-        points.push_back({*updates, counter.total()});
-      }
+      const std::optional<int64_t> updates = JsonIntegerAt(*obj, "updates");
+      if (updates && !by_role.empty()) result.by_update.push_back({*updates, total()});
     }
   }
-  return points;
+  result.total = total();
+  return result;
 }
 
 std::optional<int64_t> EpisodesAt(const std::vector<EpisodesAtUpdate>& points, int64_t update) {

@@ -4,10 +4,8 @@
 #pragma once
 
 #include <cstdint>
-#include <map>
 #include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "evaluator/learning_curve.h"
@@ -29,28 +27,24 @@ struct TrainingSeries {
 /// parse (a torn last line) are skipped. A missing file gives no plots. O(file size).
 std::vector<TrainingSeries> LoadTrainingSeries(const std::string& path);
 
-/// Counts the episodes of a run's actors from their metrics lines, all their lives together: a
-/// restarted actor counts from 0 again, so a drop in one actor's count adds the count before it.
-class ActorEpisodeCounter {
- public:
-  /// One actor line: the actor's role ("actor-3") and its episode count.
-  void Add(const std::string& role, int64_t episodes);
-  int64_t total() const;
-
- private:
-  std::map<std::string, std::pair<int64_t, int64_t>> by_role_;  // {earlier lives, this life}
-};
-
 /// The actors' episodes (all lives) when the learner had made `updates` updates.
 struct EpisodesAtUpdate {
   int64_t updates = 0;
   int64_t episodes = 0;
 };
 
-/// One point per learner line of the metrics file at `path`, in file order: the learner's
-/// updates and the actors' episodes of the lines before it. Empty for a missing file (or an
-/// empty path) or one without actors' episodes. Lines that do not parse are skipped. O(file size).
-std::vector<EpisodesAtUpdate> LoadEpisodesByUpdate(const std::string& path);
+/// The episodes of a run's actors in its metrics file, all their lives together: a restarted
+/// actor counts from 0 again, so a drop in one actor's count adds the count before it.
+struct ActorEpisodes {
+  /// One point per learner line after the first actor line, in file order: the learner's
+  /// updates and the actors' episodes of the lines before it.
+  std::vector<EpisodesAtUpdate> by_update;
+  int64_t total = 0;  // by the end of the file
+};
+
+/// Reads the metrics file at `path`: empty for a missing file (or an empty path) or one without
+/// actors' episodes. Lines that do not parse are skipped. O(file size).
+ActorEpisodes LoadActorEpisodes(const std::string& path);
 
 /// The training episodes by the checkpoint at `update`: those of the first point with at least
 /// that many updates; nullopt when the points end before it.

@@ -573,7 +573,7 @@ CompareRun LoadCompareRun(const std::string& dir) {
   if (run.records.empty()) {
     throw std::runtime_error(dir + ": eval.jsonl has no evaluation yet");
   }
-  run.episodes = evaluator::LoadEpisodesByUpdate((fs::path(dir) / "metrics.jsonl").string());
+  run.episodes = evaluator::LoadActorEpisodes((fs::path(dir) / "metrics.jsonl").string()).by_update;
   return run;
 }
 

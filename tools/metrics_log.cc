@@ -134,20 +134,7 @@ double LastT(const std::string& path) {
 
 }  // namespace
 
-int64_t ActorEpisodes(const std::string& path) {
-  std::ifstream in(path);
-  evaluator::ActorEpisodeCounter counter;
-  std::string line;
-  while (std::getline(in, line)) {
-    const auto object = ParseJsonLine(line);
-    if (!object) continue;
-    const auto role = JsonStringAt(*object, "role");
-    const auto episodes = JsonIntegerAt(*object, "episodes");
-    if (!role || role->rfind("actor-", 0) != 0 || !episodes) continue;
-    counter.Add(*role, *episodes);
-  }
-  return counter.total();
-}
+int64_t ActorEpisodes(const std::string& path) { return evaluator::LoadActorEpisodes(path).total; }
 
 MetricsLog::MetricsLog(const std::string& path, double dense_seconds, double dense_period,
                        double sparse_period)

@@ -61,9 +61,6 @@ struct Rates {
   Part reset, moves, grasp, render;
 };
 
-// Physics steps of a step that grasps: the closing and the lifting (500 each) and more.
-constexpr int64_t kGraspPhysicsSteps = 1000;
-
 // Runs `episodes` episodes with the oracle (or uniformly random actions), rendering every
 // observation at the native size when `render` is set.
 Rates Run(rl::envs::KukaDiverseObjectEnv& env, int episodes, uint64_t seed, bool oracle,
@@ -95,10 +92,9 @@ Rates Run(rl::envs::KukaDiverseObjectEnv& env, int episodes, uint64_t seed, bool
     while (!done) {
       const int action = oracle ? rl::envs::kuka::OracleAction(env)
                                 : static_cast<int>(rl::envs::UniformInt(rng, 0, 7));
-      const int64_t before = env.physics_steps();
       const rl::envs::StepResult s = env.Step(rl::envs::DiscreteAction(action));
-      const bool grasped = env.physics_steps() - before >= kGraspPhysicsSteps;
-      charge(grasped ? &r.grasp : &r.moves, &cpu, &physics);
+      // The step that closed the gripper and lifted (the episode's last).
+      charge(env.attempted_grasp() ? &r.grasp : &r.moves, &cpu, &physics);
       if (render) env.Render(&rgb, &w, &h);
       charge(&r.render, &cpu, &physics);
       reward += s.reward;

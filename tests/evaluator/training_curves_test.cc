@@ -110,7 +110,9 @@ TEST(TrainingCurvesTest, EpisodesByUpdateCountEveryLifeOfTheActors) {
         << "\n"
         << R"({"t": 4, "role": "learner", "upd)";  // cut short
   }
-  const std::vector<EpisodesAtUpdate> points = LoadEpisodesByUpdate(path);
+  const ActorEpisodes episodes = LoadActorEpisodes(path);
+  EXPECT_EQ(episodes.total, 5 + 2 + 3);
+  const std::vector<EpisodesAtUpdate>& points = episodes.by_update;
   ASSERT_EQ(points.size(), 2u);
   EXPECT_EQ(points[0].updates, 100);
   EXPECT_EQ(points[0].episodes, 5 + 3);
@@ -120,7 +122,7 @@ TEST(TrainingCurvesTest, EpisodesByUpdateCountEveryLifeOfTheActors) {
   EXPECT_EQ(EpisodesAt(points, 100), 8);
   EXPECT_EQ(EpisodesAt(points, 101), 10);  // the first point at or past the update
   EXPECT_EQ(EpisodesAt(points, 251), std::nullopt);
-  EXPECT_TRUE(LoadEpisodesByUpdate(dir / "missing.jsonl").empty());
+  EXPECT_TRUE(LoadActorEpisodes(dir / "missing.jsonl").by_update.empty());
 }
 
 TEST(TrainingCurvesTest, TheReportSaysTheTrainingEpisodesOfEachCheckpoint) {
