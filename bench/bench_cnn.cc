@@ -28,6 +28,7 @@
 // bf16 emulated on this CPU).
 //
 // Usage: bench_cnn [repeats (5)] [seconds per measurement (1.0)] [thread counts ("1,2")]
+//                  [what ("nature_cnn,grasp_cnn,actors")]
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -514,13 +515,28 @@ void BenchConvPasses(const NetSpec& spec, const Sequential& net, rl::nn::Precisi
 int main(int argc, char** argv) {
   const rl::bench::Args args(
       argc, argv,
-      "usage: bench_cnn [REPEATS (5)] [SECONDS per repeat (1)] [THREADS (1,2)]\n"
+      "usage: bench_cnn [REPEATS (5)] [SECONDS per repeat (1)] [THREADS (1,2)] [WHAT]\n"
       "Pixel networks' updates/s, latency and GFLOP/s against the machine's "
-      "peaks (JSON lines).",
-      3);
+      "peaks (JSON lines). WHAT: a comma-separated subset of nature_cnn, grasp_cnn and "
+      "actors (the TD3 actors' latency), all by default.",
+      4);
   const int repeats = args.Int(0, 5);
   const double seconds = args.Number(1, 1.0);
   const std::vector<int> thread_counts = ParseThreads(args.Text(2, "1,2").c_str());
+  std::vector<std::string> what;
+  {
+    std::stringstream ss(args.Text(3, "nature_cnn,grasp_cnn,actors"));
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+      if (item != "nature_cnn" && item != "grasp_cnn" && item != "actors") {
+        args.Fail("WHAT is a list of nature_cnn, grasp_cnn and actors, not '" + item + "'");
+      }
+      what.push_back(item);
+    }
+  }
+  const auto wanted = [&what](const std::string& name) {
+    return std::find(what.begin(), what.end(), name) != what.end();
+  };
   if (thread_counts.empty() ||
       std::any_of(thread_counts.begin(), thread_counts.end(), [](int t) { return t < 1; })) {
     args.Fail("THREADS is a list of thread counts, e.g. 1,2");
@@ -545,6 +561,7 @@ int main(int argc, char** argv) {
     rl::nn::SetNumThreads(threads);
     const Peaks peaks = MeasurePeaks(threads, repeats, seconds);
     for (const NetSpec& spec : nets) {
+      if (!wanted(spec.name)) continue;
       for (const rl::nn::Precision precision : precisions) {
         std::mt19937 rng(1);
         Sequential net = spec.make(&rng);
@@ -556,6 +573,7 @@ int main(int argc, char** argv) {
       }
     }
     for (const auto& [name, arch] : actors) {
+      if (!wanted("actors")) break;
       for (const rl::nn::Precision precision : precisions) {
         std::mt19937 rng(1);
         Sequential net = rl::nn::BuildFromArchitecture(arch, &rng);

@@ -172,10 +172,7 @@ void Conv2d::Im2col(const float* planes, int count, bool panels, Scratch* scratc
     // Pairs are 4 bytes, as floats.
     const int64_t size = internal::PackedPairs(static_cast<int>(m), geo_.taps);
     if (scratch->cols.size() < size) scratch->cols.setZero(size);
-    const int64_t panel = internal::Im2colPairsPanelFloats(geo_);
-    if (scratch->panel.size() < panel) scratch->panel.resize(panel);
-    kernels.im2col_pairs(geo_, planes, count, reinterpret_cast<uint32_t*>(scratch->cols.data()),
-                         scratch->panel.data());
+    kernels.im2col_pairs(geo_, planes, count, reinterpret_cast<uint32_t*>(scratch->cols.data()));
     return;
   }
   if (panels) {

@@ -88,7 +88,6 @@ class Conv2d : public Layer {
     Vector planes;      // Phase planes of one group.
     Vector padded_row;  // A zero-padded input row: plane_w_ * stride floats.
     Vector cols;        // Unfolded group: (group * P) x taps, column-major or packed.
-    Vector panel;       // One panel of the unfolding into bf16 pairs (Im2colPairsPanelFloats()).
     Vector group_out;   // (group * P) x out_channels: a product before it is scattered.
     Vector dcols;       // Gradient of cols, after dcols_front_ floats of slack.
     std::vector<internal::GradientRun> runs;  // (kernel / stride, rounded up)^2 entries.

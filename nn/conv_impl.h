@@ -205,6 +205,30 @@ void Im2colPanels(const ConvGeometry& g, const float* planes, int count, int pan
   const int64_t m = static_cast<int64_t>(count) * g.pixels;
   const int64_t panels = (m + panel_rows - 1) / panel_rows;
   std::array<PanelPiece, kMaxPanelRows> pieces{};
+#if RL_NN_AVX512
+  // Whole vectors of a tap's panel row gathered in registers (panel_gather_impl.h): one store
+  // each, where copying the pieces one by one stores each in parts.
+  if (panel_rows % 16 == 0) {
+    constexpr int kMaxVectors = kMaxPanelRows / 16;
+    const int vectors = panel_rows / 16;
+    std::array<PanelLoad, kMaxVectors * kMaxLoadsPerVector> loads{};
+    std::array<int, kMaxVectors + 1> first{};
+    for (int64_t q = 0; q < panels; ++q) {
+      const int n_pieces = PanelPieces(g, q, panel_rows, m, pieces.data());
+      PlanPanelLoads(pieces.data(), n_pieces, vectors, loads.data(), first.data());
+      float* dst = cols + q * panel_rows * g.taps;
+      for (int tap = 0; tap < g.taps; ++tap, dst += panel_rows) {
+        const float* src = planes + g.tap_offset[static_cast<size_t>(tap)];
+        for (int v = 0; v < vectors; ++v) {
+          const int n = first[static_cast<size_t>(v + 1)] - first[static_cast<size_t>(v)];
+          _mm512_storeu_ps(dst + v * 16,
+                           GatherVector(loads.data() + first[static_cast<size_t>(v)], n, src));
+        }
+      }
+    }
+    return;
+  }
+#endif
   for (int64_t q = 0; q < panels; ++q) {
     const int n_pieces = PanelPieces(g, q, panel_rows, m, pieces.data());
     float* dst = cols + q * panel_rows * g.taps;

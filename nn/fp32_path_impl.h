@@ -15,6 +15,9 @@
 RL_NN_TARGET_BEGIN(RL_NN_TARGETS)
 #include "nn/gemm_block_impl.h"
 // (after the block helpers it uses)
+#if RL_NN_AVX512
+#include "nn/panel_gather_impl.h"
+#endif
 #include "nn/conv_impl.h"
 #include "nn/gemm_fp32_impl.h"
 #include "nn/gemv_impl.h"

@@ -16,7 +16,6 @@ constexpr int kL = 16;
 constexpr int kMaxV = 3;
 constexpr int kNrB = 8;
 constexpr int kMrB = kMaxV * kL;
-static_assert(kMrB == 48, "nn/kernels.h sizes the scratch space of Im2colPairs() for 48 rows");
 // Pairs of the shared dimension per slice: a packed panel of 48 x 128 pairs (24 KB) stays in L1
 // while B streams by.
 constexpr int kKcPairs = 128;
@@ -343,93 +342,32 @@ void GemmPairsOneBf16(const uint32_t* a_pairs, int m, int k, const ConstView& b,
   PanelGemmBf16({nullptr, m, k, 0, 0}, b, c, accumulate, epilogue, workspace, {nullptr, a_pairs});
 }
 
-// Taps gathered before they are paired: 32 rows of 48 floats (6 KB), with the planes' floats
-// they read, stay in L1 (nn/kernels.h sizes the scratch space of Im2colPairs() for it).
-constexpr int kGatherTaps = 32;
-static_assert(kGatherTaps % 2 == 0, "a block of taps holds whole pairs");
-
-// One copy of the unfolding's gather: up to 16 plane floats (for tap offset 0) into a run of a
-// panel row.
-struct GatherChunk {
-  int64_t src;
-  int lane;
-  __mmask16 mask;  // The floats it copies.
-};
-
 // The convolution's unfolding (conv_impl.h's Im2colPanels()) straight into bf16 pairs, a panel
-// at a time and 32 taps at a time: those rows unfolded as floats into `panel` (32 x 48 floats),
-// then rounded and paired. (Pairing each two taps as they are gathered would read
-// vectors just written in pieces, which stalls on store forwarding.) The panel's pieces are cut
-// into chunks of 16 once per panel, and every tap copies the chunks with whole-vector loads and
-// stores where it can: a chunk's store may write past its run, because the next chunk of the row
-// overwrites those lanes (only the row's last chunk is a masked store), and its load may read
-// past its run while that stays inside the group's planes.
-void Im2colPairs(const ConvGeometry& g, const float* planes, int count, uint32_t* pairs,
-                 float* panel) {
+// at a time: every pair of taps reads its two panel rows into registers (panel_gather_impl.h),
+// rounds and pairs them, and stores the pairs, one whole store per vector and tap pair.
+void Im2colPairs(const ConvGeometry& g, const float* planes, int count, uint32_t* pairs) {
   const int64_t m = static_cast<int64_t>(count) * g.pixels;
   const int64_t panels = (m + kMrB - 1) / kMrB;
   const int steps = (g.taps + 1) / 2;
-  // A whole-vector load at chunk offset o reads [o + tap_offset, o + tap_offset + 16).
-  const int64_t readable = static_cast<int64_t>(count) * g.plane_stride;
-  const int64_t max_tap_offset = *std::max_element(g.tap_offset.begin(), g.tap_offset.end());
   std::array<PanelPiece, kMrB> pieces{};
-  std::array<GatherChunk, 2 * kMrB> chunks{};
+  std::array<PanelLoad, kMaxV * kMaxLoadsPerVector> loads{};
+  std::array<int, kMaxV + 1> first{};
   for (int64_t q = 0; q < panels; ++q) {
     const int n_pieces = PanelPieces(g, q, kMrB, m, pieces.data());
-    int n_chunks = 0;
-    for (int i = 0; i < n_pieces; ++i) {
-      const PanelPiece& piece = pieces[static_cast<size_t>(i)];
-      for (int x = 0; x < piece.n; x += 16) {
-        chunks[static_cast<size_t>(n_chunks++)] = {piece.src + x, piece.lane + x,
-                                                   FirstLanes(piece.n - x)};
-      }
-    }
-    // Chunks [0, whole_stores) end their row's 16 lanes inside it and have a chunk after them;
-    // the rest are masked stores. Lanes rise through the panel, so they are a prefix.
-    int whole_stores = 0;
-    while (whole_stores < n_chunks - 1 &&
-           chunks[static_cast<size_t>(whole_stores)].lane + 16 <= kMrB) {
-      ++whole_stores;
-    }
-    const bool whole_loads =
-        chunks[static_cast<size_t>(n_chunks - 1)].src + max_tap_offset + 16 <= readable;
-    const int64_t r_end = std::min(m, (q + 1) * kMrB);
-    const int filled = static_cast<int>(r_end - q * kMrB);
-    // Taps a block at a time, each block gathered and then paired while it is still in L1.
+    PlanPanelLoads(pieces.data(), n_pieces, kMaxV, loads.data(), first.data());
     Pair* dst = pairs + q * kMrB * steps;
-    for (int t0 = 0; t0 < g.taps; t0 += kGatherTaps) {
-      const int t1 = std::min(g.taps, t0 + kGatherTaps);
-      float* row = panel;
-      for (int tap = t0; tap < t1; ++tap, row += kMrB) {
-        const float* src = planes + g.tap_offset[static_cast<size_t>(tap)];
-        if (whole_loads) {
-          int i = 0;
-          for (; i < whole_stores; ++i) {
-            const GatherChunk& c = chunks[static_cast<size_t>(i)];
-            _mm512_storeu_ps(row + c.lane, _mm512_loadu_ps(src + c.src));
-          }
-          for (; i < n_chunks; ++i) {
-            const GatherChunk& c = chunks[static_cast<size_t>(i)];
-            _mm512_mask_storeu_ps(row + c.lane, c.mask, _mm512_loadu_ps(src + c.src));
-          }
-        } else {
-          for (int i = 0; i < n_chunks; ++i) {
-            const GatherChunk& c = chunks[static_cast<size_t>(i)];
-            _mm512_mask_storeu_ps(row + c.lane, c.mask, _mm512_maskz_loadu_ps(c.mask, src + c.src));
-          }
-        }
-        // Rows past m (the last panel only) are zero.
-        std::fill(row + filled, row + kMrB, 0.0f);
-      }
+    for (int tap = 0; tap < g.taps; tap += 2, dst += kMrB) {
+      const float* even = planes + g.tap_offset[static_cast<size_t>(tap)];
       // An odd number of taps pairs the last one with zeros.
-      if ((t1 - t0) % 2 != 0) std::fill(row, row + kMrB, 0.0f);
-      const float* even = panel;
-      for (int tap = t0; tap < t1; tap += 2, dst += kMrB, even += 2 * kMrB) {
+      const bool has_odd = tap + 1 < g.taps;
+      const float* odd = has_odd ? planes + g.tap_offset[static_cast<size_t>(tap + 1)] : nullptr;
 #pragma GCC unroll 3
-        for (int v = 0; v < kMaxV; ++v) {
-          _mm512_storeu_si512(dst + v * kL, PairUp(_mm512_loadu_ps(even + v * kL),
-                                                   _mm512_loadu_ps(even + kMrB + v * kL)));
-        }
+      for (int v = 0; v < kMaxV; ++v) {
+        const PanelLoad* vector_loads = loads.data() + first[static_cast<size_t>(v)];
+        const int n = first[static_cast<size_t>(v + 1)] - first[static_cast<size_t>(v)];
+        const __m512 e = GatherVector(vector_loads, n, even);
+        const __m512 o = has_odd ? GatherVector(vector_loads, n, odd) : _mm512_setzero_ps();
+        _mm512_storeu_si512(dst + v * kL, PairUp(e, o));
       }
     }
   }

@@ -103,10 +103,8 @@ struct KernelSet {
   GemmFn gemm_bf16;
   GemmPackedFn gemm_packed_bf16;
   GemmPairsFn gemm_pairs_bf16;
-  // Im2col in the bf16 pairs of GemmPackedPairs() (nn/gemm.h), `count` samples; `panel` is
-  // scratch space of Im2colPairsPanelFloats() floats.
-  void (*im2col_pairs)(const ConvGeometry& g, const float* planes, int count, uint32_t* pairs,
-                       float* panel);
+  // Im2col in the bf16 pairs of GemmPackedPairs() (nn/gemm.h), `count` samples.
+  void (*im2col_pairs)(const ConvGeometry& g, const float* planes, int count, uint32_t* pairs);
   // Outputs [i_begin, i_end) of Gemv() (nn/gemv.h), i_begin a multiple of 128.
   void (*gemv_rows)(const float* w, int out, int in, const float* x, const float* b, bool relu,
                     float* y, int i_begin, int i_end);
@@ -129,11 +127,6 @@ struct KernelSet {
   // Writes plane_h x plane_w floats (row-major) into `out`: the sum of the runs.
   void (*plane_gradient)(const ConvGeometry& g, const GradientRun* runs, int n_runs, float* out);
 };
-
-/// The scratch space of KernelSet::im2col_pairs: 48 rows of up to 32 taps, an even number.
-inline int64_t Im2colPairsPanelFloats(const ConvGeometry& g) {
-  return 48 * std::min(32, (g.taps + 1) / 2 * 2);
-}
 
 /// The set in use (see KernelPath() in nn/precision.h). Throws std::runtime_error the first time
 /// when RL_KERNELS asks for a path that cannot run.

@@ -17,7 +17,8 @@ RL_NN_TARGET_BEGIN(
 #define RL_NN_ISA avx512_bf16
 #define RL_NN_AVX512 1
 #include "nn/gemm_block_impl.h"
-// (after the block helpers it uses)
+#include "nn/panel_gather_impl.h"
+// (after the block helpers and the gather it uses)
 #include "nn/gemm_bf16_impl.h"
 RL_NN_TARGET_END
 
