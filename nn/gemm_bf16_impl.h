@@ -360,11 +360,11 @@ void Im2colPairs(const ConvGeometry& g, const float* planes, int count, uint32_t
       const float* even = planes + g.tap_offset[static_cast<size_t>(tap)];
       // An odd number of taps pairs the last one with zeros.
       const bool has_odd = tap + 1 < g.taps;
-      const float* odd = has_odd ? planes + g.tap_offset[static_cast<size_t>(tap + 1)] : nullptr;
+      const float* odd = has_odd ? planes + g.tap_offset[static_cast<size_t>(tap) + 1] : nullptr;
 #pragma GCC unroll 3
       for (int v = 0; v < kMaxV; ++v) {
         const PanelLoad* vector_loads = loads.data() + first[static_cast<size_t>(v)];
-        const int n = first[static_cast<size_t>(v + 1)] - first[static_cast<size_t>(v)];
+        const int n = first[static_cast<size_t>(v) + 1] - first[static_cast<size_t>(v)];
         const __m512 e = GatherVector(vector_loads, n, even);
         const __m512 o = has_odd ? GatherVector(vector_loads, n, odd) : _mm512_setzero_ps();
         _mm512_storeu_si512(dst + v * kL, PairUp(e, o));
