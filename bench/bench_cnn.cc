@@ -406,13 +406,20 @@ int64_t SectionsOf(const std::function<void()>& op) {
   return rl::nn::internal::ParallelSections() - before;
 }
 
-std::vector<int> ParseThreads(const char* arg) {
-  std::vector<int> out;
-  std::stringstream ss(arg);
+// The non-empty items of a comma-separated list.
+std::vector<std::string> SplitCommas(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {
-    if (!item.empty()) out.push_back(std::atoi(item.c_str()));
+    if (!item.empty()) out.push_back(item);
   }
+  return out;
+}
+
+std::vector<int> ParseThreads(const std::string& arg) {
+  std::vector<int> out;
+  for (const std::string& item : SplitCommas(arg)) out.push_back(std::atoi(item.c_str()));
   return out;
 }
 
@@ -522,16 +529,12 @@ int main(int argc, char** argv) {
       4);
   const int repeats = args.Int(0, 5);
   const double seconds = args.Number(1, 1.0);
-  const std::vector<int> thread_counts = ParseThreads(args.Text(2, "1,2").c_str());
-  std::vector<std::string> what;
-  {
-    std::stringstream ss(args.Text(3, "nature_cnn,grasp_cnn,actors"));
-    std::string item;
-    while (std::getline(ss, item, ',')) {
-      if (item != "nature_cnn" && item != "grasp_cnn" && item != "actors") {
-        args.Fail("WHAT is a list of nature_cnn, grasp_cnn and actors, not '" + item + "'");
-      }
-      what.push_back(item);
+  const std::vector<int> thread_counts = ParseThreads(args.Text(2, "1,2"));
+  const std::vector<std::string> what = SplitCommas(args.Text(3, "nature_cnn,grasp_cnn,actors"));
+  if (what.empty()) args.Fail("WHAT names nothing to measure");
+  for (const std::string& item : what) {
+    if (item != "nature_cnn" && item != "grasp_cnn" && item != "actors") {
+      args.Fail("WHAT is a list of nature_cnn, grasp_cnn and actors, not '" + item + "'");
     }
   }
   const auto wanted = [&what](const std::string& name) {

@@ -220,9 +220,8 @@ void Im2colPanels(const ConvGeometry& g, const float* planes, int count, int pan
       for (int tap = 0; tap < g.taps; ++tap, dst += panel_rows) {
         const float* src = planes + g.tap_offset[static_cast<size_t>(tap)];
         for (int v = 0; v < vectors; ++v) {
-          const int n = first[static_cast<size_t>(v) + 1] - first[static_cast<size_t>(v)];
           _mm512_storeu_ps(dst + v * 16,
-                           GatherVector(loads.data() + first[static_cast<size_t>(v)], n, src));
+                           GatherVector(LoadsOfVector(loads.data(), first.data(), v), src));
         }
       }
     }

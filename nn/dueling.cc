@@ -102,7 +102,10 @@ void Dueling::BackwardParams(const Matrix& grad_out) {
 std::vector<Param> Dueling::Params() {
   std::vector<Param> params;
   auto add = [&params](const std::string& prefix, Linear& layer) {
-    for (Param& p : layer.Params()) params.push_back({prefix + p.name, p.value, p.grad});
+    for (Param& p : layer.Params()) {
+      p.name = prefix + p.name;
+      params.push_back(p);
+    }
   };
   add("value.0.", value_hidden_);
   add("value.2.", value_out_);

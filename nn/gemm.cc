@@ -203,6 +203,24 @@ void GemmPackedPairs(const uint32_t* a_pairs, int m, int k, ConstView b, MutView
               });
 }
 
+void RoundIntoPairs(ConstView a, uint32_t* pairs) {
+  const KernelSet& set = Kernels();
+  RL_CHECK(set.round_into_pairs != nullptr) << "RoundIntoPairs on the " << set.name << " path";
+  const int rows_per_panel = set.bf16_panel_rows;
+  const int panels = (a.rows + rows_per_panel - 1) / rows_per_panel;
+  const int64_t pairs_per_row = (a.cols + 1) / 2;
+  const int tasks = TasksForElements(static_cast<int64_t>(a.rows) * a.cols, panels);
+  ParallelFor(tasks, [&](int task) {
+    const int i0 = panels * task / tasks * rows_per_panel;
+    const int i1 = std::min(a.rows, panels * (task + 1) / tasks * rows_per_panel);
+    set.round_into_pairs(a, i0, i1 - i0, pairs + i0 * pairs_per_row);
+  });
+}
+
+bool GemmUsesPairs(ConstView a, ConstView b, MutView c) {
+  return Kernels().gemm_bf16 != nullptr && Bf16Applies(a, b, c);
+}
+
 void AddRowSums(const Matrix& g, float* out) {
   Kernels().add_row_sums(g.data(), static_cast<int>(g.rows()), static_cast<int>(g.cols()), out);
 }

@@ -108,6 +108,15 @@ int64_t PackedPairs(int m, int k);
 void GemmPackedPairs(const uint32_t* a_pairs, int m, int k, ConstView b, MutView c, bool accumulate,
                      const Epilogue& epilogue, GemmWorkspace* workspace);
 
+/// `a` rounded to bfloat16 and packed into `pairs` (PackedPairs(a.rows, a.cols) words), the layout
+/// of GemmPackedPairs(): a left operand packed once for several products (Linear's weight). Only
+/// where NativeBf16(); aborts elsewhere. Split over threads by panels. O(a.rows a.cols).
+void RoundIntoPairs(ConstView a, uint32_t* pairs);
+
+/// Whether Gemm(a, b, c, ..., Precision::kBf16) multiplies the bf16 pairs of `a` on the CPU's
+/// instructions, so that GemmPackedPairs() of RoundIntoPairs(a) computes the same c, bit for bit.
+bool GemmUsesPairs(ConstView a, ConstView b, MutView c);
+
 /// out[i] += sum_j g(i, j) for a column-major g (the bias gradient of a batch). O(rows cols).
 void AddRowSums(const Matrix& g, float* out);
 

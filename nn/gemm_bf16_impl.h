@@ -342,6 +342,16 @@ void GemmPairsOneBf16(const uint32_t* a_pairs, int m, int k, const ConstView& b,
   PanelGemmBf16({nullptr, m, k, 0, 0}, b, c, accumulate, epilogue, workspace, {nullptr, a_pairs});
 }
 
+// Rows [i0, i0 + rows) of `a` (i0 a multiple of kMrB) rounded into the bf16 pairs of
+// GemmPackedPairs(), panel i0 / kMrB first, at `pairs`.
+void RoundIntoPairs(const ConstView& a, int i0, int rows, uint32_t* pairs) {
+  const int k2 = (a.cols + 1) / 2;
+  for (int r = 0; r < rows; r += kMrB) {
+    PackPairs(a, i0 + r, std::min(kMrB, rows - r), 0, k2, kMrB, kMrB,
+              pairs + static_cast<int64_t>(r) * k2);
+  }
+}
+
 // The convolution's unfolding (conv_impl.h's Im2colPanels()) straight into bf16 pairs, a panel
 // at a time: every pair of taps reads its two panel rows into registers (panel_gather_impl.h),
 // rounds and pairs them, and stores the pairs, one whole store per vector and tap pair.
@@ -363,10 +373,9 @@ void Im2colPairs(const ConvGeometry& g, const float* planes, int count, uint32_t
       const float* odd = has_odd ? planes + g.tap_offset[static_cast<size_t>(tap) + 1] : nullptr;
 #pragma GCC unroll 3
       for (int v = 0; v < kMaxV; ++v) {
-        const PanelLoad* vector_loads = loads.data() + first[static_cast<size_t>(v)];
-        const int n = first[static_cast<size_t>(v) + 1] - first[static_cast<size_t>(v)];
-        const __m512 e = GatherVector(vector_loads, n, even);
-        const __m512 o = has_odd ? GatherVector(vector_loads, n, odd) : _mm512_setzero_ps();
+        const VectorLoads vector_loads = LoadsOfVector(loads.data(), first.data(), v);
+        const __m512 e = GatherVector(vector_loads, even);
+        const __m512 o = has_odd ? GatherVector(vector_loads, odd) : _mm512_setzero_ps();
         _mm512_storeu_si512(dst + v * kL, PairUp(e, o));
       }
     }

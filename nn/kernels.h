@@ -105,6 +105,9 @@ struct KernelSet {
   GemmPairsFn gemm_pairs_bf16;
   // Im2col in the bf16 pairs of GemmPackedPairs() (nn/gemm.h), `count` samples.
   void (*im2col_pairs)(const ConvGeometry& g, const float* planes, int count, uint32_t* pairs);
+  // Rows [i0, i0 + rows) of `a` (i0 a multiple of bf16_panel_rows) in the bf16 pairs of
+  // GemmPackedPairs(), from the first word of panel i0 / bf16_panel_rows on.
+  void (*round_into_pairs)(const ConstView& a, int i0, int rows, uint32_t* pairs);
   // Outputs [i_begin, i_end) of Gemv() (nn/gemv.h), i_begin a multiple of 128.
   void (*gemv_rows)(const float* w, int out, int in, const float* x, const float* b, bool relu,
                     float* y, int i_begin, int i_end);

@@ -34,6 +34,7 @@ KernelSet Avx512Bf16Kernels() {
   set.gemm_packed_bf16 = &avx512_bf16::GemmPackedOneBf16;
   set.gemm_pairs_bf16 = &avx512_bf16::GemmPairsOneBf16;
   set.im2col_pairs = &avx512_bf16::Im2colPairs;
+  set.round_into_pairs = &avx512_bf16::RoundIntoPairs;
   return set;
 }
 

@@ -53,14 +53,41 @@ const Matrix& Linear::Forward(const Matrix& x) {
     internal::Epilogue epilogue;
     epilogue.row_bias = bias_.data();
     epilogue.relu = fused_output_relu_;
-    internal::Gemm(internal::View(weight_), internal::View(x), internal::View(&output_),
-                   /*accumulate=*/false, epilogue, &workspace_, precision_);
+    const internal::ConstView w = internal::View(weight_);
+    if (precision_ == Precision::kBf16 &&
+        internal::GemmUsesPairs(w, internal::View(x), internal::View(&output_)) &&
+        UseWeightPairs()) {
+      internal::GemmPackedPairs(weight_pairs_.data(), out, w.cols, internal::View(x),
+                                internal::View(&output_), /*accumulate=*/false, epilogue,
+                                &workspace_);
+    } else {
+      internal::Gemm(w, internal::View(x), internal::View(&output_), /*accumulate=*/false, epilogue,
+                     &workspace_, precision_);
+    }
   } else {
     output_.noalias() = weight_ * x;
     output_.colwise() += bias_.col(0);
     if (fused_output_relu_) output_ = output_.cwiseMax(0.0f);
   }
   return output_;
+}
+
+bool Linear::UseWeightPairs() {
+  if (seen_version_ != weight_version_) {
+    pairs_pay_ = passes_at_version_ >= 2;
+    seen_version_ = weight_version_;
+    passes_at_version_ = 0;
+  }
+  ++passes_at_version_;
+  if (have_pairs_ && pairs_version_ == weight_version_) return true;
+  if (!pairs_pay_ && passes_at_version_ == 1) return false;
+  const auto out = static_cast<int>(weight_.rows());
+  const auto in = static_cast<int>(weight_.cols());
+  weight_pairs_.resize(static_cast<size_t>(internal::PackedPairs(out, in)));
+  internal::RoundIntoPairs(internal::View(weight_), weight_pairs_.data());
+  pairs_version_ = weight_version_;
+  have_pairs_ = true;
+  return true;
 }
 
 void Linear::AccumulateParamGrads(const Matrix& grad_out) {
@@ -107,7 +134,7 @@ const Matrix& Linear::Backward(const Matrix& grad_out) {
 }
 
 std::vector<Param> Linear::Params() {
-  return {{"weight", &weight_, &weight_grad_}, {"bias", &bias_, &bias_grad_}};
+  return {{"weight", &weight_, &weight_grad_, &weight_version_}, {"bias", &bias_, &bias_grad_}};
 }
 
 std::string Linear::Describe() const {

@@ -54,6 +54,11 @@ Optimizer::Optimizer(std::vector<Param> params, float lr)
   }
 }
 
+void Optimizer::Step() {
+  UpdateParams();
+  for (const Param& p : params_) p.MarkChanged();
+}
+
 void Optimizer::GetState(std::vector<float>* values, int64_t* steps) const {
   values->clear();
   for (const std::vector<Matrix>* list : state_) {
@@ -94,7 +99,7 @@ Adam::Adam(std::vector<Param> params, float lr, float beta1, float beta2, float 
   RegisterStepCounter(&step_count_);
 }
 
-void Adam::Step() {
+void Adam::UpdateParams() {
   ++step_count_;
   const double t = static_cast<double>(step_count_);
   const auto bias_correction1 = static_cast<float>(1.0 - std::pow(double{beta1_}, t));
@@ -133,7 +138,7 @@ RmsProp::RmsProp(std::vector<Param> params, float lr, float alpha, float eps, bo
   RegisterState(&momentum_buf_);
 }
 
-void RmsProp::Step() {
+void RmsProp::UpdateParams() {
   const float lr = learning_rate();
   const std::vector<Param>& ps = params();
   for (size_t i = 0; i < ps.size(); ++i) {

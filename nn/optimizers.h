@@ -19,8 +19,9 @@ class Optimizer {
   Optimizer(const Optimizer&) = delete;
   Optimizer& operator=(const Optimizer&) = delete;
 
-  /// Applies one update using the current gradients.
-  virtual void Step() = 0;
+  /// Applies one update using the current gradients, and marks every parameter changed
+  /// (Param::MarkChanged()).
+  void Step();
 
   void set_learning_rate(float lr) { learning_rate_ = lr; }
   float learning_rate() const { return learning_rate_; }
@@ -41,6 +42,8 @@ class Optimizer {
   /// once, in their constructor; both must be members of the optimizer itself.
   void RegisterState(std::vector<Matrix>* buffers) { state_.push_back(buffers); }
   void RegisterStepCounter(int64_t* steps) { steps_ = steps; }
+  /// The update of Step(), writing the parameters' values.
+  virtual void UpdateParams() = 0;
 
  private:
   std::vector<Param> params_;
@@ -57,9 +60,11 @@ class Adam : public Optimizer {
   /// Throws std::invalid_argument unless lr >= 0, 0 <= beta < 1 and eps >= 0.
   explicit Adam(std::vector<Param> params, float lr = 1e-3f, float beta1 = 0.9f,
                 float beta2 = 0.999f, float eps = 1e-8f);
-  void Step() override;
   /// Number of Step() calls so far (t in the formulas).
   int64_t step_count() const { return step_count_; }
+
+ protected:
+  void UpdateParams() override;
 
  private:
   float beta1_;
@@ -79,7 +84,9 @@ class RmsProp : public Optimizer {
   /// Throws std::invalid_argument unless lr >= 0, 0 <= alpha <= 1, eps >= 0 and momentum >= 0.
   explicit RmsProp(std::vector<Param> params, float lr = 1e-2f, float alpha = 0.99f,
                    float eps = 1e-8f, bool centered = false, float momentum = 0.0f);
-  void Step() override;
+
+ protected:
+  void UpdateParams() override;
 
  private:
   float alpha_;

@@ -52,9 +52,20 @@ inline __m512 GatherVector(const PanelLoad* loads, const float* tap_planes) {
   return v;
 }
 
-// The same for any number of loads, the common counts unrolled.
-inline __m512 GatherVector(const PanelLoad* loads, int n, const float* tap_planes) {
-  switch (n) {
+// The loads of one vector in a plan of PlanPanelLoads(): loads[first[v], first[v + 1]).
+struct VectorLoads {
+  const PanelLoad* loads;
+  int n;
+};
+
+inline VectorLoads LoadsOfVector(const PanelLoad* loads, const int* first, int v) {
+  return {loads + first[v], first[v + 1] - first[v]};
+}
+
+// A vector from any number of loads, the common counts unrolled.
+inline __m512 GatherVector(const VectorLoads& vector, const float* tap_planes) {
+  const PanelLoad* loads = vector.loads;
+  switch (vector.n) {
     case 0:
       return _mm512_setzero_ps();
     case 1:
@@ -66,7 +77,7 @@ inline __m512 GatherVector(const PanelLoad* loads, int n, const float* tap_plane
       return GatherVector<3>(loads, tap_planes);
     default: {
       __m512 v = GatherVector<4>(loads, tap_planes);
-      for (int i = 4; i < n; ++i) {
+      for (int i = 4; i < vector.n; ++i) {
         v = _mm512_mask_loadu_ps(v, loads[i].mask, tap_planes + loads[i].src);
       }
       return v;

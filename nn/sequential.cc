@@ -74,7 +74,8 @@ void Sequential::Add(std::unique_ptr<Layer> layer) {
              p.value->cols() == p.grad->cols())
         << layer->Describe() << ": parameter " << p.name << " lacks a matching gradient";
     num_params_ += p.value->size();
-    params_.push_back({prefix + p.name, p.value, p.grad});
+    p.name = prefix + p.name;
+    params_.push_back(p);
   }
   for (Buffer& b : layer->Buffers()) {
     RL_CHECK(b.value != nullptr) << layer->Describe() << ": buffer " << b.name << " is null";
@@ -160,6 +161,7 @@ void Sequential::SetFlat(const float* data, size_t n) {
   }
   for (Param& p : params_) {
     std::copy_n(data, p.value->size(), p.value->data());
+    p.MarkChanged();
     data += p.value->size();
   }
   for (Buffer& b : buffers_) {
@@ -172,7 +174,10 @@ void Sequential::CopyParamsFrom(const Sequential& other) {
   RL_CHECK(architecture_ == other.architecture_)
       << "CopyParamsFrom needs the same architecture: " << architecture_ << " vs "
       << other.architecture_;
-  for (size_t i = 0; i < params_.size(); ++i) *params_[i].value = *other.params_[i].value;
+  for (size_t i = 0; i < params_.size(); ++i) {
+    *params_[i].value = *other.params_[i].value;
+    params_[i].MarkChanged();
+  }
   for (size_t i = 0; i < buffers_.size(); ++i) *buffers_[i].value = *other.buffers_[i].value;
 }
 
@@ -183,6 +188,7 @@ void Sequential::SoftUpdateFrom(const Sequential& other, float tau) {
   for (size_t i = 0; i < params_.size(); ++i) {
     Matrix& mine = *params_[i].value;
     mine = tau * *other.params_[i].value + (1.0f - tau) * mine;
+    params_[i].MarkChanged();
   }
   for (size_t i = 0; i < buffers_.size(); ++i) {
     Matrix& mine = *buffers_[i].value;

@@ -2,6 +2,7 @@
 // one sample per column: a batch of 128 CartPole observations is a 4 x 128 Matrix.
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 // GCC 12's AVX-512 intrinsic headers, which Eigen includes, raise a false -Wmaybe-uninitialized
@@ -41,6 +42,16 @@ struct Param {
   std::string name;  ///< e.g. "0.weight", "2.bias" (layer index in the network, then the tensor).
   Matrix* value;     ///< The parameter.
   Matrix* grad;      ///< Same shape as `value`; layers accumulate into it in Backward().
+  /// Counts the writes of `value` (null for a parameter no layer keeps a copy of): a layer may
+  /// keep a derived copy of the parameter (Linear's weight rounded and packed for bf16 products)
+  /// for as long as the count has not moved. Whoever writes *value through this Param calls
+  /// MarkChanged() before the layer's next Forward(); the optimizers and Sequential's writers
+  /// (SetFlat, CopyParamsFrom, SoftUpdateFrom) do.
+  uint64_t* version = nullptr;
+
+  void MarkChanged() const {
+    if (version != nullptr) ++*version;
+  }
 };
 
 /// A non-trainable tensor that is part of a layer's state, e.g. the running statistics of a batch

@@ -13,6 +13,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -21,6 +22,7 @@
 #include "nn/dueling.h"
 #include "nn/gemm.h"
 #include "nn/linear.h"
+#include "nn/optimizers.h"
 #include "nn/presets.h"
 #include "nn/sequential.h"
 #include "tests/nn/gradient_check.h"
@@ -400,6 +402,65 @@ TEST_P(Bf16LayerTest, LinearMatchesTheFp32KernelOnRoundedInputs) {
                    std::max({in, out, batch}),
                    "linear(" + std::to_string(in) + "," + std::to_string(out) + ")");
   }
+}
+
+// Linear keeps its weight rounded into bf16 pairs from one change of the weight to the next
+// (Param::version). Its forward pass is Gemm()'s in bf16 bit for bit, and after each writer of
+// the weights it is that of a copy made then (which rounds the weights anew), bit for bit: a
+// writer that did not mark the weights changed would leave the old pairs in use.
+TEST_P(Bf16LayerTest, LinearRoundsItsWeightAnewAfterEveryWriter) {
+  if (!NativeBf16()) GTEST_SKIP() << "the weight is kept in bf16 pairs on paths with AVX512_BF16";
+  std::mt19937 rng(9);
+  const Matrix x = RandomMatrix(300, 32, &rng);
+  {
+    Linear layer(300, 100, &rng);
+    layer.set_precision(Precision::kBf16);
+    Matrix want(100, 32);
+    internal::Epilogue epilogue;
+    epilogue.row_bias = layer.bias().data();
+    internal::GemmWorkspace workspace;
+    internal::Gemm(internal::View(std::as_const(layer).weight()), internal::View(x),
+                   internal::View(&want), false, epilogue, &workspace, Precision::kBf16);
+    EXPECT_EQ((layer.Forward(x) - want).cwiseAbs().maxCoeff(), 0.0f);
+    EXPECT_EQ((layer.Forward(x) - want).cwiseAbs().maxCoeff(), 0.0f) << "the second pass";
+  }
+  const std::string architecture = "linear(300,100),relu,linear(100,64),relu,dueling(64,32,5)";
+  Sequential net = BuildFromArchitecture(architecture, &rng);
+  const Sequential other = BuildFromArchitecture(architecture, &rng);
+  net.set_precision(Precision::kBf16);
+  const auto gradients = [&net, &x, &rng] {
+    net.ZeroGrad();
+    net.Forward(x);
+    net.BackwardParams(RandomMatrix(5, 32, &rng));
+  };
+  const auto check_after = [&net, &x](const char* writer, const auto& write) {
+    const Matrix before = net.Forward(x);
+    write();
+    const Matrix after = net.Forward(x);
+    Sequential copy = net;
+    EXPECT_GT((after - before).cwiseAbs().maxCoeff(), 0.0f) << writer << " changed nothing";
+    EXPECT_EQ((after - copy.Forward(x)).cwiseAbs().maxCoeff(), 0.0f)
+        << "after " << writer << " the network computes with weights it no longer has";
+  };
+  Adam adam(net.Params(), 1e-2f);
+  RmsProp rms_prop(net.Params(), 1e-2f);
+  check_after("an Adam step", [&] {
+    gradients();
+    adam.Step();
+  });
+  check_after("an RMSprop step", [&] {
+    gradients();
+    rms_prop.Step();
+  });
+  check_after("SoftUpdateFrom", [&] { net.SoftUpdateFrom(other, 0.5f); });
+  check_after("CopyParamsFrom", [&] { net.CopyParamsFrom(other); });
+  std::vector<float> flat;
+  other.GetFlat(&flat);
+  for (float& v : flat) v *= 0.5f;
+  check_after("SetFlat (a checkpoint's load)", [&] { net.SetFlat(flat.data(), flat.size()); });
+  check_after("Linear::weight()", [&] {
+    dynamic_cast<Linear&>(net.layer(0)).weight() *= 2.0f;  // NOLINT(cppcoreguidelines-pro-type-*)
+  });
 }
 
 // A network passes its precision to every layer, new ones included, and copies keep it: the
