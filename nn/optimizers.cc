@@ -15,7 +15,7 @@ namespace {
 std::vector<Matrix> ZerosLike(const std::vector<Param>& params) {
   std::vector<Matrix> out;
   out.reserve(params.size());
-  for (const Param& p : params) out.push_back(Matrix::Zero(p.value->rows(), p.value->cols()));
+  for (const Param& p : params) out.emplace_back(Matrix::Zero(p.value->rows(), p.value->cols()));
   return out;
 }
 
