@@ -12,6 +12,10 @@ namespace rl {
 /// in `state` unless it is empty (/proc's hex code: "0A" is a TCP socket listening).
 int SocketsOnPort(std::string_view protocol, int port, std::string_view state = "");
 
+/// The same, counting only the sockets this process holds open (those of other processes, say
+/// tests running beside it that picked the same port, do not count).
+int OwnSocketsOnPort(std::string_view protocol, int port);
+
 /// Whether one of a run's three UDP ports (P, P + 1, P + 2: main, bulk, samples) is bound here.
 bool RunPortsInUse(int port);
 

@@ -48,7 +48,9 @@ inline __m512i PairsOfRun(const float* src, int valid) {
   return (__m512i)_mm512_cvtne2ps_pbh(hi, lo);
 }
 
+// The first n lanes (none for n <= 0: the padding rows of a panel).
 inline __mmask16 FirstLanes(int n) {
+  if (n <= 0) return 0;
   return static_cast<__mmask16>(n >= 16 ? 0xFFFFU : (1U << n) - 1U);
 }
 

@@ -2,7 +2,10 @@
 
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <gtest/gtest.h>
 
@@ -52,6 +55,35 @@ TEST(SocketsOnPortTest, CountsTheSocketsOfAPortByProtocolAndState) {
   }
   EXPECT_EQ(SocketsOnPort("udp", udp_port), 0);
   EXPECT_EQ(SocketsOnPort("tcp", tcp_port, "0A"), 0);
+}
+
+// A socket of another process is on the host's count of its port but not on this process's.
+TEST(SocketsOnPortTest, OwnSocketsAreThoseOfThisProcess) {
+  BoundSocket mine(SOCK_DGRAM);
+  EXPECT_EQ(OwnSocketsOnPort("udp", mine.port()), 1);
+  int ports[2];  // the child's port, then its "done"
+  ASSERT_EQ(pipe(ports), 0);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    close(ports[0]);
+    BoundSocket theirs(SOCK_DGRAM);
+    const int port = theirs.port();
+    if (write(ports[1], &port, sizeof(port)) != sizeof(port)) _exit(1);
+    pause();  // until the parent kills it
+    _exit(0);
+  }
+  close(ports[1]);
+  int theirs = 0;
+  const bool got = read(ports[0], &theirs, sizeof(theirs)) == sizeof(theirs);
+  close(ports[0]);
+  if (got) {
+    EXPECT_EQ(SocketsOnPort("udp", theirs), 1);
+    EXPECT_EQ(OwnSocketsOnPort("udp", theirs), 0);
+  }
+  kill(child, SIGKILL);
+  waitpid(child, nullptr, 0);
+  EXPECT_TRUE(got) << "the child did not say its port";
 }
 
 TEST(RunPortsTest, ARunsThreePortsAreInUseWhenAnyIsAndAPickAvoidsThem) {

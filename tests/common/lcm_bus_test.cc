@@ -653,21 +653,22 @@ TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
   }
   bus->Subscribe<rlmsg::stats_actor_t>(channels::kStatsActor, [](const rlmsg::stats_actor_t&) {});
   // LCM closes a port it cannot hear its own test message on (multicast loopback blocked).
-  if (SocketsOnPort("udp", port) == 0) GTEST_SKIP() << "LCM cannot receive multicast here";
+  if (OwnSocketsOnPort("udp", port) == 0) GTEST_SKIP() << "LCM cannot receive multicast here";
   bus->Handle(0);
-  EXPECT_EQ(SocketsOnPort("udp", port), 1);
-  EXPECT_EQ(SocketsOnPort("udp", port + 1), 0) << "the bulk port was bound without a subscription";
+  EXPECT_EQ(OwnSocketsOnPort("udp", port), 1);
+  EXPECT_EQ(OwnSocketsOnPort("udp", port + 1), 0)
+      << "the bulk port was bound without a subscription";
 
   // Subscribed there too, it hears what is published there.
   int weights = 0;
   bus->Subscribe<rlmsg::weights_chunk_t>(
       channels::kWeights, [&weights](const rlmsg::weights_chunk_t&) { ++weights; }, Port::kBulk);
-  EXPECT_EQ(SocketsOnPort("udp", port + 1), 1);
+  EXPECT_EQ(OwnSocketsOnPort("udp", port + 1), 1);
   rlmsg::weights_chunk_t w = examples::Example<rlmsg::weights_chunk_t>();
   ASSERT_TRUE(bus->Publish(channels::kWeights, &w));
   for (int i = 0; i < 100 && weights == 0; ++i) bus->Handle(10);
   EXPECT_EQ(weights, 1);
-  EXPECT_EQ(SocketsOnPort("udp", port + 2), 0)
+  EXPECT_EQ(OwnSocketsOnPort("udp", port + 2), 0)
       << "the samples port was bound without a subscription";
 
   // And the same for the samples port: subscribed, it is bound and hears the replies, which no
@@ -676,7 +677,7 @@ TEST(BusPortsTest, HandleBindsOnlyThePortsWithASubscription) {
   bus->Subscribe<rlmsg::sample_batch_t>(channels::kSamples,
                                         [&replies](const rlmsg::sample_batch_t&) { ++replies; });
   bus->Handle(0);
-  EXPECT_EQ(SocketsOnPort("udp", port + 2), 1);
+  EXPECT_EQ(OwnSocketsOnPort("udp", port + 2), 1);
   rlmsg::sample_batch_t s = examples::Example<rlmsg::sample_batch_t>();
   ASSERT_TRUE(bus->Publish(channels::kSamples, &s));
   for (int i = 0; i < 100 && replies == 0; ++i) bus->Handle(10);
@@ -704,9 +705,9 @@ TEST(BusPortsTest, TheSamplesPortCanShareTheBulkPort) {
   bus->Subscribe<rlmsg::weights_chunk_t>(channels::kWeights,
                                          [&weights](const rlmsg::weights_chunk_t&) { ++weights; });
   bus->Handle(0);
-  if (SocketsOnPort("udp", port + 1) == 0) GTEST_SKIP() << "LCM cannot receive multicast here";
-  EXPECT_EQ(SocketsOnPort("udp", port + 1), 1) << "two sockets on the shared port";
-  EXPECT_EQ(SocketsOnPort("udp", port + 2), 0);
+  if (OwnSocketsOnPort("udp", port + 1) == 0) GTEST_SKIP() << "LCM cannot receive multicast here";
+  EXPECT_EQ(OwnSocketsOnPort("udp", port + 1), 1) << "two sockets on the shared port";
+  EXPECT_EQ(OwnSocketsOnPort("udp", port + 2), 0);
   rlmsg::sample_batch_t s = examples::Example<rlmsg::sample_batch_t>();
   rlmsg::weights_chunk_t w = examples::Example<rlmsg::weights_chunk_t>();
   ASSERT_TRUE(bus->Publish(channels::kSamples, &s));
