@@ -79,14 +79,13 @@ bool Linear::UseWeightPairs() {
     passes_at_version_ = 0;
   }
   ++passes_at_version_;
-  if (have_pairs_ && pairs_version_ == weight_version_) return true;
+  if (!weight_pairs_.empty() && pairs_version_ == weight_version_) return true;
   if (!pairs_pay_ && passes_at_version_ == 1) return false;
   const auto out = static_cast<int>(weight_.rows());
   const auto in = static_cast<int>(weight_.cols());
   weight_pairs_.resize(static_cast<size_t>(internal::PackedPairs(out, in)));
   internal::RoundIntoPairs(internal::View(weight_), weight_pairs_.data());
   pairs_version_ = weight_version_;
-  have_pairs_ = true;
   return true;
 }
 

@@ -84,10 +84,9 @@ class Linear : public Layer {
   Matrix grad_input_;                   // in x batch
   const Matrix* input_ = nullptr;       // The x of the last Forward().
   internal::GemmWorkspace workspace_;   // Scratch space of the products.
-  std::vector<uint32_t> weight_pairs_;  // W as it was at pairs_version_, in bf16 pairs.
+  std::vector<uint32_t> weight_pairs_;  // W as it was at pairs_version_, in bf16 pairs (or none).
   uint64_t weight_version_ = 0;         // Param::version of W.
   uint64_t pairs_version_ = 0;
-  bool have_pairs_ = false;    // weight_pairs_ holds W as it was at pairs_version_.
   uint64_t seen_version_ = 0;  // The version of W at the last bf16 forward pass.
   int passes_at_version_ = 0;  // bf16 forward passes at seen_version_.
   bool pairs_pay_ = true;      // The last version of W served several passes.
