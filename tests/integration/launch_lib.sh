@@ -21,10 +21,11 @@ wait_launch() {  # wait_launch LOG
   tail -8 "$1"
 }
 
-# SIGKILLs the newest process of ROLE in $dir/run/pids; sets victim to its pid.
-kill_role() {  # kill_role ROLE
+# Sends SIGNAL (KILL unless given) to the newest process of ROLE in $dir/run/pids; sets victim
+# to its pid.
+kill_role() {  # kill_role ROLE [SIGNAL]
   victim=$(awk -v r="$1" '$1 == r {p = $2} END {print p}' "$dir/run/pids")
   [ -n "$victim" ] || fail "no pid for $1"
-  kill -KILL "$victim"
-  echo "killed $1 (pid $victim)"
+  kill -"${2:-KILL}" "$victim"
+  echo "sent SIG${2:-KILL} to $1 (pid $victim)"
 }
