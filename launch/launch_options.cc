@@ -185,15 +185,14 @@ so does a hang-up, its terminal closed (exit 129). Bad input is refused before a
 
 The launcher supervises every process: one that fails while the run goes on (a crash, an error
 status, a signal it does not handle, such as SIGKILL) is started again after 1, 2, 4, ... s (at
-most --max-backoff), at most --max-restarts times in a row; one that ran
---reset-restarts-after seconds before it exited starts a new count. One that fails
-with an error status before it is ready, or within 3 s of its start, is not restarted: the run
-stops at once with its log (a snapshot or state it refuses, a bad option). The learner always
-starts with --resume and the replay with --snapshot RUN/replay-snapshot.bin, so that a restarted
-one continues. Restarts are lines of RUN/restarts, of the process's log and of the progress line.
-One that exits with status 0 (its work done, or a SIGTERM, which every process takes as a
-clean stop) is left down: the run goes on without an actor or the recorder; any other process
-down ends it (exit 1).
+most --max-backoff), at most --max-restarts times in a row; one that ran --reset-restarts-after
+seconds before it exited starts a new count. One that fails with an error status before it is
+ready, or within 3 s of its start, is not restarted: the run stops at once with its log (a
+snapshot or state it refuses, a bad option). The learner always starts with --resume and the
+replay with --snapshot RUN/replay-snapshot.bin, so that a restarted one continues. Restarts are
+lines of RUN/restarts, of the process's log and of the progress line. One that exits with status 0
+(its work done, or a SIGTERM, which every process takes as a clean stop) is left down: the run
+goes on without an actor or the recorder; any other process down ends it (exit 1).
 Should the launcher itself die (killed, a crash), its processes get SIGTERM, so that they write
 their last snapshot and state, and a watchdog kills those still running 10 s later. A stop
 (Ctrl-C, --stop, the end of the run) gives every process 10 s, and waits longer for the replay's

@@ -59,7 +59,7 @@ void LearnerConfig::Validate() const {
   }
   if (!(stats_hz > 0)) throw std::invalid_argument("stats-hz must be > 0");
   if (threads < 1 || threads > 64) throw std::invalid_argument("threads must be in [1, 64]");
-  nn::ParsePrecision(precision);
+  if (precision != "auto") nn::ParsePrecision(precision);
 }
 
 float LearningRateScale(int64_t updates, int64_t decay_updates, double end) {
@@ -70,7 +70,7 @@ float LearningRateScale(int64_t updates, int64_t decay_updates, double end) {
 }
 
 Learner::Learner(LearnerConfig config, Bus* bus)
-    : config_((config.Validate(), std::move(config))),
+    : config_(Resolved(std::move(config))),
       bus_(bus),
       spec_(envs::LookupSpec(config_.env_id)),
       algorithm_(MakeAlgorithm(config_, spec_)),
@@ -184,11 +184,29 @@ void Learner::TrainOn(const rlmsg::sample_batch_t& m) {
   ++stat_updates_;
 }
 
-std::string Learner::StatePath() const {
-  return (std::filesystem::path(config_.out_dir) / "checkpoints" / nn::kLearnerStateFile).string();
+std::string Learner::StatePath(const LearnerConfig& c) {
+  return (std::filesystem::path(c.out_dir) / "checkpoints" / nn::kLearnerStateFile).string();
 }
 
-std::string Learner::StateKind() const { return "learner " + config_.algorithm; }
+std::string Learner::StatePath() const { return StatePath(config_); }
+
+LearnerConfig Learner::Resolved(LearnerConfig c) {
+  c.Validate();
+  if (c.precision != "auto") return c;
+  // A resumed run goes on in the precision it was trained in, whatever this CPU runs fast (the
+  // state is read twice then: once here, once by LoadState).
+  if (c.resume && std::filesystem::exists(StatePath(c))) {
+    const StateFile state = StateFile::Load(StatePath(c), StateKind(c));
+    c.precision = state.Has("learner.precision") ? state.Text("learner.precision") : "fp32";
+  } else {
+    c.precision = nn::NativeBf16() ? "bf16" : "fp32";
+  }
+  return c;
+}
+
+std::string Learner::StateKind() const { return StateKind(config_); }
+
+std::string Learner::StateKind(const LearnerConfig& c) { return "learner " + c.algorithm; }
 
 StateFile Learner::SaveState() const {
   StateFile state(StateKind());

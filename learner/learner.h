@@ -56,6 +56,8 @@ struct LearnerConfig {
   double learning_rate_end = 0.1;
   int threads = 1;  // compute threads of the network library (nn::SetNumThreads)
   // The networks' matrix products, "fp32" or "bf16" (nn/precision.h); kept in the learner state.
+  // "auto": bf16 where the CPU runs bf16 products natively (nn::NativeBf16()), fp32 elsewhere,
+  // and on a resume the precision the saved state was trained in. The Learner resolves it.
   std::string precision = "fp32";
   std::string out_dir = ".";  // checkpoints go to <out_dir>/checkpoints/
   // Continue from <out_dir>/checkpoints/learner-state.bin when it exists (written with every
@@ -102,6 +104,8 @@ class Learner {
   std::string StatePath() const;
   // Whether the constructor resumed from a saved state.
   bool resumed() const { return resumed_; }
+  // The networks' precision, "fp32" or "bf16" ("auto" resolved).
+  const std::string& precision() const { return config_.precision; }
 
  private:
   struct Request {
@@ -121,6 +125,10 @@ class Learner {
   StateFile SaveState() const;
   void LoadState(const StateFile& state);
   std::string StateKind() const;
+  static std::string StateKind(const LearnerConfig& c);
+  static std::string StatePath(const LearnerConfig& c);
+  // `c` validated, with precision "auto" resolved (LearnerConfig::precision).
+  static LearnerConfig Resolved(LearnerConfig c);
 
   LearnerConfig config_;
   Bus* bus_;

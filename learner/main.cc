@@ -98,9 +98,10 @@ int Main(int argc, char** argv) {
        "the fraction of the learning rates left at the end of that decay, in [0, 1]")  //
       ("precision", rl::po::value(&c.precision)->default_value(c.precision),
        "the networks' matrix products: fp32, or bf16 (inputs rounded to bfloat16, sums in fp32; "
-       "weights, optimizer, activations and losses stay fp32). bf16 is fast on CPUs with "
-       "AVX512_BF16 and emulated, slower than fp32, elsewhere; the kernels follow the CPU, or "
-       "RL_KERNELS (avx512_bf16, avx512, avx2)")  //
+       "weights, optimizer, activations and losses stay fp32), or auto (bf16 where the CPU has "
+       "AVX512_BF16, fp32 elsewhere; a resume keeps the saved state's). bf16 is fast on CPUs "
+       "with AVX512_BF16 and emulated, slower than fp32, elsewhere; the kernels follow the CPU, "
+       "or RL_KERNELS (avx512_bf16, avx512, avx2)")  //
       ("threads", rl::po::value(&c.threads)->default_value(c.threads),
        "compute threads for the network (convolutions and large products are split; 1 leaves "
        "the other cores to the actors)")  //
@@ -148,21 +149,28 @@ int Main(int argc, char** argv) {
   c.seed = seed;
   // The kernels the networks will run on (throws, naming the reason, when RL_KERNELS asks for a
   // path this CPU cannot run).
+  const std::string kernel_path = rl::nn::KernelPath();
+  rl::InstallStopHandlers();
+  rl::Bus bus(common.MakeBusConfig("learner"));
+  rl::learner::Learner learner(c, &bus);
+  const std::string& precision = learner.precision();
   const std::string& encoder_precision = c.Get<rl::learner::Td3Config>().encoder_precision;
-  std::string kernels = "precision " + c.precision;
+  std::string kernels = "precision " + precision;
+  if (c.precision == "auto") {
+    kernels += learner.resumed()      ? " (auto: the saved state's)"
+               : rl::nn::NativeBf16() ? " (auto: the CPU has AVX512_BF16)"
+                                      : " (auto: no AVX512_BF16)";
+  }
   if (c.algorithm == rl::learner::Td3Config::kName && !encoder_precision.empty()) {
     kernels += " (the shared encoder's: " + encoder_precision + ")";
   }
-  kernels += ", " + rl::nn::KernelPath() + " kernels";
-  if ((c.precision == "bf16" || encoder_precision == "bf16") && !rl::nn::NativeBf16()) {
+  kernels += ", " + kernel_path + " kernels";
+  if ((precision == "bf16" || encoder_precision == "bf16") && !rl::nn::NativeBf16()) {
     kernels += ", bf16 emulated: no AVX512_BF16";
     std::fprintf(stderr,
                  "learner: warning: this CPU (or RL_KERNELS) gives no AVX512_BF16: bf16 products "
                  "are emulated (the same rounding, slower than fp32)\n");
   }
-  rl::InstallStopHandlers();
-  rl::Bus bus(common.MakeBusConfig("learner"));
-  rl::learner::Learner learner(c, &bus);
   std::string shifts;
   if (const int k = c.augment_shift; k > 0) {
     shifts = ", random shifts of up to " + std::to_string(k) + " pixels";

@@ -5,8 +5,10 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <random>
 #include <set>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -16,6 +18,7 @@
 #include "learner/parameter_average.h"
 #include "nn/checkpoint.h"
 #include "nn/parallel.h"
+#include "nn/precision.h"
 #include "rlmsg/checkpoint_t.hpp"
 #include "rlmsg/priority_update_t.hpp"
 #include "rlmsg/sample_request_t.hpp"
@@ -451,6 +454,38 @@ TEST_F(LearnerTest, Bf16ResumesInBf16AndRefusesAnotherPrecision) {
   }
   c.precision = "fp16";
   EXPECT_THROW(c.Validate(), std::invalid_argument);
+}
+
+// precision = auto is bf16 on a kernel path with native bf16 products and fp32 on one without
+// (each path this CPU runs), and a resume keeps the precision the saved state was trained in
+// whatever the path: a bf16 state resumes in bf16 on the fp32-only path, not refused.
+TEST_F(LearnerTest, AutoPrecisionFollowsTheCpuAndAResumeKeepsTheSavedOne) {
+  LearnerConfig c = ShortRun(16, 30, 10);
+  c.precision = "auto";
+  EXPECT_NO_THROW(c.Validate());
+  std::vector<std::unique_ptr<Learner>> alive;  // alive to the end: the bus keeps their handlers
+  for (const std::string& path : nn::RunnableKernelPaths()) {
+    nn::SetKernelPath(path);
+    alive.push_back(std::make_unique<Learner>(c, bus_.get()));
+    const bool native = nn::NativeBf16();
+    EXPECT_EQ(alive.back()->precision(), native ? "bf16" : "fp32") << path;
+    EXPECT_EQ(alive.back()->algorithm().policy().precision(),
+              native ? nn::Precision::kBf16 : nn::Precision::kFp32)
+        << path;
+  }
+  nn::SetKernelPath("auto");
+  LearnerConfig bf16 = c;
+  bf16.precision = "bf16";
+  alive.push_back(std::make_unique<Learner>(bf16, bus_.get()));
+  alive.back()->Run();                                  // writes a bf16 state
+  nn::SetKernelPath(nn::RunnableKernelPaths().back());  // the slowest: bf16 emulated
+  ASSERT_FALSE(nn::NativeBf16());
+  c.resume = true;
+  alive.push_back(std::make_unique<Learner>(c, bus_.get()));
+  nn::SetKernelPath("auto");
+  EXPECT_TRUE(alive.back()->resumed());
+  EXPECT_EQ(alive.back()->precision(), "bf16");
+  EXPECT_EQ(alive.back()->updates(), 30);
 }
 
 TEST_F(LearnerTest, RefusesAStateOfAnotherRunOrATornOne) {
